@@ -1,0 +1,121 @@
+// The free-floating quantities of Yoshida et al. (MATH.md): centroid terms, J*, H*, G*.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/jntspaceinertiamatrix.hpp>
+#include <memory>
+#include <vector>
+
+#include "kdl_space/errors.hpp"
+#include "kdl_space/model.hpp"
+#include "kdl_space/spatial.hpp"
+#include "kdl_space/state.hpp"
+
+namespace kdl_space {
+
+/// \brief Computes, for one state of a FloatingModel, the centroid terms (w, r_g, I_g, M_a,
+/// A_m), the fixed-base H and the generalized inertia H* (eq. 7), and at any contact point the
+/// fixed-base J, the generalized Jacobian J* (eq. 4), the Ex-IIT G* (eq. 11), the grounded
+/// G = J H^-1 J^T (eq. 22) and the locked R_h M_a^-1 R_h^T (eq. 20).
+///
+/// Usage: `compute(state)` once per state (forward kinematics and a composite-rigid-body pass
+/// over the KDL tree, factorisation of H* and H), then any number of contact queries, which
+/// read the result of the last successful `compute`. Every vector and matrix is in the world
+/// frame; twists are (v; w), wrenches (f; n). Compute calls never throw: they return 0 or an
+/// Error code (errors.hpp). Workspaces are sized in the constructor; contact queries use
+/// them, so one solver serves one thread (build one per thread: the model is shared).
+class FreeFloatingSolver {
+ public:
+  explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model);
+
+  const FloatingModel& model() const { return *model_; }
+
+  /// \brief Forward kinematics, centroid terms, H, A_m, H*; factorises H* and H.
+  /// \return E_NOERROR, E_SIZE_MISMATCH (q), E_NOT_FINITE, or E_NOT_POSITIVE_DEFINITE if H* is
+  /// not (then nothing that needs H* is available).
+  int compute(const State& state);
+
+  // --- Results of the last compute() (world frame) ------------------------------------------
+  /// Total mass w [kg].
+  double w() const { return model_->totalMass(); }
+  /// System CoM r_g [m].
+  const Vector3d& r_g() const { return r_g_; }
+  /// Locked inertia about the CoM, I_g (eq. 3) [kg m^2].
+  const Matrix3d& I_g() const { return I_g_; }
+  /// Centroid inertia M_a = diag(w E, I_g) (eq. 12).
+  const Matrix6d& M_a() const { return M_a_; }
+  /// Momentum about r_g produced by unit joint rates with the base still (6 x n).
+  const Matrix6Xd& A_m() const { return A_m_; }
+  /// Fixed-base joint-space inertia H (n x n), armature included.
+  const KDL::JntSpaceInertiaMatrix& H() const { return H_; }
+  /// Generalized inertia H* = H - A_m^T M_a^-1 A_m (eq. 7).
+  const KDL::JntSpaceInertiaMatrix& H_star() const { return H_star_; }
+  /// World pose of body i (model().bodies() order).
+  const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
+  /// Whether H is positive definite (false: the grounded G is unavailable).
+  bool groundedAvailable() const { return H_ok_; }
+
+  // --- Momentum (eq. 2) ----------------------------------------------------------------------
+  /// \brief Total momentum (P_g; L_g), angular part about r_g, from the base twist (linear
+  /// velocity of the base frame's origin, angular velocity) and the joint rates.
+  int momentum(const KDL::Twist& base_twist, const KDL::JntArray& qdot, Vector6d& PL_g) const;
+  /// \brief Inverse of momentum(): the base twist that gives momentum (P_g; L_g) with rates qdot.
+  int baseTwist(const Vector6d& PL_g, const KDL::JntArray& qdot, KDL::Twist& base_twist) const;
+  /// \brief Kinetic energy of the whole system, 1/2 [y; qdot]^T [[M_a, A_m], [A_m^T, H]] [y; qdot].
+  int kineticEnergy(const KDL::Twist& base_twist, const KDL::JntArray& qdot, double& T) const;
+
+  // --- One contact point h ---------------------------------------------------------------------
+  /// World position p_h of the contact point.
+  int contactPoint(const Contact& h, Vector3d& p_h) const;
+  /// R_h = [[E, -skew(r_gh)], [0, E]], r_gh = p_h - r_g (eq. 5).
+  int R_h(const Contact& h, Matrix6d& R) const;
+  /// Fixed-base Jacobian J of h (6 x n; base held still).
+  int J(const Contact& h, KDL::Jacobian& J);
+  /// Generalized Jacobian J* = J - R_h M_a^-1 A_m (eq. 4).
+  int J_star(const Contact& h, KDL::Jacobian& J_star);
+  /// Ex-IIT G* = J* H*^-1 J*^T + R_h M_a^-1 R_h^T (eq. 11).
+  int G_star(const Contact& h, Matrix6d& G);
+  /// Grounded G = J H^-1 J^T (eq. 22); singular where J is (see spectralFigures()).
+  int G_grounded(const Contact& h, Matrix6d& G);
+  /// Locked G = R_h M_a^-1 R_h^T (eq. 20): the whole system as one rigid body.
+  int G_locked(const Contact& h, Matrix6d& G) const;
+  /// Twist of h from joint rates and momentum: t_h = J* qdot + R_h M_a^-1 (P_g; L_g) (eq. 4).
+  int handTwist(const Contact& h, const KDL::JntArray& qdot, const Vector6d& PL_g,
+                KDL::Twist& t_h);
+
+  // --- Several contact points (dual-arm) -------------------------------------------------------
+  /// \brief The 6k x 6k G* over contacts h_1..h_k: blocks
+  /// G*_ij = J*_i H*^-1 J*_j^T + R_i M_a^-1 R_j^T (eq. 11), one factorisation of H* for all.
+  int G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G);
+
+ private:
+  int ready(const Contact& h) const;
+  /// Fixed-base Jacobian of h into J (6 x n, sized).
+  void fixedBaseJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J) const;
+  /// J* of h into J_star (6 x n, sized), eq. 4.
+  void generalizedJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J_star) const;
+  /// x <- M_a^-1 x for a 6-row block (M_a is block diagonal: 1/w and a factorised I_g).
+  void M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const;
+
+  std::shared_ptr<const FloatingModel> model_;
+  bool computed_ = false;
+  bool H_ok_ = false;
+  KDL::Frame world_T_base_;
+  std::vector<KDL::Frame> world_T_body_;  ///< per body
+  std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world
+  std::vector<Matrix6d> I_c_;             ///< per body: composite spatial inertia about r_g
+  Vector3d r_g_ = Vector3d::Zero();
+  Matrix3d I_g_ = Matrix3d::Zero();
+  Matrix6d M_a_ = Matrix6d::Zero();
+  Eigen::LLT<Matrix3d> I_g_llt_;
+  Matrix6Xd A_m_;
+  Matrix6Xd Am_work_;           ///< M_a^-1 A_m (6 x n), kept from compute()
+  KDL::JntSpaceInertiaMatrix H_, H_star_;
+  Eigen::LLT<Eigen::MatrixXd> H_star_llt_, H_llt_;
+  Matrix6Xd J_work_;            ///< contact-query workspace (6 x n)
+  Eigen::MatrixXd X_work_;      ///< H^-1 J^T workspace (n x 6)
+};
+
+}  // namespace kdl_space

@@ -1,0 +1,98 @@
+// The immutable free-floating model: a KDL tree whose root segment is the base (the satellite),
+// the base's own inertia (which kdl_parser drops), joint order and names, and an index-based
+// traversal computed once.
+#pragma once
+
+#include <Eigen/Core>
+#include <kdl/chain.hpp>
+#include <kdl/rigidbodyinertia.hpp>
+#include <kdl/tree.hpp>
+#include <string>
+#include <vector>
+
+namespace kdl_space {
+
+/// A problem that does not stop the computation (a massless link, a root inertia kdl_parser
+/// would have dropped, a dropped floating joint). The library never prints: callers read these.
+struct Diagnostic {
+  std::string element;  ///< the link or joint concerned ("" for the model as a whole)
+  std::string message;  ///< what was found and what the model does about it
+};
+
+/// One rigid link of the model, in traversal order (a parent always precedes its children).
+struct Body {
+  std::string name;        ///< link (KDL segment) name
+  int parent = -1;         ///< index of the parent body; -1 for the base
+  int joint = -1;          ///< index of the movable joint from the parent; -1 if fixed or base
+  KDL::Segment segment;    ///< joint + pose of this body's frame in the parent body's frame
+  double mass = 0.0;       ///< [kg]
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< CoM, this body's frame [m]
+  Eigen::Matrix3d I_com = Eigen::Matrix3d::Zero();     ///< inertia about the CoM, body axes [kg m^2]
+};
+
+/// A contact point h: a body plus an offset in that body's frame (MATH.md conventions).
+struct Contact {
+  int body = -1;                    ///< index into FloatingModel::bodies()
+  KDL::Vector offset = KDL::Vector::Zero();  ///< in the body's frame [m]
+};
+
+/// \brief The free-floating link system A of the paper: base body 0 and links 1..N (a chain or a
+/// tree), n movable joints (revolute, continuous, prismatic; fixed joints merge rigidly).
+///
+/// Immutable once built; solvers share it through `std::shared_ptr<const FloatingModel>`.
+/// Joint order is the KDL tree's joint numbering (q_nr), fixed here once.
+class FloatingModel {
+ public:
+  /// \brief Builds the model from a KDL tree whose root segment is the base, plus the base
+  /// body's inertia (in the base frame, as KDL segments hold theirs).
+  /// \param armature optional rotor inertia per joint (model order), added to H's diagonal.
+  /// \throws ModelError naming the link or joint when the model cannot be used.
+  FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
+                std::vector<double> armature = {}, std::vector<Diagnostic> diagnostics = {});
+
+  /// \brief Same from a chain: its first segment hangs on a base named `base_name`.
+  FloatingModel(const KDL::Chain& chain, const KDL::RigidBodyInertia& base_inertia,
+                const std::string& base_name = "base", std::vector<double> armature = {});
+
+  /// Number of movable joints n.
+  unsigned int nj() const { return static_cast<unsigned int>(joint_names_.size()); }
+  /// Bodies in traversal order; body 0 is the base.
+  const std::vector<Body>& bodies() const { return bodies_; }
+  /// Joint names in model order.
+  const std::vector<std::string>& jointNames() const { return joint_names_; }
+  /// Index of the body each joint moves (model order).
+  const std::vector<int>& jointBody() const { return joint_body_; }
+  /// Rotor inertia per joint (zeros unless given).
+  const std::vector<double>& armature() const { return armature_; }
+  /// Problems found that do not stop the computation.
+  const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
+  /// The KDL tree (root segment = base; the base inertia is in `bodies()[0]`, not in the tree).
+  const KDL::Tree& tree() const { return tree_; }
+  /// Total mass w [kg].
+  double totalMass() const { return total_mass_; }
+
+  /// Index of the joint named `name`, or -1.
+  int jointIndex(const std::string& name) const;
+  /// Index of the body (link) named `name`, or -1.
+  int bodyIndex(const std::string& name) const;
+  /// \brief A contact point on link `link` at `offset` (link frame).
+  /// \throws ModelError if the model has no such link.
+  Contact contact(const std::string& link, const KDL::Vector& offset = KDL::Vector::Zero()) const;
+
+  /// A copy of this model with rotor inertias (model order, size nj()) on the joints.
+  FloatingModel withArmature(std::vector<double> armature) const;
+
+ private:
+  void validate();
+  void checkArmature() const;
+
+  KDL::Tree tree_;
+  std::vector<Body> bodies_;
+  std::vector<std::string> joint_names_;
+  std::vector<int> joint_body_;
+  std::vector<double> armature_;
+  std::vector<Diagnostic> diagnostics_;
+  double total_mass_ = 0.0;
+};
+
+}  // namespace kdl_space

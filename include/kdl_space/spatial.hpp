@@ -1,0 +1,66 @@
+// Pure 6-D algebra in the conventions of MATH.md: twist (v; w), wrench (f; n), world frame.
+// Stateless, allocation-free free functions.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <kdl/frames.hpp>
+
+namespace kdl_space {
+
+using Vector3d = Eigen::Vector3d;
+using Matrix3d = Eigen::Matrix3d;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+/// The one 6x6 alias KDL lacks (spatial inertias, G*, R_h).
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+/// 6 x n matrices indexed by joint (A_m, J, J*).
+using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+/// \brief Cross-product matrix: skew(r) x = r x x (the paper's r-hat, eq. 1).
+Matrix3d skew(const Vector3d& r);
+
+/// \brief Rigid transfer of a twist from point a to point a + r (eq. 5):
+/// `[[E, -skew(r)], [0, E]]`. With r = r_gh it is the paper's R_h; its transpose maps a wrench
+/// at a + r to the same wrench at a (eq. 8).
+Matrix6d transfer(const Vector3d& r);
+
+/// \brief Spatial inertia (6x6, (v; w) order) of a rigid body about a reference point, world
+/// axes: mass m, CoM at c relative to the reference point, inertia I_c about the CoM.
+/// Maps a twist at the reference point to the momentum (P; L about the reference point).
+Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c);
+
+/// \brief Centroid inertia M_a = diag(w E, I_g) (eq. 12).
+Matrix6d centroidInertia(double w, const Matrix3d& I_g);
+
+/// \brief Rank and conditioning of a symmetric positive semi-definite 6x6 matrix (e.g. the
+/// grounded G, which is singular where J is).
+struct SpectralFigures {
+  int rank = 0;                  ///< eigenvalues above `tolerance * largest`
+  double min_eigenvalue = 0.0;
+  double max_eigenvalue = 0.0;
+  double condition = 0.0;        ///< max/min eigenvalue; +inf when singular
+};
+SpectralFigures spectralFigures(const Matrix6d& G, double tolerance = 1e-12);
+
+/// Conversions between KDL and Eigen, same component order.
+inline Vector3d toEigen(const KDL::Vector& v) { return Vector3d(v.x(), v.y(), v.z()); }
+inline Vector6d toEigen(const KDL::Twist& t) {
+  Vector6d r;
+  r << t.vel.x(), t.vel.y(), t.vel.z(), t.rot.x(), t.rot.y(), t.rot.z();
+  return r;
+}
+inline Vector6d toEigen(const KDL::Wrench& w) {
+  Vector6d r;
+  r << w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(), w.torque.z();
+  return r;
+}
+Matrix3d toEigen(const KDL::Rotation& R);
+inline KDL::Vector toKDL(const Vector3d& v) { return KDL::Vector(v.x(), v.y(), v.z()); }
+inline KDL::Twist toTwist(const Vector6d& t) {
+  return KDL::Twist(KDL::Vector(t(0), t(1), t(2)), KDL::Vector(t(3), t(4), t(5)));
+}
+inline KDL::Wrench toWrench(const Vector6d& w) {
+  return KDL::Wrench(KDL::Vector(w(0), w(1), w(2)), KDL::Vector(w(3), w(4), w(5)));
+}
+
+}  // namespace kdl_space

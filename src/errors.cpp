@@ -1,0 +1,17 @@
+#include "kdl_space/errors.hpp"
+
+namespace kdl_space {
+
+const char* strError(int code) {
+  switch (code) {
+    case E_NOERROR: return "no error";
+    case E_SIZE_MISMATCH: return "the size of an input does not match the model";
+    case E_NOT_COMPUTED: return "compute(state) has not succeeded for this solver";
+    case E_NOT_FINITE: return "an input holds NaN or infinite values";
+    case E_NOT_POSITIVE_DEFINITE: return "an inertia matrix is not positive definite";
+    case E_BAD_CONTACT: return "the contact refers to no body of this model";
+    default: return "unknown error";
+  }
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,256 @@
+#include "kdl_space/free_floating_solver.hpp"
+
+#include <cmath>
+
+namespace kdl_space {
+namespace {
+
+bool finite(const KDL::Frame& f) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(f.p(i))) return false;
+    for (int j = 0; j < 3; ++j)
+      if (!std::isfinite(f.M(i, j))) return false;
+  }
+  return true;
+}
+
+/// Moves the reference point of a twist by r (from the old point to the new one).
+Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {
+  Vector6d s = t;
+  s.head<3>() += t.tail<3>().cross(r);
+  return s;
+}
+
+}  // namespace
+
+FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
+    : model_(std::move(model)) {
+  if (!model_) throw ModelError("FreeFloatingSolver: null model");
+  const std::size_t nb = model_->bodies().size();
+  const unsigned int n = model_->nj();
+  world_T_body_.resize(nb);
+  I_c_.resize(nb);
+  S_.resize(n);
+  A_m_.setZero(6, n);
+  Am_work_.setZero(6, n);
+  J_work_.setZero(6, n);
+  X_work_.setZero(n, 6);
+  H_.resize(n);
+  H_star_.resize(n);
+  H_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
+  H_star_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
+}
+
+int FreeFloatingSolver::compute(const State& state) {
+  computed_ = false;
+  H_ok_ = false;
+  const std::vector<Body>& bodies = model_->bodies();
+  const unsigned int n = model_->nj();
+  if (state.q.rows() != n) return E_SIZE_MISMATCH;
+  if (!state.q.data.allFinite() || !finite(state.world_T_base)) return E_NOT_FINITE;
+  world_T_base_ = state.world_T_base;
+  H_.data.setZero();
+
+  // Forward kinematics (parents first); unit joint twists at each moved body's origin.
+  Vector3d first_moment = Vector3d::Zero();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    if (b.parent < 0) {
+      world_T_body_[i] = world_T_base_;
+    } else {
+      const double q = b.joint >= 0 ? state.q(b.joint) : 0.0;
+      const KDL::Frame& world_T_parent = world_T_body_[b.parent];
+      world_T_body_[i] = world_T_parent * b.segment.pose(q);
+      // KDL: twist of the segment tip relative to its parent, parent axes, tip reference point.
+      if (b.joint >= 0) S_[b.joint] = toEigen(world_T_parent.M * b.segment.twist(q, 1.0));
+    }
+    first_moment += b.mass * toEigen(world_T_body_[i] * toKDL(b.com));
+  }
+  r_g_ = first_moment / w();
+
+  // Spatial inertia of every body about r_g (world axes), then composites (children first).
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    const Matrix3d R = toEigen(world_T_body_[i].M);
+    const Vector3d r_gi = toEigen(world_T_body_[i] * toKDL(b.com)) - r_g_;
+    I_c_[i] = spatialInertia(b.mass, r_gi, R * b.I_com * R.transpose());
+  }
+  for (std::size_t i = bodies.size(); i-- > 1;) I_c_[bodies[i].parent] += I_c_[i];
+
+  // Joint twists moved to r_g; A_m and H by the composite-rigid-body pass.
+  for (unsigned int j = 0; j < n; ++j) {
+    const int b = model_->jointBody()[j];
+    S_[j] = shiftTwist(S_[j], r_g_ - toEigen(world_T_body_[b].p));
+  }
+  for (unsigned int j = 0; j < n; ++j) {
+    const int b = model_->jointBody()[j];
+    const Vector6d F = I_c_[b] * S_[j];  // momentum about r_g of the subtree moved by joint j
+    A_m_.col(j) = F;
+    H_(j, j) = S_[j].dot(F) + model_->armature()[j];
+    for (int a = bodies[b].parent; a >= 0; a = bodies[a].parent) {
+      const int k = bodies[a].joint;
+      if (k >= 0) H_(k, j) = H_(j, k) = S_[k].dot(F);
+    }
+  }
+
+  I_g_ = I_c_[0].bottomRightCorner<3, 3>();  // eq. 3 (about r_g the coupling block vanishes)
+  M_a_ = centroidInertia(w(), I_g_);          // eq. 12
+  I_g_llt_.compute(I_g_);
+  if (I_g_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+
+  Am_work_ = A_m_;
+  M_a_solveInPlace(Am_work_);
+  H_star_.data.noalias() = H_.data - A_m_.transpose() * Am_work_;  // eq. 7
+  H_llt_.compute(H_.data);
+  H_ok_ = H_llt_.info() == Eigen::Success;
+  H_star_llt_.compute(H_star_.data);
+  if (H_star_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  computed_ = true;
+  return E_NOERROR;
+}
+
+void FreeFloatingSolver::M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const {
+  x.topRows<3>() /= w();
+  auto angular = x.bottomRows<3>();
+  I_g_llt_.solveInPlace(angular);
+}
+
+int FreeFloatingSolver::momentum(const KDL::Twist& base_twist, const KDL::JntArray& qdot,
+                                 Vector6d& PL_g) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
+  PL_g.noalias() = M_a_ * y + A_m_ * qdot.data;  // eq. 2
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::baseTwist(const Vector6d& PL_g, const KDL::JntArray& qdot,
+                                  KDL::Twist& base_twist) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  Vector6d y = PL_g - A_m_ * qdot.data;
+  M_a_solveInPlace(y);
+  base_twist = toTwist(shiftTwist(y, toEigen(world_T_base_.p) - r_g_));
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::JntArray& qdot,
+                                      double& T) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
+  T = 0.5 * y.dot(M_a_ * y) + y.dot(A_m_ * qdot.data) + 0.5 * qdot.data.dot(H_.data * qdot.data);
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::ready(const Contact& h) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::contactPoint(const Contact& h, Vector3d& p_h) const {
+  if (const int rc = ready(h)) return rc;
+  p_h = toEigen(world_T_body_[h.body] * h.offset);
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::R_h(const Contact& h, Matrix6d& R) const {
+  Vector3d p_h;
+  if (const int rc = contactPoint(h, p_h)) return rc;
+  R = transfer(p_h - r_g_);  // eq. 5
+  return E_NOERROR;
+}
+
+void FreeFloatingSolver::fixedBaseJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J) const {
+  const std::vector<Body>& bodies = model_->bodies();
+  const Vector3d r_gh = toEigen(world_T_body_[h.body] * h.offset) - r_g_;
+  J.setZero();
+  for (int b = h.body; b >= 0; b = bodies[b].parent)
+    if (bodies[b].joint >= 0) J.col(bodies[b].joint) = shiftTwist(S_[bodies[b].joint], r_gh);
+}
+
+void FreeFloatingSolver::generalizedJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J_star) const {
+  fixedBaseJacobian(h, J_star);
+  const Vector3d r_gh = toEigen(world_T_body_[h.body] * h.offset) - r_g_;
+  // J* = J - R_h M_a^-1 A_m (eq. 4); Am_work_ holds M_a^-1 A_m since compute().
+  J_star.topRows<3>() -= Am_work_.topRows<3>() - skew(r_gh) * Am_work_.bottomRows<3>();
+  J_star.bottomRows<3>() -= Am_work_.bottomRows<3>();
+}
+
+int FreeFloatingSolver::J(const Contact& h, KDL::Jacobian& J) {
+  if (const int rc = ready(h)) return rc;
+  if (J.columns() != model_->nj()) return E_SIZE_MISMATCH;
+  fixedBaseJacobian(h, J.data);
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::J_star(const Contact& h, KDL::Jacobian& J_star) {
+  if (const int rc = ready(h)) return rc;
+  if (J_star.columns() != model_->nj()) return E_SIZE_MISMATCH;
+  generalizedJacobian(h, J_star.data);
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::G_locked(const Contact& h, Matrix6d& G) const {
+  Matrix6d R;
+  if (const int rc = R_h(h, R)) return rc;
+  Matrix6d X = R.transpose();
+  M_a_solveInPlace(X);
+  G.noalias() = R * X;  // eq. 20
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
+  if (const int rc = G_locked(h, G)) return rc;
+  generalizedJacobian(h, J_work_);
+  X_work_ = J_work_.transpose();
+  H_star_llt_.solveInPlace(X_work_);
+  G.noalias() += J_work_ * X_work_;  // eq. 11
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
+  if (const int rc = ready(h)) return rc;
+  if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
+  fixedBaseJacobian(h, J_work_);
+  X_work_ = J_work_.transpose();
+  H_llt_.solveInPlace(X_work_);
+  G.noalias() = J_work_ * X_work_;  // eq. 22
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::handTwist(const Contact& h, const KDL::JntArray& qdot, const Vector6d& PL_g,
+                                  KDL::Twist& t_h) {
+  Matrix6d R;
+  if (const int rc = R_h(h, R)) return rc;
+  if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  generalizedJacobian(h, J_work_);
+  Vector6d v_g = PL_g;
+  M_a_solveInPlace(v_g);
+  t_h = toTwist(J_work_ * qdot.data + R * v_g);  // eq. 4
+  return E_NOERROR;
+}
+
+int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G) {
+  const std::size_t k = contacts.size();
+  const unsigned int n = model_->nj();
+  Eigen::MatrixXd J_all(6 * k, n);
+  std::vector<Matrix6d> R(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    if (const int rc = R_h(contacts[i], R[i])) return rc;
+    generalizedJacobian(contacts[i], J_work_);
+    J_all.middleRows<6>(6 * i) = J_work_;
+  }
+  Eigen::MatrixXd X = J_all.transpose();
+  H_star_llt_.solveInPlace(X);  // one factorisation of H* for every block
+  G.noalias() = J_all * X;
+  for (std::size_t i = 0; i < k; ++i) {
+    Matrix6d Y = R[i].transpose();
+    M_a_solveInPlace(Y);
+    for (std::size_t j = 0; j < k; ++j) G.block<6, 6>(6 * j, 6 * i) += R[j] * Y;  // eq. 11
+  }
+  return E_NOERROR;
+}
+
+}  // namespace kdl_space

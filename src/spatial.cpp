@@ -1,0 +1,58 @@
+#include "kdl_space/spatial.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <limits>
+
+namespace kdl_space {
+
+Matrix3d skew(const Vector3d& r) {
+  Matrix3d S;
+  S << 0.0, -r.z(), r.y(),  //
+      r.z(), 0.0, -r.x(),   //
+      -r.y(), r.x(), 0.0;
+  return S;
+}
+
+Matrix6d transfer(const Vector3d& r) {
+  Matrix6d R = Matrix6d::Identity();
+  R.topRightCorner<3, 3>() = -skew(r);  // eq. 5
+  return R;
+}
+
+Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c) {
+  const Matrix3d C = skew(c);
+  Matrix6d M;
+  M.topLeftCorner<3, 3>() = m * Matrix3d::Identity();
+  M.topRightCorner<3, 3>() = -m * C;
+  M.bottomLeftCorner<3, 3>() = m * C;
+  M.bottomRightCorner<3, 3>() = I_c - m * C * C;  // eq. 3, one body
+  return M;
+}
+
+Matrix6d centroidInertia(double w, const Matrix3d& I_g) {
+  Matrix6d M_a = Matrix6d::Zero();
+  M_a.topLeftCorner<3, 3>() = w * Matrix3d::Identity();  // eq. 12
+  M_a.bottomRightCorner<3, 3>() = I_g;
+  return M_a;
+}
+
+SpectralFigures spectralFigures(const Matrix6d& G, double tolerance) {
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(G, Eigen::EigenvaluesOnly);
+  const Vector6d& lambda = eig.eigenvalues();  // ascending
+  SpectralFigures f;
+  f.max_eigenvalue = lambda(5);
+  f.min_eigenvalue = lambda(0);
+  const double threshold = tolerance * std::max(std::abs(lambda(5)), std::numeric_limits<double>::min());
+  for (int i = 0; i < 6; ++i) f.rank += lambda(i) > threshold ? 1 : 0;
+  f.condition = f.rank == 6 ? lambda(5) / lambda(0) : std::numeric_limits<double>::infinity();
+  return f;
+}
+
+Matrix3d toEigen(const KDL::Rotation& R) {
+  Matrix3d M;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) M(i, j) = R(i, j);
+  return M;
+}
+
+}  // namespace kdl_space
