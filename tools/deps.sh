@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages kdl_space needs to build, test and run, when missing.
+# Used by tools/demo.sh and tools/test.sh; safe to run again (installs nothing if all present).
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev
+  libeigen3-dev libgtest-dev nlohmann-json3-dev libcli11-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "tools/deps.sh: installing ${missing[*]}" >&2
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

@@ -1,0 +1,174 @@
+#include "inspect.hpp"
+
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/urdf_loader.hpp"
+
+namespace kdl_space::cli {
+namespace {
+
+struct ContactRequest {
+  std::string link;
+  KDL::Vector offset = KDL::Vector::Zero();
+  bool has_offset = false;
+};
+
+/// Pairs every --offset with the --tip before it (CLI11 records one entry per parsed value).
+std::vector<ContactRequest> pairContacts(const CLI::App& command, const InspectOptions& o) {
+  const CLI::Option* tip = command.get_option("--tip");
+  const CLI::Option* offset = command.get_option("--offset");
+  std::vector<ContactRequest> contacts;
+  std::size_t tips = 0, offset_values = 0;
+  for (const CLI::Option* opt : command.parse_order()) {
+    if (opt == tip) {
+      contacts.push_back({o.tips.at(tips++)});
+    } else if (opt == offset) {
+      if (offset_values % 3 == 0) {
+        if (contacts.empty()) throw UsageError("--offset must follow the --tip it belongs to");
+        ContactRequest& c = contacts.back();
+        if (c.has_offset) throw UsageError("--tip " + c.link + " has two --offset options");
+        c.has_offset = true;
+        const std::size_t k = offset_values;
+        c.offset = KDL::Vector(o.offsets.at(k), o.offsets.at(k + 1), o.offsets.at(k + 2));
+      }
+      ++offset_values;
+    }
+  }
+  return contacts;
+}
+
+std::string describe(const Diagnostic& d) { return d.element.empty() ? d.message : d.element + ": " + d.message; }
+
+}  // namespace
+
+CLI::App* addInspect(CLI::App& app, InspectOptions& o) {
+  CLI::App* cmd = app.add_subcommand("inspect", "Print the free-floating quantities (mass, CoM, I_g, J*, H*, G*) of a URDF robot");
+  cmd->add_option("--urdf", o.urdf, "URDF file; its root link is the free-floating base")->required();
+  cmd->add_option("--tip", o.tips, "Contact link (repeat for several contact points)")->required()
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--offset", o.offsets, "Contact point offset X Y Z in the preceding --tip's frame [m]")
+      ->expected(3)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->type_size(3);
+  cmd->add_option("--q", o.q, "Joint position NAME=VALUE [rad or m]; unnamed joints are 0")
+      ->expected(1, -1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--base-pos", o.base_pos, "Base position X Y Z in the world [m]")->expected(3);
+  cmd->add_option("--base-rpy", o.base_rpy, "Base roll pitch yaw about fixed axes [rad]")->expected(3);
+  cmd->add_flag("--json", o.json, "Print one JSON object instead of the report");
+  return cmd;
+}
+
+void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& out) {
+  const std::vector<ContactRequest> requests = pairContacts(command, o);
+  std::map<std::string, double> q_by_name;
+  for (const std::string& a : o.q) {
+    const auto [name, value] = parseAssignment(a, "--q");
+    if (!q_by_name.emplace(name, value).second) throw UsageError("--q " + name + " given twice");
+  }
+  for (double v : o.base_pos) if (!std::isfinite(v)) throw UsageError("--base-pos: not a finite number");
+  for (double v : o.base_rpy) if (!std::isfinite(v)) throw UsageError("--base-rpy: not a finite number");
+
+  std::shared_ptr<const FloatingModel> model;
+  State state;
+  std::vector<Contact> contacts;
+  try {
+    model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
+    state = State(*model);
+    state.q = jointsByName(*model, q_by_name);
+    for (const ContactRequest& r : requests) contacts.push_back(model->contact(r.link, r.offset));
+  } catch (const ModelError& e) {
+    throw InputError(e.what());
+  }
+  state.world_T_base = basePose(KDL::Vector(o.base_pos[0], o.base_pos[1], o.base_pos[2]),
+                                o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
+
+  FreeFloatingSolver solver(model);
+  if (const int rc = solver.compute(state)) throw InputError(o.urdf + ": " + strError(rc));
+
+  std::vector<std::string> diagnostics;
+  for (const Diagnostic& d : model->diagnostics()) diagnostics.push_back(describe(d));
+  const std::vector<std::string>& joints = model->jointNames();
+  const unsigned int n = model->nj();
+
+  Json json_contacts = Json::array();
+  std::ostringstream report;
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const Contact& h = contacts[i];
+    const std::string& link = requests[i].link;
+    Vector3d p_h;
+    KDL::Jacobian J_star(n);
+    Matrix6d G_star, G_grounded, G_locked;
+    solver.contactPoint(h, p_h);
+    solver.J_star(h, J_star);
+    solver.G_star(h, G_star);
+    solver.G_locked(h, G_locked);
+    const bool grounded = solver.G_grounded(h, G_grounded) == E_NOERROR;
+    if (grounded) {
+      const SpectralFigures f = spectralFigures(G_grounded);
+      if (f.rank < 6) {
+        std::ostringstream s;
+        s << "contact '" << link << "': grounded G = J H^-1 J^T is singular (rank " << f.rank
+          << " of 6): a grounded arm cannot move this point in every direction here";
+        diagnostics.push_back(s.str());
+      }
+    } else {
+      diagnostics.push_back("contact '" + link + "': grounded G unavailable: H is not positive definite");
+    }
+    json_contacts.push_back(Json{{"link", link},
+                                 {"offset", toJson(toEigen(h.offset))},
+                                 {"point", toJson(p_h)},
+                                 {"J_star", toJson(J_star.data)},
+                                 {"G_star", toJson(G_star)},
+                                 {"G_grounded", grounded ? toJson(G_grounded) : Json(nullptr)},
+                                 {"G_locked", toJson(G_locked)}});
+    if (!o.json) {
+      report << "\nContact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", "
+             << h.offset.y() << ", " << h.offset.z() << ") m, at (" << p_h.x() << ", " << p_h.y() << ", "
+             << p_h.z() << ") m in the world\n";
+      printMatrix(report, "J* (generalized Jacobian, eq. 4), one row per joint: twist (v; w) per unit rate",
+                  J_star.data.transpose(), joints, twistLabels());
+      printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", G_star, twistLabels(), twistLabels());
+      if (grounded)
+        printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels());
+      printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels());
+    }
+  }
+  Eigen::MatrixXd G_all;
+  solver.G_star(contacts, G_all);
+
+  if (o.json) {
+    Json j;
+    j["mass"] = solver.w();
+    j["com"] = toJson(solver.r_g());
+    j["I_g"] = toJson(solver.I_g());
+    j["joint_names"] = joints;
+    j["H_star"] = n ? toJson(solver.H_star().data) : Json::array();
+    j["contacts"] = json_contacts;
+    j["G_star_all"] = toJson(G_all);
+    j["diagnostics"] = diagnostics;
+    out << std::setprecision(17) << j.dump(2) << "\n";
+    return;
+  }
+  out << "Free-floating model " << o.urdf << ": base '" << model->bodies()[0].name << "', "
+      << model->bodies().size() << " links, " << n << " movable joints\n";
+  out << "Total mass w = " << solver.w() << " kg\n";
+  out << "System CoM r_g = (" << solver.r_g().x() << ", " << solver.r_g().y() << ", " << solver.r_g().z()
+      << ") m\n";
+  printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
+              {"x", "y", "z"});
+  printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints);
+  out << report.str();
+  if (contacts.size() > 1) {
+    std::vector<std::string> labels;
+    for (const ContactRequest& r : requests)
+      for (const std::string& l : twistLabels()) labels.push_back(r.link + ":" + l);
+    printMatrix(out, "\nG* over all contact points (with cross-coupling blocks)", G_all, labels, labels);
+  }
+  out << "\nDiagnostics:" << (diagnostics.empty() ? " none" : "") << "\n";
+  for (const std::string& d : diagnostics) out << "  - " << d << "\n";
+}
+
+}  // namespace kdl_space::cli

@@ -1,0 +1,36 @@
+// kdl_space: command-line tool. Parses, calls the library, prints. Exit codes: 0 success,
+// 2 usage error, 3 the model or an input cannot be used.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "cli_common.hpp"
+#include "inspect.hpp"
+
+int main(int argc, char** argv) {
+  using namespace kdl_space::cli;
+  CLI::App app{"kdl_space: free-floating space manipulator dynamics (Yoshida et al., Ex-IIT) on Orocos KDL"};
+  app.require_subcommand(1);
+  InspectOptions inspect_options;
+  CLI::App* inspect = addInspect(app, inspect_options);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "kdl_space: " << e.what() << "\n(run 'kdl_space --help' or 'kdl_space <command> --help')\n";
+    return kUsage;
+  }
+  try {
+    if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
+    return kOk;
+  } catch (const UsageError& e) {
+    std::cerr << "kdl_space: " << e.what() << "\n";
+    return kUsage;
+  } catch (const InputError& e) {
+    std::cerr << "kdl_space: " << e.what() << "\n";
+    return kUnusable;
+  } catch (const std::exception& e) {
+    std::cerr << "kdl_space: cannot complete: " << e.what() << "\n";
+    return kUnusable;
+  }
+}
