@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "kdl_space/spatial.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"
 
