@@ -14,6 +14,13 @@ bool finite(const KDL::Frame& f) {
   return true;
 }
 
+/// Averages a square matrix with its transpose in place (removes round-off asymmetry).
+template <typename Derived>
+void symmetrize(Eigen::MatrixBase<Derived>& A) {
+  for (Eigen::Index i = 0; i < A.rows(); ++i)
+    for (Eigen::Index j = i + 1; j < A.cols(); ++j) A(i, j) = A(j, i) = 0.5 * (A(i, j) + A(j, i));
+}
+
 /// Moves the reference point of a twist by r (from the old point to the new one).
 Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {
   Vector6d s = t;
@@ -101,6 +108,7 @@ int FreeFloatingSolver::compute(const State& state) {
   Am_work_ = A_m_;
   M_a_solveInPlace(Am_work_);
   H_star_.data.noalias() = H_.data - A_m_.transpose() * Am_work_;  // eq. 7
+  symmetrize(H_star_.data);
   H_llt_.compute(H_.data);
   H_ok_ = H_llt_.info() == Eigen::Success;
   H_star_llt_.compute(H_star_.data);
@@ -198,6 +206,7 @@ int FreeFloatingSolver::G_locked(const Contact& h, Matrix6d& G) const {
   Matrix6d X = R.transpose();
   M_a_solveInPlace(X);
   G.noalias() = R * X;  // eq. 20
+  symmetrize(G);
   return E_NOERROR;
 }
 
@@ -207,6 +216,7 @@ int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
   X_work_ = J_work_.transpose();
   H_star_llt_.solveInPlace(X_work_);
   G.noalias() += J_work_ * X_work_;  // eq. 11
+  symmetrize(G);
   return E_NOERROR;
 }
 
@@ -217,6 +227,7 @@ int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
   X_work_ = J_work_.transpose();
   H_llt_.solveInPlace(X_work_);
   G.noalias() = J_work_ * X_work_;  // eq. 22
+  symmetrize(G);
   return E_NOERROR;
 }
 
@@ -250,6 +261,7 @@ int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::Matr
     M_a_solveInPlace(Y);
     for (std::size_t j = 0; j < k; ++j) G.block<6, 6>(6 * j, 6 * i) += R[j] * Y;  // eq. 11
   }
+  symmetrize(G);
   return E_NOERROR;
 }
 
