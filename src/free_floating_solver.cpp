@@ -243,6 +243,43 @@ int FreeFloatingSolver::handTwist(const Contact& h, const KDL::JntArray& qdot, c
   return E_NOERROR;
 }
 
+int FreeFloatingSolver::G(const Contact& h, Response response, Matrix6d& G) {
+  switch (response) {
+    case Response::FreeFloating: return G_star(h, G);
+    case Response::Grounded: return G_grounded(h, G);
+    case Response::JointsLocked: return G_locked(h, G);
+  }
+  return E_BAD_CONTACT;
+}
+
+int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const Vector6d& F,
+                                     Vector6d& dPL_g, KDL::JntArray& dqdot) {
+  Matrix6d R;
+  if (const int rc = R_h(h, R)) return rc;
+  if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!F.allFinite()) return E_NOT_FINITE;
+  dPL_g.setZero();
+  SetToZero(dqdot);
+  switch (response) {
+    case Response::FreeFloating:
+      generalizedJacobian(h, J_work_);
+      dqdot.data.noalias() = J_work_.transpose() * F;
+      H_star_llt_.solveInPlace(dqdot.data);  // eq. 18: dqdot = H*^-1 J*^T F
+      dPL_g.noalias() = R.transpose() * F;   // eq. 8
+      break;
+    case Response::Grounded:
+      if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
+      fixedBaseJacobian(h, J_work_);
+      dqdot.data.noalias() = J_work_.transpose() * F;
+      H_llt_.solveInPlace(dqdot.data);  // eq. 23
+      break;
+    case Response::JointsLocked:
+      dPL_g.noalias() = R.transpose() * F;  // eq. 21
+      break;
+  }
+  return E_NOERROR;
+}
+
 int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G) {
   const std::size_t k = contacts.size();
   const unsigned int n = model_->nj();

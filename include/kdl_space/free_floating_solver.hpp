@@ -15,6 +15,14 @@
 
 namespace kdl_space {
 
+/// How the robot answers an impulse at a contact point: the paper's three cases, as options of
+/// one solver rather than separate code paths.
+enum class Response {
+  FreeFloating,  ///< base free: G* (eq. 11), the general case
+  Grounded,      ///< base held still: G = J H^-1 J^T (eq. 22/23)
+  JointsLocked,  ///< joints braked: one rigid body, R_h M_a^-1 R_h^T (eq. 20/21)
+};
+
 /// \brief Computes, for one state of a FloatingModel, the centroid terms (w, r_g, I_g, M_a,
 /// A_m), the fixed-base H and the generalized inertia H* (eq. 7), and at any contact point the
 /// fixed-base J, the generalized Jacobian J* (eq. 4), the Ex-IIT G* (eq. 11), the grounded
@@ -84,6 +92,16 @@ class FreeFloatingSolver {
   /// Twist of h from joint rates and momentum: t_h = J* qdot + R_h M_a^-1 (P_g; L_g) (eq. 4).
   int handTwist(const Contact& h, const KDL::JntArray& qdot, const Vector6d& PL_g,
                 KDL::Twist& t_h);
+
+  // --- Impulses (section 4) -------------------------------------------------------------------
+  /// \brief The inverse inertia seen at h for a response: G*, the grounded G or the locked G.
+  int G(const Contact& h, Response response, Matrix6d& G);
+  /// \brief Velocity jump from an impulse wrench F (on the robot, at h, world frame):
+  /// FreeFloating: dqdot = H*^-1 J*^T F, d(P_g; L_g) = R_h^T F (eq. 8, 18);
+  /// Grounded: dqdot = H^-1 J^T F, no momentum change of the base (the ground takes it);
+  /// JointsLocked: dqdot = 0, d(P_g; L_g) = R_h^T F.
+  int velocityJump(const Contact& h, Response response, const Vector6d& F, Vector6d& dPL_g,
+                   KDL::JntArray& dqdot);
 
   // --- Several contact points (dual-arm) -------------------------------------------------------
   /// \brief The 6k x 6k G* over contacts h_1..h_k: blocks

@@ -1,0 +1,119 @@
+// The whole of both systems before and after an impact: the impulse from impact.hpp applied to
+// a free-floating robot (FreeFloatingSolver) and to what it hits (a rigid body or another
+// free-floating robot), with momentum and energy accounting.
+#pragma once
+
+#include <memory>
+
+#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/impact.hpp"
+
+namespace kdl_space {
+
+/// Velocity of a free-floating system: base twist (linear velocity of the base frame's origin,
+/// angular velocity; world frame) and joint rates (model order).
+struct FloatingVelocity {
+  KDL::Twist base_twist = KDL::Twist::Zero();
+  KDL::JntArray qdot;
+};
+
+/// A free rigid body (the target): everything in the world frame.
+struct RigidBody {
+  double mass = 0.0;                           ///< [kg]
+  Matrix3d I_com = Matrix3d::Identity();       ///< inertia about the CoM, world axes [kg m^2]
+  Vector3d com = Vector3d::Zero();             ///< CoM position [m]
+  Vector6d twist = Vector6d::Zero();           ///< (v of the CoM; w)
+};
+
+/// One side of an impact: its inverse inertia and contact twist before, and its state after an
+/// impulse. Implemented for a free-floating robot and for a rigid body.
+class ImpactSide {
+ public:
+  virtual ~ImpactSide() = default;
+  /// Inverse inertia at the contact point (G*, G, or G_B), twist per impulse.
+  virtual const Matrix6d& G() const = 0;
+  /// Twist of the side's material point at the contact point, before / after the impulse.
+  virtual const Vector6d& contactTwistBefore() const = 0;
+  virtual Vector6d contactTwistAfter() const = 0;
+  /// Linear momentum and angular momentum about the world origin, before / after.
+  virtual Vector6d momentumBefore() const = 0;
+  virtual Vector6d momentumAfter() const = 0;
+  /// Kinetic energy before / after [J].
+  virtual double energyBefore() const = 0;
+  virtual double energyAfter() const = 0;
+  /// \brief Applies the impulse wrench F received by this side at the contact point.
+  /// \return 0 or an Error code.
+  virtual int applyImpulse(const Vector6d& F) = 0;
+};
+
+/// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
+/// The solver must have computed the state; the side keeps a reference to it (and uses it).
+class FloatingSide : public ImpactSide {
+ public:
+  /// \throws ModelError if the solver's compute() failed, the contact is unknown, qdot has the
+  /// wrong size, or the response is unavailable (grounded with a singular H).
+  FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
+               Response response = Response::FreeFloating);
+
+  const Matrix6d& G() const override { return G_; }
+  const Vector6d& contactTwistBefore() const override { return t_before_; }
+  Vector6d contactTwistAfter() const override { return t_after_; }
+  Vector6d momentumBefore() const override { return aboutOrigin(PL_before_); }
+  Vector6d momentumAfter() const override { return aboutOrigin(PL_after_); }
+  double energyBefore() const override { return T_before_; }
+  double energyAfter() const override { return T_after_; }
+  int applyImpulse(const Vector6d& F) override;
+
+  const FloatingVelocity& before() const { return before_; }
+  /// The base twist and joint rates after the last applyImpulse (before it: equal to before()).
+  const FloatingVelocity& after() const { return after_; }
+  /// Locked twist at the system CoM before / after: (v_g; w_g) = M_a^-1 (P_g; L_g).
+  Vector6d centroidTwistBefore() const;
+  Vector6d centroidTwistAfter() const;
+
+ private:
+  Vector6d aboutOrigin(const Vector6d& PL_g) const;
+  Vector6d contactTwist(const FloatingVelocity& v) const;
+  FreeFloatingSolver& solver_;
+  Contact h_;
+  Response response_;
+  Matrix6d G_;
+  FloatingVelocity before_, after_;
+  Vector6d PL_before_, PL_after_, t_before_, t_after_;
+  double T_before_ = 0.0, T_after_ = 0.0;
+};
+
+/// \brief A rigid body as an impact side, touched at a world point.
+class RigidBodySide : public ImpactSide {
+ public:
+  /// \throws ModelError if the mass is not > 0 or the inertia is not positive definite.
+  RigidBodySide(const RigidBody& body, const Vector3d& contact_point);
+
+  const Matrix6d& G() const override { return G_; }
+  const Vector6d& contactTwistBefore() const override { return t_before_; }
+  Vector6d contactTwistAfter() const override;
+  Vector6d momentumBefore() const override { return momentum(body_.twist); }
+  Vector6d momentumAfter() const override { return momentum(twist_after_); }
+  double energyBefore() const override { return energy(body_.twist); }
+  double energyAfter() const override { return energy(twist_after_); }
+  int applyImpulse(const Vector6d& F) override;
+
+  /// Twist at the CoM before / after.
+  const Vector6d& twistBefore() const { return body_.twist; }
+  const Vector6d& twistAfter() const { return twist_after_; }
+
+ private:
+  Vector6d momentum(const Vector6d& twist) const;
+  double energy(const Vector6d& twist) const;
+  RigidBody body_;
+  Vector3d r_bc_;
+  Matrix6d G_;
+  Vector6d t_before_, twist_after_;
+};
+
+/// \brief Solves the impact between A (the robot) and B (the target) with `law`, and applies
+/// the impulse: F to A, -F to B. Afterwards each side reports its state after.
+/// \return the impulse (on A), or throws ModelError if a side rejects it.
+Impulse collide(ImpactSide& A, ImpactSide& B, const ImpactLaw& law);
+
+}  // namespace kdl_space

@@ -1,0 +1,54 @@
+// Impact laws between two bodies that touch at one point (section 4 of the paper, MATH.md).
+// Pure functions of the two sides' inverse inertias at the contact point and their contact
+// twists: stateless, allocation-free.
+//
+// Sign convention: F is the impulse wrench on side A (the robot) at the contact point, world
+// frame; side B (the target) receives -F. The unit normal n points from A's contact point toward
+// B. A approaches B when u_n = n^T (v_A - v_B) > 0.
+#pragma once
+
+#include "kdl_space/spatial.hpp"
+
+namespace kdl_space {
+
+/// The impact laws a user can choose.
+enum class ImpactKind {
+  Capture,               ///< rigid 6-D grasp: both contact twists equal afterwards (eq. 24-25)
+  PointImpact,           ///< frictionless, Newton restitution e along n
+  FrictionalImpact,      ///< Newton restitution e along n and Coulomb friction mu
+  TranslationalCapture,  ///< linear velocities equal afterwards, rotation free (probe in a drogue)
+};
+
+/// An impact law and its parameters.
+struct ImpactLaw {
+  ImpactKind kind = ImpactKind::Capture;
+  Vector3d normal = Vector3d::UnitX();  ///< unit, from A toward B (point impacts)
+  double restitution = 0.0;             ///< e in [0, 1] (point impacts)
+  double friction = 0.0;                ///< mu >= 0 (FrictionalImpact)
+};
+
+/// The impulse an impact law gives.
+struct Impulse {
+  Vector6d F = Vector6d::Zero();  ///< impulse wrench on A at the contact point (B gets -F)
+  bool separating = false;        ///< point impacts: already separating along n, no impulse
+  bool sticking = false;          ///< FrictionalImpact: tangential slip stopped (else sliding)
+};
+
+/// \brief Solves an impact law.
+/// \param G_A, G_B inverse inertias (Ex-IIT) of A and B at the contact point (twist per impulse)
+/// \param t_A, t_B twists of A's and B's material points at the contact point before the impact
+/// Uses (G_A + G_B), never G_A^-1, so a grounded A at a singular configuration is fine.
+/// Frictional model: Newton's kinematic restitution along n with Coulomb's law (see
+/// docs/IMPACT.md): the sticking impulse if it lies in the friction cone, else sliding with the
+/// friction impulse at the cone's edge opposite the initial slip direction (Brach 1991).
+Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
+                    const ImpactLaw& law);
+
+/// \brief Virtual mass of a side along a unit direction n: 1 / (n^T G_vv n) (the seed's ref. 3).
+double virtualMass(const Matrix6d& G, const Vector3d& n);
+
+/// \brief Inverse inertia of a rigid body B at a point c: G_B = R_b M_b^-1 R_b^T (eq. 15-17),
+/// mass m, inertia I_com about the CoM (world axes), r_bc = p_c - p_b.
+Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
+
+}  // namespace kdl_space
