@@ -20,12 +20,14 @@ std::string quoted(const std::string& s) { return "'" + s + "'"; }
 class CapturedLog : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages.push_back(text);
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors.push_back(text);
   }
-  std::vector<std::string> messages;
+  std::vector<std::string> errors;
 };
 
-/// Parses with urdfdom; its messages become the error text.
+/// Parses with urdfdom; its error messages become the error text. urdfdom returns a model even
+/// after some errors (an unparsable number in <inertial> leaves the link massless): any logged
+/// error refuses the file.
 urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& source) {
   static std::mutex console_mutex;  // console_bridge's handler is process-wide
   std::lock_guard<std::mutex> lock(console_mutex);
@@ -35,13 +37,13 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& s
   try {
     model = urdf::parseURDF(xml);
   } catch (const std::exception& e) {
-    log.messages.push_back(e.what());
+    log.errors.push_back(e.what());
   }
   console_bridge::restorePreviousOutputHandler();
-  if (!model) {
+  if (!model || !log.errors.empty()) {
     std::string why;
-    for (const std::string& m : log.messages) why += (why.empty() ? "" : "; ") + m;
-    throw ModelError(source + ": not a usable URDF" + (why.empty() ? "" : ": " + why));
+    for (const std::string& m : log.errors) why += (why.empty() ? "" : "; ") + m;
+    throw ModelError(source + ": not XML or not a usable URDF" + (why.empty() ? "" : ": " + why));
   }
   return model;
 }

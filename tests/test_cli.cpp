@@ -2,34 +2,13 @@
 // reference engine, the readable report, and every exit code.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <fstream>
-#include <sstream>
 
+#include "cli_runner.hpp"
 #include "reference_case.hpp"
 
 namespace kdl_space::test {
 namespace {
-
-struct ToolRun {
-  int rc;
-  std::string out, err;
-};
-
-/// Runs the tool with `args` (already shell-quoted where needed).
-ToolRun kdlSpace(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "kdl_space_cli_stderr.txt";
-  const std::string cmd = std::string(KDL_SPACE_CLI) + " " + args + " 2>" + err_file;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buffer[4096];
-  while (std::size_t n = fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
-  const int status = pclose(pipe);
-  std::ifstream e(err_file);
-  std::stringstream err;
-  err << e.rdbuf();
-  return {WEXITSTATUS(status), out, err.str()};
-}
 
 const std::string kTwolink = dataDir() + "/reference/models/spacedyn_twolink.urdf";
 

@@ -21,8 +21,8 @@ namespace {
 
 /// Adds, below `parent_name` of `dst`, a copy of every segment below `src` (same segments).
 void copySubtree(const KDL::SegmentMap::const_iterator& src, const std::string& parent_name, KDL::Tree& dst) {
-  for (const auto& child : KDL::GetTreeElementChildren(src->second)) {
-    if (!dst.addSegment(KDL::GetTreeElementSegment(child->second), parent_name))
+  for (const auto& child : GetTreeElementChildren(src->second)) {
+    if (!dst.addSegment(GetTreeElementSegment(child->second), parent_name))
       throw std::runtime_error("virtual route: cannot add segment " + child->first);
     copySubtree(child, child->first, dst);
   }
@@ -105,9 +105,9 @@ VirtualJointTree::VirtualJointTree(const FloatingModel& model, const State& stat
     : tree_(buildVirtualTree(model, state.world_T_base)), n_(static_cast<int>(model.nj())) {
   std::map<std::string, int> by_name;
   for (const auto& [name, element] : tree_.getSegments()) {
-    const KDL::Segment& seg = KDL::GetTreeElementSegment(element);
+    const KDL::Segment& seg = GetTreeElementSegment(element);
     if (seg.getJoint().getType() != KDL::Joint::None)
-      by_name[seg.getJoint().getName()] = static_cast<int>(KDL::GetTreeElementQNr(element));
+      by_name[seg.getJoint().getName()] = static_cast<int>(GetTreeElementQNr(element));
   }
   index_ = coordinateIndex(model, by_name);
   const unsigned int nt = tree_.getNrOfJoints();

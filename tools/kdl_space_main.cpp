@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "capture.hpp"
 #include "cli_common.hpp"
 #include "inspect.hpp"
 
@@ -12,6 +13,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   InspectOptions inspect_options;
   CLI::App* inspect = addInspect(app, inspect_options);
+  CaptureOptions capture_options;
+  CLI::App* capture = addCapture(app, capture_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -22,6 +25,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
+    if (capture->parsed()) runCapture(capture_options, std::cout);
     return kOk;
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";

@@ -31,16 +31,17 @@ struct ImpactLaw {
 struct Impulse {
   Vector6d F = Vector6d::Zero();  ///< impulse wrench on A at the contact point (B gets -F)
   bool separating = false;        ///< point impacts: already separating along n, no impulse
-  bool sticking = false;          ///< FrictionalImpact: tangential slip stopped (else sliding)
+  bool sticking = false;          ///< FrictionalImpact: no slip at the end of the impact
 };
 
 /// \brief Solves an impact law.
 /// \param G_A, G_B inverse inertias (Ex-IIT) of A and B at the contact point (twist per impulse)
 /// \param t_A, t_B twists of A's and B's material points at the contact point before the impact
 /// Uses (G_A + G_B), never G_A^-1, so a grounded A at a singular configuration is fine.
-/// Frictional model: Newton's kinematic restitution along n with Coulomb's law (see
-/// docs/IMPACT.md): the sticking impulse if it lies in the friction cone, else sliding with the
-/// friction impulse at the cone's edge opposite the initial slip direction (Brach 1991).
+/// Frictional model (docs/IMPACT.md): Coulomb friction through the impact by Routh's method in
+/// impulse space, sticking while the sticking impulse rate lies in the cone and sliding against
+/// the slip otherwise, with Stronge's energetic restitution e (Stronge 2000, ch. 5). Never adds
+/// energy, always in the cone; with mu = 0 it is PointImpact (Newton's and Stronge's e agree).
 Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
                     const ImpactLaw& law);
 

@@ -1,0 +1,159 @@
+// `kdl_space capture` end to end: reference cases written as scenario files (YAML and JSON),
+// the JSON contract, the shipped example scenarios, and bad scenarios naming their field.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "cli_runner.hpp"
+#include "reference_case.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+constexpr double kRel = 1e-9;
+constexpr double kAbs = 1e-12;
+const std::string kScenarios = dataDir() + "/scenarios/";
+
+std::vector<std::string> keys(const nlohmann::json& j) {
+  std::vector<std::string> k;
+  for (const auto& item : j.items()) k.push_back(item.key());
+  return k;  // nlohmann::json keeps keys sorted
+}
+
+Eigen::MatrixXd m(const nlohmann::json& j) { return ReferenceCase::mat(j); }
+
+struct Case {
+  std::string reference, scenario;
+};
+
+class CaptureTool : public ::testing::TestWithParam<Case> {};
+
+TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
+  const ReferenceCase c(GetParam().reference);
+  const bool capture = GetParam().scenario.find("capture") != std::string::npos;
+  const nlohmann::json& e = c.json.at(capture ? "capture" : "point_impact");
+  const ToolRun r = kdlSpace("capture " + kScenarios + GetParam().scenario + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(keys(j), (std::vector<std::string>{"G_B", "G_star", "energy_after", "energy_before", "energy_lost",
+                                               "impulse", "momentum_after", "momentum_before", "robot", "target",
+                                               "virtual_mass"}));
+  EXPECT_EQ(keys(j.at("robot")), (std::vector<std::string>{"base_twist_after", "base_twist_before",
+                                                           "contact_twist_after", "contact_twist_before",
+                                                           "joint_names", "qdot_after", "qdot_before"}));
+  EXPECT_EQ(keys(j.at("target")), (std::vector<std::string>{"twist_after", "twist_before"}));
+
+  const nlohmann::json& robot = j.at("robot");
+  EXPECT_EQ(robot.at("joint_names"), c.json.at("expected").at("joint_names"));
+  if (capture) {
+    EXPECT_TRUE(near(m(j.at("impulse")), m(e.at("impulse_on_robot")), kRel, kAbs, "impulse"));
+    EXPECT_TRUE(near(m(robot.at("contact_twist_before")), m(e.at("contact_twist_before")), kRel, kAbs, "before"));
+    Vector6d momentum;
+    momentum << m(e.at("linear_momentum")), m(e.at("angular_momentum_about_origin"));
+    EXPECT_TRUE(near(m(j.at("momentum_before")), momentum, kRel, kAbs, "momentum_before"));
+    EXPECT_TRUE(near(m(j.at("momentum_after")), momentum, kRel, kAbs, "momentum_after"));
+  } else {
+    const Vector3d n = m(e.at("normal"));
+    const double lambda = e.at("impulse_magnitude_on_target").get<double>();
+    EXPECT_TRUE(near(m(j.at("impulse")), (Vector6d() << -lambda * n, Vector3d::Zero()).finished(), kRel, kAbs, "impulse"));
+  }
+  EXPECT_TRUE(near(m(robot.at("contact_twist_after")), m(e.at("contact_twist_after")), kRel, kAbs, "contact after"));
+  EXPECT_TRUE(near(m(robot.at("base_twist_after")), m(e.at("base_twist_after")), kRel, kAbs, "base after"));
+  EXPECT_TRUE(near(m(robot.at("qdot_after")), m(e.at("qdot_after")), kRel, kAbs, "qdot after"));
+  EXPECT_TRUE(near(m(j.at("target").at("twist_after")), m(e.at("target_twist_after")), kRel, kAbs, "target after"));
+  const double T0 = e.at("energy_before").get<double>(), T1 = e.at("energy_after").get<double>();
+  EXPECT_NEAR(j.at("energy_before").get<double>(), T0, kRel * T0);
+  EXPECT_NEAR(j.at("energy_after").get<double>(), T1, kRel * T1);
+  EXPECT_NEAR(j.at("energy_lost").get<double>(), T0 - T1, kRel * T0);
+  // Virtual mass along the normal: 1 / (n^T G*_vv n) of the reference's G*.
+  const Vector3d n = m(c.json.at("inputs").at("target").at("contact_normal"));
+  const Eigen::Matrix3d G_vv = m(c.json.at("expected").at("G_star")).topLeftCorner(3, 3);
+  EXPECT_NEAR(j.at("virtual_mass").get<double>(), 1.0 / n.dot(G_vv * n), kRel / n.dot(G_vv * n));
+  EXPECT_TRUE(near(m(j.at("G_star")), m(c.json.at("expected").at("G_star")), kRel, kAbs, "G_star"));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenarios, CaptureTool,
+    ::testing::Values(Case{"twolink_bent", "twolink_bent_capture.yaml"}, Case{"twolink_bent", "twolink_bent_point.yaml"},
+                      Case{"arm6_reach", "arm6_reach_capture.json"}, Case{"arm6_reach", "arm6_reach_point.json"},
+                      Case{"arm6_elbow_contact", "arm6_elbow_contact_capture.yaml"},
+                      Case{"arm6_elbow_contact", "arm6_elbow_contact_point.yaml"}));
+
+TEST(CaptureTool, ShippedScenariosRunAndConserveMomentum) {
+  for (const char* name : {"tumbling_box_capture", "heavy_satellite_capture", "restitution_bounce",
+                           "robot_to_robot_capture"}) {
+    const ToolRun r = kdlSpace("capture " + std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/" + name + ".yaml --json");
+    ASSERT_EQ(r.rc, 0) << name << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const Eigen::MatrixXd before = m(j.at("momentum_before")), after = m(j.at("momentum_after"));
+    EXPECT_TRUE(near(after, before, 1e-12, 1e-12 * before.norm(), name));
+    EXPECT_GE(j.at("energy_lost").get<double>(), -1e-12 * j.at("energy_before").get<double>()) << name;
+    const ToolRun text = kdlSpace("capture " + std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/" + name + ".yaml");
+    ASSERT_EQ(text.rc, 0);
+    for (const char* s : {"Impulse on the robot", "Kinetic energy", "joint7", "Momentum"})
+      EXPECT_NE(text.out.find(s), std::string::npos) << name << ": " << s;
+  }
+}
+
+/// Writes `text` as a scenario next to the test data (so relative URDF paths resolve).
+std::string scenarioFile(const std::string& name, const std::string& text) {
+  const std::string path = kScenarios + "tmp_" + name + "_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* kGood = R"(
+robot:
+  urdf: ../reference/models/spacedyn_twolink.urdf
+  contact: {link: hand}
+  q: {joint1: 0.5}
+target:
+  mass: 20
+  inertia: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+  pose: {position: [5.5, 0, 0]}
+  twist: [-0.1, 0, 0, 0, 0, 0]
+law: {type: point, normal: [1, 0, 0], restitution: 0.5}
+)";
+
+TEST(CaptureTool, BadScenariosNameTheField) {
+  const std::string good = kGood;
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  const struct {
+    std::string name, text, needle;
+  } cases[] = {
+      {"mass", with("mass: 20", "mass: -3"), "target.mass"},
+      {"restitution", with("restitution: 0.5", "restitution: 1.5"), "law.restitution"},
+      {"normal", with("normal: [1, 0, 0]", "normal: [0, 0, 0]"), "law.normal"},
+      {"inertia", with("[[1, 0, 0], [0, 1, 0], [0, 0, 1]]", "[[1, 0, 0], [0, -1, 0], [0, 0, 1]]"), "target.inertia"},
+      {"joint", with("joint1: 0.5", "elbow: 0.5"), "elbow"},
+      {"link", with("link: hand", "link: gripper"), "gripper"},
+      {"urdf", with("spacedyn_twolink.urdf", "missing.urdf"), "missing.urdf"},
+      {"law", with("type: point", "type: bounce"), "law.type"},
+      {"unknown", with("law:", "colour: red\nlaw:"), "colour"},
+      {"number", with("mass: 20", "mass: heavy"), "target.mass"},
+      {"missing", with("  mass: 20\n", ""), "target.mass"},
+      {"yaml", with("law: {", "law: {{"), "YAML"},
+  };
+  for (const auto& c : cases) {
+    const std::string file = scenarioFile(c.name, c.text);
+    const ToolRun r = kdlSpace("capture " + file);
+    std::remove(file.c_str());
+    EXPECT_EQ(r.rc, 3) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(r.out, "") << c.name;
+  }
+  const std::string file = scenarioFile("good", good);
+  EXPECT_EQ(kdlSpace("capture " + file).rc, 0);
+  std::remove(file.c_str());
+  EXPECT_EQ(kdlSpace("capture /nonexistent.yaml").rc, 3);
+  EXPECT_EQ(kdlSpace("capture").rc, 2);
+}
+
+}  // namespace
+}  // namespace kdl_space::test
