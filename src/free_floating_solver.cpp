@@ -37,6 +37,7 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   const unsigned int n = model_->nj();
   world_T_body_.resize(nb);
   I_c_.resize(nb);
+  I_body_.resize(nb);
   S_.resize(n);
   A_m_.setZero(6, n);
   Am_work_.setZero(6, n);
@@ -80,7 +81,8 @@ int FreeFloatingSolver::compute(const State& state) {
     const Body& b = bodies[i];
     const Matrix3d R = toEigen(world_T_body_[i].M);
     const Vector3d r_gi = toEigen(world_T_body_[i] * toKDL(b.com)) - r_g_;
-    I_c_[i] = spatialInertia(b.mass, r_gi, R * b.I_com * R.transpose());
+    I_body_[i] = spatialInertia(b.mass, r_gi, R * b.I_com * R.transpose());
+    I_c_[i] = I_body_[i];
   }
   for (std::size_t i = bodies.size(); i-- > 1;) I_c_[bodies[i].parent] += I_c_[i];
 

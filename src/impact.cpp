@@ -10,6 +10,7 @@ namespace {
 struct SlipProcess {
   Vector3d P = Vector3d::Zero();  ///< impulse on B
   bool sticking = false;          ///< the contact ends the impact without slip
+  bool completed_by_max_dissipation = false;
 };
 
 /// \brief Frictional point impact by Routh's method in impulse space with Stronge's energetic
@@ -34,7 +35,8 @@ class SlipProcessSolver {
     double absorbed = 0.0;  // work of the normal impulse in compression
     for (int step = 0; step < kMaxSteps; ++step) {
       const Vector3d u_t = tangential(y.u);
-      if (u_t.norm() <= eps_) {
+      // Slip below the round-off of u_t = u - (n.u) n is no slip.
+      if (u_t.norm() <= eps_ + kRoundOff * y.u.norm()) {
         y.u -= u_t;  // exactly on the stick manifold
         Vector3d tau;
         if (stickImpulseRate(tau)) {
@@ -60,9 +62,9 @@ class SlipProcessSolver {
         continue;
       }
       // Sliding: one RK4 step that changes u by a small fraction of its size (or of the initial
-      // speed near the end of compression), cut back to the first event inside it.
-      // Near the end of slip, at most half the remaining slip per step: the approach to
-      // sticking is geometric and the slip direction never jumps within a step.
+      // speed near the end of compression), and at most half the remaining slip: the approach
+      // to sticking is geometric and the slip direction never jumps within a step. Cut back to
+      // the first event inside it.
       const Vector3d Wd = W_ * (n_ + mu_ * u_t / u_t.norm());
       const double h = std::min(kStepFraction * std::max(y.u.norm(), 1e-3 * scale) / Wd.norm(),
                                 0.5 * u_t.norm() / std::max(tangential(Wd).norm(), 1e-300));
@@ -82,12 +84,47 @@ class SlipProcessSolver {
       }
       if (!compression && absorbed - y.work >= e_ * e_ * absorbed * (1.0 - 1e-15)) return {y.P, false};
     }
-    return {y.P, false};  // not reached for positive definite W
+    // Step budget spent: a contact that chatters between stick and slip (seen only for extremely
+    // anisotropic W). Complete the impact from here with the maximum-dissipation impulse, which
+    // lies in the cone, stops the approach and can only lose energy (Anitescu 2006).
+    SlipProcess out{y.P + maximumDissipationImpulse(y.u), false};
+    out.completed_by_max_dissipation = true;
+    return out;
   }
 
  private:
+  /// argmin 1/2 P^T W P - P^T u over the cone |P_t| <= mu P_n: the sticking impulse W^-1 u if it
+  /// lies in the cone, else the best impulse on the cone's surface (a 1-D search over the slip
+  /// angle: along d = n + mu s the best magnitude is max(0, d.u) / d.W d).
+  Vector3d maximumDissipationImpulse(const Vector3d& u) const {
+    const Vector3d P_stick = W_.llt().solve(u);
+    const double P_n = n_.dot(P_stick);
+    if (P_n >= 0.0 && tangential(P_stick).norm() <= mu_ * P_n) return P_stick;
+    const Vector3d t1 = n_.unitOrthogonal(), t2 = n_.cross(t1);
+    const auto direction = [&](double a) { return Vector3d(n_ + mu_ * (std::cos(a) * t1 + std::sin(a) * t2)); };
+    const auto release = [&](double a) {
+      const Vector3d d = direction(a);
+      const double c = std::max(0.0, d.dot(u));
+      return c * c / d.dot(W_ * d);
+    };
+    constexpr int kSamples = 720;
+    constexpr double kTwoPi = 6.283185307179586, kGolden = 0.6180339887498949;
+    double best = 0.0, best_release = -1.0;
+    for (int i = 0; i < kSamples; ++i)
+      if (const double r = release(kTwoPi * i / kSamples); r > best_release) best_release = r, best = kTwoPi * i / kSamples;
+    double lo = best - kTwoPi / kSamples, hi = best + kTwoPi / kSamples;
+    double x1 = hi - kGolden * (hi - lo), x2 = lo + kGolden * (hi - lo), f1 = release(x1), f2 = release(x2);
+    for (int it = 0; it < 100 && hi - lo > 1e-15; ++it) {
+      if (f1 < f2) lo = x1, x1 = x2, f1 = f2, x2 = lo + kGolden * (hi - lo), f2 = release(x2);
+      else hi = x2, x2 = x1, f2 = f1, x1 = hi - kGolden * (hi - lo), f1 = release(x1);
+    }
+    const Vector3d d = direction(0.5 * (lo + hi));
+    return std::max(0.0, d.dot(u)) / d.dot(W_ * d) * d;
+  }
+
   static constexpr double kStepFraction = 2e-3;  ///< relative change of u per RK4 step
-  static constexpr int kMaxSteps = 1000000;
+  static constexpr double kRoundOff = 1e-12;     ///< relative floor of |u_t| (W's rounding)
+  static constexpr int kMaxSteps = 100000;
 
   struct State {
     Vector3d u;   ///< relative velocity of A with respect to B
@@ -171,7 +208,7 @@ Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_
   const Matrix6d G = G_A + G_B;  // relative twist jump per impulse: d(t_A - t_B) = G F
   const Matrix3d W = G.topLeftCorner<3, 3>();
   const Vector3d u = t_A.head<3>() - t_B.head<3>();  // relative linear velocity of A w.r.t. B
-  const Vector3d& n = law.normal;
+  const Vector3d n = law.normal.normalized();  // unit to round-off whatever the caller gave
   switch (law.kind) {
     case ImpactKind::Capture:
       out.F = G.llt().solve(t_B - t_A);  // eq. 24
@@ -197,6 +234,7 @@ Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_
     const SlipProcess sp = SlipProcessSolver(W, n, law.friction, e).solve(u);
     P = sp.P;
     out.sticking = sp.sticking;
+    out.max_dissipation_completion = sp.completed_by_max_dissipation;
   }
   out.F.head<3>() = -P;
   return out;

@@ -27,6 +27,7 @@ struct Case {
 };
 
 class CaptureTool : public ::testing::TestWithParam<Case> {};
+inline void PrintTo(const Case& c, std::ostream* os) { *os << c.scenario; }
 
 TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
   const ReferenceCase c(GetParam().reference);

@@ -67,6 +67,8 @@ std::vector<LinkPoint> contactPoints(const ModelCase& c, const FloatingModel& mo
 Eigen::MatrixXd dense(const KDL::JntSpaceInertiaMatrix& m) { return m.data; }
 
 class Independent : public ::testing::TestWithParam<ModelCase> {};
+// Names the parameter in test listings (instead of a byte dump).
+inline void PrintTo(const ModelCase& c, std::ostream* os) { *os << c.name; }
 
 TEST_P(Independent, JointOrderOfTheModelIsTheTreeNumbering) {
   // The model's joint order is documented as the KDL tree's q_nr: check it by name.

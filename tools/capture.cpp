@@ -147,7 +147,9 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
   out << "Target twist at its CoM:    before " << row(target_before) << "\n"
       << "                            after  " << row(target_after) << "\n";
   out << "Base twist:                 before " << row(toEigen(robot->before().base_twist)) << "\n"
-      << "                            after  " << row(toEigen(robot->after().base_twist)) << "\n";
+      << "                            after  " << row(toEigen(robot->after().base_twist)) << "\n"
+      << "                            jump   "
+      << row(toEigen(robot->after().base_twist) - toEigen(robot->before().base_twist)) << "\n";
   printMatrix(out, "Joint rates [rad/s or m/s]",
               (Eigen::MatrixXd(joints.size(), 3) << robot->before().qdot.data, robot->after().qdot.data,
                robot->after().qdot.data - robot->before().qdot.data).finished(),

@@ -62,6 +62,10 @@ class FreeFloatingSolver {
   const KDL::JntSpaceInertiaMatrix& H_star() const { return H_star_; }
   /// World pose of body i (model().bodies() order).
   const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
+  /// Unit twist of joint j (model order), world frame, at the point r_g.
+  const Vector6d& S(int j) const { return S_[j]; }
+  /// Spatial inertia of body i alone, world frame, about the point r_g.
+  const Matrix6d& bodyInertia(int i) const { return I_body_[i]; }
   /// Whether H is positive definite (false: the grounded G is unavailable).
   bool groundedAvailable() const { return H_ok_; }
 
@@ -123,6 +127,7 @@ class FreeFloatingSolver {
   KDL::Frame world_T_base_;
   std::vector<KDL::Frame> world_T_body_;  ///< per body
   std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world
+  std::vector<Matrix6d> I_body_;          ///< per body: its spatial inertia about r_g
   std::vector<Matrix6d> I_c_;             ///< per body: composite spatial inertia about r_g
   Vector3d r_g_ = Vector3d::Zero();
   Matrix3d I_g_ = Matrix3d::Zero();

@@ -32,6 +32,9 @@ struct Impulse {
   Vector6d F = Vector6d::Zero();  ///< impulse wrench on A at the contact point (B gets -F)
   bool separating = false;        ///< point impacts: already separating along n, no impulse
   bool sticking = false;          ///< FrictionalImpact: no slip at the end of the impact
+  /// FrictionalImpact: the slip process chattered past its step budget (extremely anisotropic
+  /// G) and was completed by the maximum-dissipation impulse (docs/IMPACT.md).
+  bool max_dissipation_completion = false;
 };
 
 /// \brief Solves an impact law.
