@@ -194,4 +194,36 @@ FloatingModel FloatingModel::withArmature(std::vector<double> armature) const {
   return copy;
 }
 
+namespace {
+/// Copies the children of `from` (in `source`) below `hook` in `target`, adding `payload` to
+/// the segment named `link`.
+void copyChildren(const KDL::Tree& source, KDL::SegmentMap::const_iterator from, const std::string& hook,
+                  KDL::Tree& target, const std::string& link, const KDL::RigidBodyInertia& payload) {
+  for (const auto& child : GetTreeElementChildren(from->second)) {
+    const KDL::Segment& seg = GetTreeElementSegment(child->second);
+    const KDL::RigidBodyInertia inertia = seg.getName() == link ? seg.getInertia() + payload : seg.getInertia();
+    target.addSegment(KDL::Segment(seg.getName(), seg.getJoint(), seg.pose(0.0), inertia), hook);
+    copyChildren(source, child, seg.getName(), target, link, payload);
+  }
+}
+}  // namespace
+
+FloatingModel FloatingModel::withPayload(const std::string& link, const KDL::RigidBodyInertia& inertia) const {
+  const int body = bodyIndex(link);
+  if (body < 0) throw ModelError("payload: the model has no link " + quoted(link));
+  // Rebuild the tree with the payload in the link's segment (the base's inertia lives apart).
+  const KDL::SegmentMap::const_iterator root = tree_.getRootSegment();
+  KDL::Tree tree(root->first);
+  copyChildren(tree_, root, root->first, tree, link, inertia);
+  const Matrix3d& I = bodies_[0].I_com;
+  KDL::RigidBodyInertia base(bodies_[0].mass, toKDL(bodies_[0].com),
+                             KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+  if (body == 0) base = base + inertia;
+  std::vector<Diagnostic> diagnostics = diagnostics_;
+  diagnostics.push_back({link, "carries a rigid payload of " + std::to_string(inertia.getMass()) + " kg"});
+  FloatingModel merged(tree, base, armature_, {});
+  merged.diagnostics_ = std::move(diagnostics);
+  return merged;
+}
+
 }  // namespace kdl_space

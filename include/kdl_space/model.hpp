@@ -82,6 +82,11 @@ class FloatingModel {
   /// A copy of this model with rotor inertias (model order, size nj()) on the joints.
   FloatingModel withArmature(std::vector<double> armature) const;
 
+  /// \brief A copy of this model with a rigid payload merged into link `link` (e.g. a captured
+  /// target): `inertia` is the payload's, in that link's frame (KDL convention: mass, CoM, and
+  /// rotational inertia about the CoM at construction). \throws ModelError for an unknown link.
+  FloatingModel withPayload(const std::string& link, const KDL::RigidBodyInertia& inertia) const;
+
  private:
   void validate();
   void checkArmature() const;

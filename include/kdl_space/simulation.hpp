@@ -1,0 +1,108 @@
+// The motion of a free-floating system over time (section 6 of the paper): integrate the
+// equations of motion from a state, e.g. the one right after a capture.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "kdl_space/forward_dynamics.hpp"
+
+namespace kdl_space {
+
+/// Time integration schemes.
+enum class Integrator {
+  RK4,              ///< classical fixed-step Runge-Kutta, order 4
+  DormandPrince54,  ///< adaptive embedded Runge-Kutta 5(4) with error control (Dormand & Prince 1980)
+};
+
+/// What drives a joint.
+struct JointControl {
+  enum class Mode {
+    Free,    ///< zero torque
+    Locked,  ///< brakes on: the joint moves with its neighbour (rate held at zero)
+    PD,      ///< servo to a set point: tau = kp (set_point - q) - kd qdot
+  };
+  Mode mode = Mode::Free;
+  double kp = 0.0, kd = 0.0, set_point = 0.0;
+};
+
+/// Integration settings; all are the user's.
+struct SimulationOptions {
+  Integrator integrator = Integrator::DormandPrince54;
+  double step = 1e-3;      ///< RK4 step; first trial step of the adaptive method [s]
+  double rtol = 1e-10;     ///< adaptive: relative tolerance per state component
+  double atol = 1e-12;     ///< adaptive: absolute tolerance per state component
+  double max_step = 0.05;  ///< adaptive: largest step [s]
+  Vector3d gravity = Vector3d::Zero();  ///< world frame; zero in orbit
+};
+
+/// Time, configuration and velocity of the system.
+struct SimulationState {
+  double t = 0.0;
+  State state;                ///< base pose (world_T_base) and joint positions
+  FloatingVelocity velocity;  ///< base twist (v of the base origin; w) and joint rates
+};
+
+/// Joint torques from the user's own controller, added to those of the joint modes.
+using TorqueCallback = std::function<void(const SimulationState&, KDL::JntArray& tau)>;
+
+/// Counters of the last run().
+struct SimulationStats {
+  long accepted_steps = 0;
+  long rejected_steps = 0;
+};
+
+/// \brief Integrates the free-floating equations of motion.
+///
+/// The state integrated is (base position, base orientation as a unit quaternion, q, total
+/// momentum (P; L about the world origin), qdot). The base twist follows from the momentum and
+/// the joint rates (eq. 2), so with no external force the momentum is an exact invariant of every
+/// Runge-Kutta step; the orientation is renormalised after every step (no Euler angles).
+class Simulator {
+ public:
+  explicit Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options = {});
+
+  const FloatingModel& model() const { return dynamics_.model(); }
+  const SimulationOptions& options() const { return options_; }
+  /// \throws ModelError for a joint index out of range or a negative gain.
+  void setJointControl(unsigned int joint, const JointControl& control);
+  const std::vector<JointControl>& jointControls() const { return controls_; }
+  void setTorqueCallback(TorqueCallback callback) { callback_ = std::move(callback); }
+
+  /// \brief Brakes on: the locked joints' rates become zero by an internal impulse (momentum
+  /// unchanged), as when brakes engage. Call before run() if locked joints may be moving.
+  int engageBrakes(SimulationState& s);
+
+  /// \brief Integrates from s.t to t_end. `observer` (may be empty) sees s.t, every multiple of
+  /// output_dt after it, and t_end. \return 0 or an Error code (state left at the last good step).
+  int run(SimulationState& s, double t_end, double output_dt,
+          const std::function<void(const SimulationState&)>& observer);
+
+  /// Kinetic energy and momentum (P; L about the world origin) of a state.
+  int energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O);
+
+  const SimulationStats& stats() const { return stats_; }
+
+ private:
+  using Vector = Eigen::VectorXd;
+  void pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const;
+  int unpack(const Vector& x, double t, SimulationState& s);
+  int derivative(double t, const Vector& x, Vector& dx);
+  int stepRK4(double t, double h, Vector& x);
+  int stepDP54(double t, double h, Vector& x, double& error);
+
+  ForwardDynamicsSolver dynamics_;
+  SimulationOptions options_;
+  std::vector<JointControl> controls_;
+  TorqueCallback callback_;
+  SimulationStats stats_;
+  // workspaces
+  SimulationState scratch_;
+  KDL::JntArray tau_;
+  FloatingAcceleration acc_;
+  std::vector<Vector> k_;
+  Vector x_tmp_, x_new_;
+};
+
+}  // namespace kdl_space

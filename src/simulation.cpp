@@ -1,0 +1,233 @@
+#include "kdl_space/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kdl_space {
+namespace {
+
+// Dormand & Prince (1980) RK5(4)7M tableau.
+constexpr double kC[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+constexpr double kA[7][6] = {
+    {},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+constexpr double kB5[7] = {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0.0};
+constexpr double kB4[7] = {5179.0 / 57600, 0.0, 7571.0 / 16695, 393.0 / 640, -92097.0 / 339200, 187.0 / 2100, 1.0 / 40};
+
+}  // namespace
+
+Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
+    : dynamics_(std::move(model)), options_(options) {
+  const unsigned int n = this->model().nj();
+  controls_.assign(n, JointControl{});
+  scratch_.state = State(this->model());
+  scratch_.velocity.qdot = KDL::JntArray(n);
+  tau_ = KDL::JntArray(n);
+  acc_.qddot = KDL::JntArray(n);
+  const int size = 13 + 2 * static_cast<int>(n);
+  k_.assign(7, Vector::Zero(size));
+  x_tmp_.setZero(size);
+  x_new_.setZero(size);
+  dynamics_.setGravity(options_.gravity);
+  if (!(options_.step > 0.0) || !(options_.rtol > 0.0) || !(options_.atol > 0.0) || !(options_.max_step > 0.0))
+    throw ModelError("simulation: step, rtol, atol and max_step must be > 0");
+}
+
+void Simulator::setJointControl(unsigned int joint, const JointControl& control) {
+  if (joint >= controls_.size()) throw ModelError("simulation: joint index " + std::to_string(joint) + " out of range");
+  if (control.kp < 0.0 || control.kd < 0.0 || !std::isfinite(control.kp) || !std::isfinite(control.kd) ||
+      !std::isfinite(control.set_point))
+    throw ModelError("simulation: joint '" + model().jointNames()[joint] + "': gains must be finite and >= 0");
+  controls_[joint] = control;
+  std::vector<bool> locked(controls_.size());
+  for (std::size_t j = 0; j < controls_.size(); ++j) locked[j] = controls_[j].mode == JointControl::Mode::Locked;
+  dynamics_.setLocked(locked);
+}
+
+int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
+  FreeFloatingSolver& k = dynamics_.kinematics();
+  if (const int rc = k.compute(s.state)) return rc;
+  Vector6d PL_g;
+  if (const int rc = k.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
+  h_O = PL_g;
+  h_O.tail<3>() += k.r_g().cross(PL_g.head<3>());  // L_O = L_g + r_g x P
+  return k.kineticEnergy(s.velocity.base_twist, s.velocity.qdot, T);
+}
+
+int Simulator::engageBrakes(SimulationState& s) {
+  const unsigned int n = model().nj();
+  std::vector<unsigned int> locked;
+  for (unsigned int j = 0; j < n; ++j)
+    if (controls_[j].mode == JointControl::Mode::Locked && s.velocity.qdot(j) != 0.0) locked.push_back(j);
+  if (locked.empty()) return E_NOERROR;
+  FreeFloatingSolver& k = dynamics_.kinematics();
+  if (const int rc = k.compute(s.state)) return rc;
+  // Generalized velocity nu = (twist at r_g; qdot), mass matrix [[M_a, A_m], [A_m^T, H]]:
+  // nu+ = nu - M^-1 G^T (G M^-1 G^T)^-1 G nu, G selecting the locked rates. The base rows of
+  // M nu (the momentum) are unchanged: the brake impulse is internal.
+  Eigen::MatrixXd M(6 + n, 6 + n);
+  M << k.M_a(), k.A_m(), k.A_m().transpose(), k.H().data;
+  Eigen::VectorXd nu(6 + n);
+  const Vector3d p_b = toEigen(s.state.world_T_base.p);
+  Vector6d y = toEigen(s.velocity.base_twist);
+  y.head<3>() += y.tail<3>().cross(k.r_g() - p_b);
+  nu << y, s.velocity.qdot.data;
+  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(6 + n, locked.size());
+  for (std::size_t i = 0; i < locked.size(); ++i) Gt(6 + locked[i], i) = 1.0;
+  const Eigen::LLT<Eigen::MatrixXd> M_llt(M);
+  if (M_llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  const Eigen::MatrixXd X = M_llt.solve(Gt);
+  const Eigen::VectorXd lambda = (Gt.transpose() * X).llt().solve(Gt.transpose() * nu);
+  nu -= X * lambda;
+  for (unsigned int j : locked) nu(6 + j) = 0.0;  // exactly
+  y = nu.head<6>();
+  y.head<3>() += y.tail<3>().cross(p_b - k.r_g());
+  s.velocity.base_twist = toTwist(y);
+  s.velocity.qdot.data = nu.tail(n);
+  return E_NOERROR;
+}
+
+void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const {
+  const unsigned int n = model().nj();
+  const KDL::Frame& T = s.state.world_T_base;
+  double qx, qy, qz, qw;
+  T.M.GetQuaternion(qx, qy, qz, qw);
+  x.head<3>() = toEigen(T.p);
+  x.segment<4>(3) << qx, qy, qz, qw;
+  x.segment(7, n) = s.state.q.data;
+  x.segment<6>(7 + n) = h_O;
+  x.tail(n) = s.velocity.qdot.data;
+}
+
+int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
+  const unsigned int n = model().nj();
+  const Eigen::Vector4d quat = x.segment<4>(3).normalized();
+  s.t = t;
+  s.state.world_T_base = KDL::Frame(KDL::Rotation::Quaternion(quat(0), quat(1), quat(2), quat(3)),
+                                    KDL::Vector(x(0), x(1), x(2)));
+  s.state.q.data = x.segment(7, n);
+  s.velocity.qdot.data = x.tail(n);
+  FreeFloatingSolver& k = dynamics_.kinematics();
+  if (const int rc = k.compute(s.state)) return rc;
+  Vector6d PL_g = x.segment<6>(7 + n);
+  PL_g.tail<3>() -= k.r_g().cross(PL_g.head<3>());  // L_g = L_O - r_g x P
+  return k.baseTwist(PL_g, s.velocity.qdot, s.velocity.base_twist);  // eq. 2
+}
+
+int Simulator::derivative(double t, const Vector& x, Vector& dx) {
+  const unsigned int n = model().nj();
+  if (const int rc = unpack(x, t, scratch_)) return rc;
+  for (unsigned int j = 0; j < n; ++j) {
+    const JointControl& c = controls_[j];
+    tau_(j) = c.mode == JointControl::Mode::PD
+                  ? c.kp * (c.set_point - scratch_.state.q(j)) - c.kd * scratch_.velocity.qdot(j)
+                  : 0.0;
+  }
+  if (callback_) {
+    KDL::JntArray extra(n);
+    callback_(scratch_, extra);
+    if (extra.rows() != n) return E_SIZE_MISMATCH;
+    tau_.data += extra.data;
+  }
+  if (const int rc = dynamics_.CartToJnt(scratch_.state, scratch_.velocity, tau_, {}, acc_)) return rc;
+  const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
+  const Eigen::Vector4d quat = x.segment<4>(3);
+  dx.head<3>() = toEigen(scratch_.velocity.base_twist.vel);
+  dx.segment<3>(3) = 0.5 * (quat(3) * w + w.cross(quat.head<3>()));  // 1/2 (0, w) * q, w in world
+  dx(6) = -0.5 * w.dot(quat.head<3>());
+  dx.segment(7, n) = x.tail(n);
+  const double mass = model().totalMass();
+  const Vector3d& r_g = dynamics_.kinematics().r_g();
+  dx.segment<3>(7 + n) = mass * options_.gravity;                    // dP/dt: external force
+  dx.segment<3>(10 + n) = r_g.cross(mass * options_.gravity);        // dL_O/dt: its moment
+  dx.tail(n) = acc_.qddot.data;
+  return E_NOERROR;
+}
+
+int Simulator::stepRK4(double t, double h, Vector& x) {
+  if (int rc = derivative(t, x, k_[0])) return rc;
+  x_tmp_ = x + 0.5 * h * k_[0];
+  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[1])) return rc;
+  x_tmp_ = x + 0.5 * h * k_[1];
+  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[2])) return rc;
+  x_tmp_ = x + h * k_[2];
+  if (int rc = derivative(t + h, x_tmp_, k_[3])) return rc;
+  x += h / 6.0 * (k_[0] + 2.0 * k_[1] + 2.0 * k_[2] + k_[3]);
+  return E_NOERROR;
+}
+
+int Simulator::stepDP54(double t, double h, Vector& x, double& error) {
+  for (int i = 0; i < 7; ++i) {
+    x_tmp_ = x;
+    for (int j = 0; j < i; ++j) x_tmp_ += h * kA[i][j] * k_[j];
+    if (int rc = derivative(t + kC[i] * h, x_tmp_, k_[i])) return rc;
+  }
+  x_new_ = x;
+  x_tmp_.setZero();  // the error estimate
+  for (int i = 0; i < 7; ++i) {
+    x_new_ += h * kB5[i] * k_[i];
+    x_tmp_ += h * (kB5[i] - kB4[i]) * k_[i];
+  }
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const double scale = options_.atol + options_.rtol * std::max(std::abs(x(i)), std::abs(x_new_(i)));
+    sum += (x_tmp_(i) / scale) * (x_tmp_(i) / scale);
+  }
+  error = std::sqrt(sum / static_cast<double>(x.size()));
+  return std::isfinite(error) ? E_NOERROR : E_NOT_FINITE;
+}
+
+int Simulator::run(SimulationState& s, double t_end, double output_dt,
+                   const std::function<void(const SimulationState&)>& observer) {
+  stats_ = {};
+  const unsigned int n = model().nj();
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!std::isfinite(t_end) || !std::isfinite(s.t) || !(output_dt > 0.0) || t_end < s.t) return E_NOT_FINITE;
+  double T;
+  Vector6d h_O;
+  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
+  Vector x(13 + 2 * n);
+  pack(s, h_O, x);
+  if (const int rc = unpack(x, s.t, s)) return rc;
+  if (observer) observer(s);
+
+  double t = s.t, h = std::min(options_.step, options_.max_step);
+  long outputs = 1;
+  const double t0 = s.t;
+  while (t < t_end) {
+    const double t_out = std::min(t0 + outputs * output_dt, t_end);
+    const double h_try = std::min(h, t_out - t);
+    const bool lands = h_try == t_out - t;
+    if (options_.integrator == Integrator::RK4) {
+      if (const int rc = stepRK4(t, h_try, x)) return rc;
+    } else {
+      double error = 0.0;
+      if (const int rc = stepDP54(t, h_try, x, error)) return rc;
+      const double factor = error == 0.0 ? 5.0 : std::clamp(0.9 * std::pow(error, -0.2), 0.2, 5.0);
+      if (error > 1.0) {
+        ++stats_.rejected_steps;
+        h = h_try * factor;
+        if (h < 1e-14 * std::max(1.0, std::abs(t))) return E_NOT_FINITE;  // step size underflow
+        continue;
+      }
+      x = x_new_;
+      if (!lands || factor < 1.0) h = std::min(h_try * factor, options_.max_step);
+    }
+    ++stats_.accepted_steps;
+    x.segment<4>(3).normalize();  // the orientation stays a unit quaternion
+    t = lands ? t_out : t + h_try;
+    if (lands) {
+      if (const int rc = unpack(x, t, s)) return rc;
+      if (observer) observer(s);
+      ++outputs;
+    }
+  }
+  return unpack(x, t, s);
+}
+
+}  // namespace kdl_space
