@@ -208,4 +208,116 @@ Eigen::MatrixXd VirtualJointChain::G(const LinkPoint& h) const { return delassus
 
 Eigen::MatrixXd VirtualJointChain::G_grounded(const LinkPoint& h) const { return delassus(J(h), H()); }
 
+// --- Dynamics with arbitrary virtual coordinates ---------------------------------------------
+
+struct VirtualJointDynamics::Solvers {
+  explicit Solvers(const KDL::Tree& tree) : fk(tree) {}
+  KDL::TreeFkSolverPos_recursive fk;
+};
+
+VirtualJointDynamics::VirtualJointDynamics(const FloatingModel& model, const KDL::Frame& offset)
+    : tree_(buildVirtualTree(model, offset)), n_(static_cast<int>(model.nj())) {
+  std::map<std::string, int> by_name;
+  for (const auto& [name, element] : tree_.getSegments()) {
+    const KDL::Segment& seg = GetTreeElementSegment(element);
+    if (seg.getJoint().getType() != KDL::Joint::None)
+      by_name[seg.getJoint().getName()] = static_cast<int>(GetTreeElementQNr(element));
+  }
+  index_ = coordinateIndex(model, by_name);
+  if (tree_.getNrOfJoints() != 6 + model.nj()) throw std::runtime_error("virtual route: joint count mismatch");
+  armature_ = Eigen::VectorXd::Zero(6 + n_);
+  for (int j = 0; j < n_; ++j) armature_(6 + j) = model.armature()[j];
+  solvers_ = std::make_unique<Solvers>(tree_);
+}
+
+VirtualJointDynamics::~VirtualJointDynamics() = default;
+
+KDL::JntArray VirtualJointDynamics::toTree(const Eigen::VectorXd& x) const {
+  if (x.size() != size()) throw std::invalid_argument("virtual route: coordinate vector of wrong size");
+  KDL::JntArray a(size());
+  for (int i = 0; i < size(); ++i) a(index_[i]) = x(i);
+  return a;
+}
+
+Eigen::VectorXd VirtualJointDynamics::fromTree(const KDL::JntArray& a) const {
+  Eigen::VectorXd x(size());
+  for (int i = 0; i < size(); ++i) x(i) = a(index_[i]);
+  return x;
+}
+
+Eigen::VectorXd VirtualJointDynamics::inverseDynamics(const Eigen::VectorXd& theta, const Eigen::VectorXd& theta_d,
+                                                      const Eigen::VectorXd& theta_dd, const KDL::Vector& gravity,
+                                                      const KDL::WrenchMap& f_ext) const {
+  KDL::TreeIdSolver_RNE rne(tree_, gravity);
+  KDL::JntArray tau(size());
+  if (rne.CartToJnt(toTree(theta), toTree(theta_d), toTree(theta_dd), f_ext, tau) != 0)
+    throw std::runtime_error("virtual route: TreeIdSolver_RNE failed");
+  return fromTree(tau) + armature_.cwiseProduct(theta_dd);
+}
+
+Eigen::MatrixXd VirtualJointDynamics::massMatrix(const Eigen::VectorXd& theta) const {
+  // tau = M(theta) e_k with zero gravity and zero velocity.
+  KDL::TreeIdSolver_RNE rne(tree_, KDL::Vector::Zero());
+  const KDL::JntArray q = toTree(theta), zero(size());
+  KDL::JntArray qdd(size()), tau(size());
+  const KDL::WrenchMap none;
+  Eigen::MatrixXd M(size(), size());
+  for (int k = 0; k < size(); ++k) {
+    qdd.data.setZero();
+    qdd(index_[k]) = 1.0;
+    if (rne.CartToJnt(q, zero, qdd, none, tau) != 0) throw std::runtime_error("virtual route: TreeIdSolver_RNE failed");
+    M.col(k) = fromTree(tau);
+  }
+  M.diagonal() += armature_;
+  return M;
+}
+
+Eigen::VectorXd VirtualJointDynamics::forwardDynamics(const Eigen::VectorXd& theta, const Eigen::VectorXd& theta_d,
+                                                      const Eigen::VectorXd& tau, const KDL::Vector& gravity,
+                                                      const KDL::WrenchMap& f_ext) const {
+  if (tau.size() != n_) throw std::invalid_argument("virtual route: tau of wrong size");
+  Eigen::VectorXd tau_full = Eigen::VectorXd::Zero(size());
+  tau_full.tail(n_) = tau;
+  const Eigen::VectorXd c = inverseDynamics(theta, theta_d, Eigen::VectorXd::Zero(size()), gravity, f_ext);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(massMatrix(theta));
+  if (ldlt.info() != Eigen::Success) throw std::runtime_error("virtual route: LDLT failed");
+  return ldlt.solve(tau_full - c);
+}
+
+KDL::Frame VirtualJointDynamics::pose(const Eigen::VectorXd& theta, const std::string& link) const {
+  KDL::Frame f;
+  if (solvers_->fk.JntToCart(toTree(theta), f, link) < 0) throw std::invalid_argument("virtual route: no link " + link);
+  return f;
+}
+
+// --- Locked joints --------------------------------------------------------------------------
+
+namespace {
+void copyLocked(const KDL::SegmentMap::const_iterator& src, const std::string& parent_name,
+                const std::map<std::string, double>& locked_at, KDL::Tree& dst, std::size_t& found) {
+  for (const auto& child : GetTreeElementChildren(src->second)) {
+    const KDL::Segment& seg = GetTreeElementSegment(child->second);
+    const auto it = locked_at.find(seg.getJoint().getName());
+    const bool lock = seg.getJoint().getType() != KDL::Joint::None && it != locked_at.end();
+    const KDL::Segment copy =
+        lock ? KDL::Segment(seg.getName(), KDL::Joint(seg.getJoint().getName(), KDL::Joint::None),
+                            seg.pose(it->second), seg.getInertia())
+             : seg;
+    found += lock ? 1 : 0;
+    if (!dst.addSegment(copy, parent_name))
+      throw std::runtime_error("virtual route: cannot add segment " + child->first);
+    copyLocked(child, child->first, locked_at, dst, found);
+  }
+}
+}  // namespace
+
+KDL::Tree lockJoints(const KDL::Tree& tree, const std::map<std::string, double>& locked_at) {
+  const KDL::SegmentMap::const_iterator root = tree.getRootSegment();
+  KDL::Tree out(root->first);
+  std::size_t found = 0;
+  copyLocked(root, root->first, locked_at, out, found);
+  if (found != locked_at.size()) throw std::invalid_argument("virtual route: a joint to lock is not in the tree");
+  return out;
+}
+
 }  // namespace kdl_space::test

@@ -21,6 +21,9 @@
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
 #include <kdl/tree.hpp>
+#include <kdl/treeidsolver.hpp>
+#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,6 +111,57 @@ class VirtualJointChain {
   KDL::JntArray q_chain_;
   Eigen::MatrixXd M_full_;
 };
+
+/// \brief The virtual-joint tree as a grounded system with ARBITRARY virtual joint positions:
+/// generalized coordinates theta = (x, y, z, a, b, c; q) (virtual first, then the model's joints
+/// in model order), with the base pose world_T_base = Trans(offset.p + (x, y, z)) Rx(a) Ry(b)
+/// Rz(c) offset.M. KDL only (TreeIdSolver_RNE, TreeFkSolverPos_recursive); used for the
+/// independent forward dynamics and for integrating the motion with a route that shares no code
+/// with kdl_space. Armature (model order) is added as a plain rotor inertia on the real joints.
+class VirtualJointDynamics {
+ public:
+  VirtualJointDynamics(const FloatingModel& model, const KDL::Frame& offset = KDL::Frame::Identity());
+  // The KDL solvers keep a reference to tree_: not copyable, not movable.
+  VirtualJointDynamics(const VirtualJointDynamics&) = delete;
+  VirtualJointDynamics& operator=(const VirtualJointDynamics&) = delete;
+  ~VirtualJointDynamics();
+
+  const KDL::Tree& tree() const { return tree_; }
+  int n() const { return n_; }
+  /// Number of coordinates 6 + n.
+  int size() const { return 6 + n_; }
+
+  /// \brief Generalized forces (coordinate order) for positions theta, rates theta_d and
+  /// accelerations theta_dd, with `gravity` (world) and external wrenches f_ext (KDL
+  /// convention: per segment name, in that segment's frame, moment about its origin).
+  Eigen::VectorXd inverseDynamics(const Eigen::VectorXd& theta, const Eigen::VectorXd& theta_d,
+                                  const Eigen::VectorXd& theta_dd, const KDL::Vector& gravity,
+                                  const KDL::WrenchMap& f_ext = KDL::WrenchMap()) const;
+  /// Mass matrix (coordinate order, armature included), column by column from inverseDynamics.
+  Eigen::MatrixXd massMatrix(const Eigen::VectorXd& theta) const;
+  /// theta_dd = M^-1 (tau_full - c), tau_full = (0 on the virtual joints; tau).
+  Eigen::VectorXd forwardDynamics(const Eigen::VectorXd& theta, const Eigen::VectorXd& theta_d,
+                                  const Eigen::VectorXd& tau, const KDL::Vector& gravity,
+                                  const KDL::WrenchMap& f_ext = KDL::WrenchMap()) const;
+  /// World pose of a link at theta.
+  KDL::Frame pose(const Eigen::VectorXd& theta, const std::string& link) const;
+
+ private:
+  KDL::JntArray toTree(const Eigen::VectorXd& x) const;
+  Eigen::VectorXd fromTree(const KDL::JntArray& x) const;
+
+  KDL::Tree tree_;
+  int n_ = 0;
+  std::vector<int> index_;  ///< coordinate -> KDL q_nr
+  Eigen::VectorXd armature_;
+  struct Solvers;
+  std::unique_ptr<Solvers> solvers_;
+};
+
+/// \brief A copy of `tree` in which the joints named in `locked_at` are fixed (KDL::Joint::None)
+/// at the given positions: each such segment keeps its name and inertia, its pose in the parent
+/// becomes seg.pose(q). Throws std::invalid_argument if a named joint is not in the tree.
+KDL::Tree lockJoints(const KDL::Tree& tree, const std::map<std::string, double>& locked_at);
 
 /// Base inertia of a model as a KDL inertia in the base frame (from bodies()[0]).
 KDL::RigidBodyInertia baseInertia(const FloatingModel& model, double scale = 1.0);

@@ -52,83 +52,89 @@ CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
   return cmd;
 }
 
-void runCapture(const CaptureOptions& o, std::ostream& out) {
-  const Scenario sc = loadScenario(o.scenario);
-  const std::unique_ptr<FreeFloatingSolver> robot_solver = computed(sc.robot);
-  const std::unique_ptr<FloatingSide> robot = side(*robot_solver, sc.robot, "robot");
-  Vector3d p_h;
-  robot_solver->contactPoint(sc.robot.contact, p_h);
-
-  std::unique_ptr<FreeFloatingSolver> target_solver;
-  std::unique_ptr<ImpactSide> target;
+CaptureRun solveCapture(const Scenario& sc) {
+  CaptureRun run;
+  run.robot_solver = computed(sc.robot);
+  run.robot = side(*run.robot_solver, sc.robot, "robot");
+  run.robot_solver->contactPoint(sc.robot.contact, run.p_h);
   if (sc.rigid_target) {
     try {
-      target = std::make_unique<RigidBodySide>(*sc.rigid_target, p_h);
+      run.target = std::make_unique<RigidBodySide>(*sc.rigid_target, run.p_h);
     } catch (const ModelError& e) {
       throw InputError(sc.file + ": " + e.what());
     }
   } else {
-    target_solver = computed(*sc.floating_target);
-    target = side(*target_solver, *sc.floating_target, "target");
+    run.target_solver = computed(*sc.floating_target);
+    run.target = side(*run.target_solver, *sc.floating_target, "target");
     Vector3d p_c;
-    target_solver->contactPoint(sc.floating_target->contact, p_c);
-    if ((p_c - p_h).norm() > 1e-3)
+    run.target_solver->contactPoint(sc.floating_target->contact, p_c);
+    if ((p_c - run.p_h).norm() > 1e-3)
       throw InputError(sc.file + ": target.contact: the target's contact point is " +
-                       std::to_string((p_c - p_h).norm()) + " m from the robot's; they must touch (within 1 mm)");
+                       std::to_string((p_c - run.p_h).norm()) + " m from the robot's; they must touch (within 1 mm)");
   }
+  run.impulse = collide(*run.robot, *run.target, sc.law);
+  return run;
+}
 
-  const Impulse impulse = collide(*robot, *target, sc.law);
-  const double T0 = robot->energyBefore() + target->energyBefore();
-  const double T1 = robot->energyAfter() + target->energyAfter();
-  const Vector6d momentum_before = robot->momentumBefore() + target->momentumBefore();
-  const Vector6d momentum_after = robot->momentumAfter() + target->momentumAfter();
-  const double virtual_mass = virtualMass(robot->G(), sc.law.normal);
-
-  Json jt;
-  Vector6d target_before, target_after;
+namespace {
+/// The target's twist at its CoM before / after (for a free-floating target: its locked twist).
+std::pair<Vector6d, Vector6d> targetTwists(const Scenario& sc, const CaptureRun& r) {
   if (sc.rigid_target) {
-    const auto& rigid = static_cast<const RigidBodySide&>(*target);
-    target_before = rigid.twistBefore();
-    target_after = rigid.twistAfter();
-    jt["twist_before"] = toJson(target_before);
-    jt["twist_after"] = toJson(target_after);
-  } else {
-    // Another free-floating system: its locked twist at its CoM, and its whole state.
-    const auto& other = static_cast<const FloatingSide&>(*target);
-    target_before = other.centroidTwistBefore();
-    target_after = other.centroidTwistAfter();
-    jt["twist_before"] = toJson(target_before);
-    jt["twist_after"] = toJson(target_after);
+    const auto& rigid = static_cast<const RigidBodySide&>(*r.target);
+    return {rigid.twistBefore(), rigid.twistAfter()};
+  }
+  const auto& other = static_cast<const FloatingSide&>(*r.target);
+  return {other.centroidTwistBefore(), other.centroidTwistAfter()};
+}
+}  // namespace
+
+Json captureJson(const Scenario& sc, const CaptureRun& r) {
+  const FloatingSide& robot = *r.robot;
+  const ImpactSide& target = *r.target;
+  const auto [target_before, target_after] = targetTwists(sc, r);
+  Json jt;
+  jt["twist_before"] = toJson(target_before);
+  jt["twist_after"] = toJson(target_after);
+  if (sc.floating_target) {
+    // Another free-floating system: its locked twist at its CoM above, and its whole state.
+    const auto& other = static_cast<const FloatingSide&>(target);
     jt["base_twist_before"] = twist(other.before().base_twist);
     jt["base_twist_after"] = twist(other.after().base_twist);
     jt["joint_names"] = sc.floating_target->model->jointNames();
     jt["qdot_before"] = toJson(other.before().qdot.data);
     jt["qdot_after"] = toJson(other.after().qdot.data);
   }
+  const double T0 = robot.energyBefore() + target.energyBefore();
+  const double T1 = robot.energyAfter() + target.energyAfter();
+  Json j;
+  j["impulse"] = toJson(r.impulse.F);
+  j["robot"] = Json{{"base_twist_before", twist(robot.before().base_twist)},
+                    {"base_twist_after", twist(robot.after().base_twist)},
+                    {"joint_names", sc.robot.model->jointNames()},
+                    {"qdot_before", toJson(robot.before().qdot.data)},
+                    {"qdot_after", toJson(robot.after().qdot.data)},
+                    {"contact_twist_before", toJson(robot.contactTwistBefore())},
+                    {"contact_twist_after", toJson(robot.contactTwistAfter())}};
+  j["target"] = jt;
+  j["momentum_before"] = toJson(robot.momentumBefore() + target.momentumBefore());
+  j["momentum_after"] = toJson(robot.momentumAfter() + target.momentumAfter());
+  j["energy_before"] = T0;
+  j["energy_after"] = T1;
+  j["energy_lost"] = T0 - T1;
+  j["virtual_mass"] = sc.has_normal ? Json(virtualMass(robot.G(), sc.law.normal)) : Json(nullptr);
+  j["G_star"] = toJson(robot.G());
+  j["G_B"] = toJson(target.G());
+  return j;
+}
 
-  if (o.json) {
-    Json j;
-    j["impulse"] = toJson(impulse.F);
-    j["robot"] = Json{{"base_twist_before", twist(robot->before().base_twist)},
-                      {"base_twist_after", twist(robot->after().base_twist)},
-                      {"joint_names", sc.robot.model->jointNames()},
-                      {"qdot_before", toJson(robot->before().qdot.data)},
-                      {"qdot_after", toJson(robot->after().qdot.data)},
-                      {"contact_twist_before", toJson(robot->contactTwistBefore())},
-                      {"contact_twist_after", toJson(robot->contactTwistAfter())}};
-    j["target"] = jt;
-    j["momentum_before"] = toJson(momentum_before);
-    j["momentum_after"] = toJson(momentum_after);
-    j["energy_before"] = T0;
-    j["energy_after"] = T1;
-    j["energy_lost"] = T0 - T1;
-    j["virtual_mass"] = sc.has_normal ? Json(virtual_mass) : Json(nullptr);
-    j["G_star"] = toJson(robot->G());
-    j["G_B"] = toJson(target->G());
-    out << j.dump(2) << "\n";
-    return;
-  }
-
+void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRun& r) {
+  const FloatingSide& robot = *r.robot;
+  const ImpactSide& target = *r.target;
+  const auto [target_before, target_after] = targetTwists(sc, r);
+  const double T0 = robot.energyBefore() + target.energyBefore();
+  const double T1 = robot.energyAfter() + target.energyAfter();
+  const Vector6d momentum_before = robot.momentumBefore() + target.momentumBefore();
+  const Vector6d momentum_after = robot.momentumAfter() + target.momentumAfter();
   const std::vector<std::string>& joints = sc.robot.model->jointNames();
   out << "Scenario " << sc.file << "\n";
   out << "Law: " << lawName(sc.law.kind);
@@ -136,29 +142,37 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     out << ", e = " << sc.law.restitution << ", normal " << row(sc.law.normal)
         << (sc.law.kind == ImpactKind::FrictionalImpact ? ", mu = " + std::to_string(sc.law.friction) : "");
   out << "\n";
-  if (impulse.separating) out << "The bodies are already separating along the normal: no impulse.\n";
-  if (sc.law.kind == ImpactKind::FrictionalImpact && !impulse.separating)
-    out << (impulse.sticking ? "Contact sticks (the impulse lies inside the friction cone).\n"
-                             : "Contact slides (the impulse lies on the friction cone).\n");
-  out << "Contact point " << row(p_h) << " m on link '" << sc.robot.contact_link << "'\n";
-  out << "Impulse on the robot (f; n) [N s; N m s]: " << row(impulse.F) << "\n";
-  out << "Robot contact twist (v; w): before " << row(robot->contactTwistBefore()) << "\n"
-      << "                            after  " << row(robot->contactTwistAfter()) << "\n";
+  if (r.impulse.separating) out << "The bodies are already separating along the normal: no impulse.\n";
+  if (sc.law.kind == ImpactKind::FrictionalImpact && !r.impulse.separating)
+    out << (r.impulse.sticking ? "Contact sticks at the end of the impact.\n" : "Contact slides at the end of the impact.\n");
+  out << "Contact point " << row(r.p_h) << " m on link '" << sc.robot.contact_link << "'\n";
+  out << "Impulse on the robot (f; n) [N s; N m s]: " << row(r.impulse.F) << "\n";
+  out << "Robot contact twist (v; w): before " << row(robot.contactTwistBefore()) << "\n"
+      << "                            after  " << row(robot.contactTwistAfter()) << "\n";
   out << "Target twist at its CoM:    before " << row(target_before) << "\n"
       << "                            after  " << row(target_after) << "\n";
-  out << "Base twist:                 before " << row(toEigen(robot->before().base_twist)) << "\n"
-      << "                            after  " << row(toEigen(robot->after().base_twist)) << "\n"
+  out << "Base twist:                 before " << row(toEigen(robot.before().base_twist)) << "\n"
+      << "                            after  " << row(toEigen(robot.after().base_twist)) << "\n"
       << "                            jump   "
-      << row(toEigen(robot->after().base_twist) - toEigen(robot->before().base_twist)) << "\n";
+      << row(toEigen(robot.after().base_twist) - toEigen(robot.before().base_twist)) << "\n";
   printMatrix(out, "Joint rates [rad/s or m/s]",
-              (Eigen::MatrixXd(joints.size(), 3) << robot->before().qdot.data, robot->after().qdot.data,
-               robot->after().qdot.data - robot->before().qdot.data).finished(),
+              (Eigen::MatrixXd(joints.size(), 3) << robot.before().qdot.data, robot.after().qdot.data,
+               robot.after().qdot.data - robot.before().qdot.data).finished(),
               joints, {"before", "after", "jump"});
   out << "Momentum (P; L about the world origin): before " << row(momentum_before) << "\n"
       << "                                        after  " << row(momentum_after) << "\n";
   out << "Kinetic energy: before " << T0 << " J, after " << T1 << " J, lost " << T0 - T1 << " J ("
       << (T0 > 0 ? 100.0 * (T0 - T1) / T0 : 0.0) << " %)\n";
-  if (sc.has_normal) out << "Virtual mass of the robot along the normal: " << virtual_mass << " kg\n";
+  if (sc.has_normal) out << "Virtual mass of the robot along the normal: " << virtualMass(robot.G(), sc.law.normal) << " kg\n";
+}
+
+void runCapture(const CaptureOptions& o, std::ostream& out) {
+  const Scenario sc = loadScenario(o.scenario);
+  const CaptureRun run = solveCapture(sc);
+  if (o.json)
+    out << captureJson(sc, run).dump(2) << "\n";
+  else
+    printCaptureSummary(out, sc, run);
 }
 
 }  // namespace kdl_space::cli

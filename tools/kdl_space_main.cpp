@@ -6,6 +6,7 @@
 #include "capture.hpp"
 #include "cli_common.hpp"
 #include "inspect.hpp"
+#include "simulate.hpp"
 
 int main(int argc, char** argv) {
   using namespace kdl_space::cli;
@@ -15,6 +16,8 @@ int main(int argc, char** argv) {
   CLI::App* inspect = addInspect(app, inspect_options);
   CaptureOptions capture_options;
   CLI::App* capture = addCapture(app, capture_options);
+  SimulateOptions simulate_options;
+  CLI::App* simulate = addSimulate(app, simulate_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -26,6 +29,7 @@ int main(int argc, char** argv) {
   try {
     if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
     if (capture->parsed()) runCapture(capture_options, std::cout);
+    if (simulate->parsed()) runSimulate(simulate_options, std::cout);
     return kOk;
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";

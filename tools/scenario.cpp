@@ -78,6 +78,14 @@ class Field {
     return values;
   }
   const std::string& path() const { return path_; }
+  bool isScalar() const { return node_.IsScalar(); }
+  /// The keys of a mapping, in file order.
+  std::vector<std::string> keys() const {
+    if (!node_.IsMap()) fail("expected a mapping");
+    std::vector<std::string> k;
+    for (const auto& item : node_) k.push_back(item.first.as<std::string>());
+    return k;
+  }
 
  private:
   YAML::Node node_;
@@ -192,6 +200,56 @@ ImpactLaw law(const Field& f, bool& has_normal) {
   return l;
 }
 
+SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
+  f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "gravity", "joints"});
+  SimulationSpec s;
+  const auto positive = [&](const char* key, double& value) {
+    if (!f.has(key)) return;
+    value = f.at(key).number();
+    if (!(value > 0.0)) f.at(key).fail("must be > 0");
+  };
+  positive("duration", s.duration);
+  positive("output_step", s.output_step);
+  positive("step", s.options.step);
+  positive("rtol", s.options.rtol);
+  positive("atol", s.options.atol);
+  positive("max_step", s.options.max_step);
+  if (f.has("integrator")) {
+    const std::string name = f.at("integrator").text();
+    if (name == "rk4") s.options.integrator = Integrator::RK4;
+    else if (name == "dopri5") s.options.integrator = Integrator::DormandPrince54;
+    else f.at("integrator").fail("'" + name + "' is not one of rk4, dopri5");
+  }
+  if (f.has("gravity")) s.options.gravity = f.at("gravity").vector(3);
+  if (f.has("joints")) {
+    const Field joints = f.at("joints");
+    for (const std::string& name : joints.keys()) {
+      const Field j = joints.at(name);
+      const int index = robot.jointIndex(name);
+      if (index < 0) j.fail("the robot has no movable joint '" + name + "'");
+      JointControl c;
+      if (j.isScalar()) {
+        const std::string mode = j.text();
+        if (mode == "free") c.mode = JointControl::Mode::Free;
+        else if (mode == "locked") c.mode = JointControl::Mode::Locked;
+        else j.fail("'" + mode + "' is not one of free, locked, {pd: {kp, kd, set_point}}");
+      } else {
+        j.onlyKeys({"pd"});
+        const Field pd = j.at("pd");
+        pd.onlyKeys({"kp", "kd", "set_point"});
+        c.mode = JointControl::Mode::PD;
+        c.kp = pd.at("kp").number();
+        c.kd = pd.at("kd").number();
+        c.set_point = pd.at("set_point").number();
+        if (c.kp < 0.0) pd.at("kp").fail("must be >= 0");
+        if (c.kd < 0.0) pd.at("kd").fail("must be >= 0");
+      }
+      s.joints.emplace_back(static_cast<unsigned int>(index), c);
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 Scenario loadScenario(const std::string& file) {
@@ -207,13 +265,14 @@ Scenario loadScenario(const std::string& file) {
   }
   const Field top(root, "", &s.file);
   if (!root.IsMap()) top.fail("a scenario is a mapping with robot, target and law");
-  top.onlyKeys({"robot", "target", "law"});
+  top.onlyKeys({"robot", "target", "law", "simulation"});
   const std::string folder = std::filesystem::path(file).parent_path().string();
   s.robot = system(top.at("robot"), folder);
   const Field target = top.at("target");
   if (target.has("urdf")) s.floating_target = system(target, folder);
   else s.rigid_target = rigidTarget(target);
   s.law = law(top.at("law"), s.has_normal);
+  if (top.has("simulation")) s.simulation = simulation(top.at("simulation"), *s.robot.model);
   return s;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "kdl_space/collision.hpp"
+#include "kdl_space/simulation.hpp"
 
 namespace kdl_space::cli {
 
@@ -21,6 +22,14 @@ struct ScenarioSystem {
   Response response = Response::FreeFloating;
 };
 
+/// The `simulation` section: what `kdl_space simulate` does after the impact.
+struct SimulationSpec {
+  double duration = 20.0;     ///< [s], overridden by --duration
+  double output_step = 0.05;  ///< CSV row spacing [s]
+  SimulationOptions options;
+  std::vector<std::pair<unsigned int, JointControl>> joints;  ///< by joint index of the robot
+};
+
 struct Scenario {
   std::string file;
   ScenarioSystem robot;
@@ -28,6 +37,7 @@ struct Scenario {
   std::optional<ScenarioSystem> floating_target;  ///< another free-floating system
   ImpactLaw law;
   bool has_normal = false;  ///< a normal was given (virtual mass is reported)
+  SimulationSpec simulation;
 };
 
 /// \brief Reads and checks a scenario file. URDF paths are relative to the scenario's folder.

@@ -1,0 +1,135 @@
+// `kdl_space simulate` end to end: the CSV and the plot are written and readable, momentum is
+// kept, bad input fails cleanly and leaves no partial file behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "cli_runner.hpp"
+#include "reference_case.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml";
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_sim_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream s(line);
+  for (std::string cell; std::getline(s, cell, ',');) cells.push_back(cell);
+  return cells;
+}
+
+TEST(SimulateTool, WritesAReadableCsvAndPlot) {
+  const std::string csv = scratch("run.csv"), svg = scratch("run.svg"), png = scratch("run.png");
+  const ToolRun r = kdlSpace("simulate " + kScenario + " --duration 2 --csv " + csv + " --plot " + svg + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("capture") && j.contains("simulation"));
+  EXPECT_EQ(j.at("simulation").at("csv"), csv);
+  EXPECT_TRUE(j.at("simulation").at("payload_attached").get<bool>());
+
+  // CSV: header with named columns, one row per 0.05 s output step from 0 to 2 s, numbers only.
+  std::ifstream in(csv);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  const std::vector<std::string> header = split(line);
+  const std::vector<std::string> joints = j.at("simulation").at("joint_names");
+  EXPECT_EQ(header.front(), "t");
+  EXPECT_EQ(header.back(), "kinetic_energy");
+  for (const std::string& name : joints) {
+    EXPECT_NE(std::find(header.begin(), header.end(), "q_" + name), header.end()) << name;
+    EXPECT_NE(std::find(header.begin(), header.end(), "qdot_" + name), header.end()) << name;
+  }
+  for (const char* col : {"base_x", "base_qw", "base_wz", "P_x", "L_z"})
+    EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << col;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    for (const std::string& cell : split(line)) row.push_back(std::stod(cell));
+    ASSERT_EQ(row.size(), header.size()) << line;
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 41u);  // t = 0, 0.05, ..., 2
+  EXPECT_DOUBLE_EQ(rows.front()[0], 0.0);
+  EXPECT_DOUBLE_EQ(rows.back()[0], 2.0);
+  // Momentum columns equal the capture's momentum after the impact (robot + target), every row.
+  const Eigen::MatrixXd h0 = ReferenceCase::mat(j.at("capture").at("momentum_after"));
+  const auto col = [&](const std::string& name) { return std::find(header.begin(), header.end(), name) - header.begin(); };
+  for (const auto& row : rows) {
+    const std::vector<std::string> names{"P_x", "P_y", "P_z", "L_x", "L_y", "L_z"};
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(row[col(names[k])], h0(k), 1e-12 * h0.norm()) << names[k];
+    // The base quaternion stays unit.
+    const double qn = std::hypot(std::hypot(row[col("base_qx")], row[col("base_qy")]),
+                                 std::hypot(row[col("base_qz")], row[col("base_qw")]));
+    EXPECT_NEAR(qn, 1.0, 1e-12);
+  }
+  // The plot is an SVG document with three panels' worth of curves.
+  std::ifstream plot(svg);
+  std::stringstream text;
+  text << plot.rdbuf();
+  EXPECT_NE(text.str().find("<svg"), std::string::npos);
+  EXPECT_NE(text.str().find("</svg>"), std::string::npos);
+  EXPECT_NE(text.str().find("base attitude"), std::string::npos);
+  EXPECT_NE(text.str().find("joint7"), std::string::npos);
+
+  ASSERT_EQ(kdlSpace("simulate " + kScenario + " --duration 0.5 --plot " + png).rc, 0);
+  std::ifstream png_in(png, std::ios::binary);
+  char magic[8] = {};
+  png_in.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  fs::remove_all(fs::path(csv).parent_path());
+}
+
+TEST(SimulateTool, ReadableSummary) {
+  const ToolRun r = kdlSpace("simulate " + kScenario + " --duration 1");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  for (const char* s : {"Impulse on the robot", "After the impact: the target is attached", "Final base attitude",
+                        "joint7", "Largest change over the run"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+}
+
+TEST(SimulateTool, BadInputFailsCleanlyAndLeavesNoFile) {
+  const std::string csv = scratch("bad.csv"), plot = scratch("bad.svg");
+  // A scenario that loads but cannot be simulated (translational capture), and bad options.
+  const std::string scenario = scratch("translational.yaml");
+  std::ifstream in(kScenario);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("type: capture"), 13, "type: translational");
+  for (const std::string dir : {std::string("../urdf/")})
+    yaml.replace(yaml.find(dir), dir.size(), std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  std::ofstream(scenario) << yaml;
+  const struct {
+    std::string args;
+    int rc;
+    std::string needle;
+  } cases[] = {
+      {"simulate " + scenario + " --csv " + csv + " --plot " + plot, 3, "translational"},
+      {"simulate " + kScenario + " --duration -1 --csv " + csv, 2, "duration"},
+      {"simulate " + kScenario + " --plot " + scratch("bad.gif"), 2, ".svg or .png"},
+      {"simulate /nonexistent.yaml --csv " + csv, 3, "nonexistent"},
+      {"simulate " + kScenario + " --csv /nonexistent/dir/run.csv", 3, "/nonexistent/dir/run.csv"},
+  };
+  for (const auto& c : cases) {
+    const ToolRun r = kdlSpace(c.args);
+    EXPECT_EQ(r.rc, c.rc) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(csv)) << c.args;
+    EXPECT_FALSE(fs::exists(plot)) << c.args;
+    for (const auto& entry : fs::directory_iterator(fs::path(csv).parent_path()))
+      EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << "left behind: " << entry.path();
+  }
+  fs::remove_all(fs::path(csv).parent_path());
+}
+
+}  // namespace
+}  // namespace kdl_space::test
