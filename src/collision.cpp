@@ -7,7 +7,7 @@ namespace kdl_space {
 
 FloatingSide::FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
                            Response response)
-    : solver_(solver), h_(h), response_(response), before_(before), after_(before) {
+    : solver_(solver), h_(h), response_(response), before_(before), after_(before), dqdot_(solver.model().nj()) {
   if (before.qdot.rows() != solver.model().nj())
     throw ModelError("robot: " + std::to_string(before.qdot.rows()) + " joint rates for " +
                      std::to_string(solver.model().nj()) + " joints");
@@ -33,9 +33,8 @@ Vector6d FloatingSide::contactTwist(const FloatingVelocity& v) const {
 
 int FloatingSide::applyImpulse(const Vector6d& F) {
   Vector6d dPL;
-  KDL::JntArray dqdot(solver_.model().nj());
-  if (const int rc = solver_.velocityJump(h_, response_, F, dPL, dqdot)) return rc;
-  after_.qdot.data = before_.qdot.data + dqdot.data;
+  if (const int rc = solver_.velocityJump(h_, response_, F, dPL, dqdot_)) return rc;
+  after_.qdot.data = before_.qdot.data + dqdot_.data;
   if (response_ != Response::Grounded) {
     PL_after_ = PL_before_ + dPL;
     solver_.baseTwist(PL_after_, after_.qdot, after_.base_twist);

@@ -10,6 +10,7 @@ const char* strError(int code) {
     case E_NOT_FINITE: return "an input holds NaN or infinite values";
     case E_NOT_POSITIVE_DEFINITE: return "an inertia matrix is not positive definite";
     case E_BAD_CONTACT: return "the contact refers to no body of this model";
+    case E_MAX_STEPS: return "the simulation spent its step budget (is a controller unstable?)";
     default: return "unknown error";
   }
 }

@@ -47,6 +47,7 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   H_star_.resize(n);
   H_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
   H_star_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
+  reserveContacts(2);  // dual-arm without allocation
 }
 
 int FreeFloatingSolver::compute(const State& state) {
@@ -69,8 +70,11 @@ int FreeFloatingSolver::compute(const State& state) {
       const double q = b.joint >= 0 ? state.q(b.joint) : 0.0;
       const KDL::Frame& world_T_parent = world_T_body_[b.parent];
       world_T_body_[i] = world_T_parent * b.segment.pose(q);
-      // KDL: twist of the segment tip relative to its parent, parent axes, tip reference point.
-      if (b.joint >= 0) S_[b.joint] = toEigen(world_T_parent.M * b.segment.twist(q, 1.0));
+      // The joint's unit twist in world axes, at the parent's origin (moved to r_g below).
+      if (b.joint >= 0) {
+        const Matrix3d R = toEigen(world_T_parent.M);
+        S_[b.joint] << R * b.joint_twist.head<3>(), R * b.joint_twist.tail<3>();
+      }
     }
     first_moment += b.mass * toEigen(world_T_body_[i] * toKDL(b.com));
   }
@@ -89,7 +93,7 @@ int FreeFloatingSolver::compute(const State& state) {
   // Joint twists moved to r_g; A_m and H by the composite-rigid-body pass.
   for (unsigned int j = 0; j < n; ++j) {
     const int b = model_->jointBody()[j];
-    S_[j] = shiftTwist(S_[j], r_g_ - toEigen(world_T_body_[b].p));
+    S_[j] = shiftTwist(S_[j], r_g_ - toEigen(world_T_body_[model_->bodies()[b].parent].p));
   }
   for (unsigned int j = 0; j < n; ++j) {
     const int b = model_->jointBody()[j];
@@ -109,7 +113,8 @@ int FreeFloatingSolver::compute(const State& state) {
 
   Am_work_ = A_m_;
   M_a_solveInPlace(Am_work_);
-  H_star_.data.noalias() = H_.data - A_m_.transpose() * Am_work_;  // eq. 7
+  H_star_.data = H_.data;
+  H_star_.data.noalias() -= A_m_.transpose() * Am_work_;  // eq. 7
   symmetrize(H_star_.data);
   H_llt_.compute(H_.data);
   H_ok_ = H_llt_.info() == Eigen::Success;
@@ -282,23 +287,33 @@ int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const 
   return E_NOERROR;
 }
 
+void FreeFloatingSolver::reserveContacts(std::size_t k) {
+  if (static_cast<Eigen::Index>(6 * k) <= J_all_work_.rows()) return;
+  J_all_work_.resize(6 * k, model_->nj());
+  X_all_work_.resize(model_->nj(), 6 * k);
+  R_all_work_.resize(k);
+}
+
 int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G) {
-  const std::size_t k = contacts.size();
-  const unsigned int n = model_->nj();
-  Eigen::MatrixXd J_all(6 * k, n);
-  std::vector<Matrix6d> R(k);
-  for (std::size_t i = 0; i < k; ++i) {
-    if (const int rc = R_h(contacts[i], R[i])) return rc;
+  const Eigen::Index k = static_cast<Eigen::Index>(contacts.size());
+  for (const Contact& h : contacts)
+    if (const int rc = ready(h)) return rc;
+  if (G.rows() != 6 * k || G.cols() != 6 * k) return E_SIZE_MISMATCH;
+  reserveContacts(contacts.size());  // no allocation up to the reserved count
+  auto J_all = J_all_work_.topRows(6 * k);
+  auto X = X_all_work_.leftCols(6 * k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    if (const int rc = R_h(contacts[i], R_all_work_[i])) return rc;
     generalizedJacobian(contacts[i], J_work_);
     J_all.middleRows<6>(6 * i) = J_work_;
   }
-  Eigen::MatrixXd X = J_all.transpose();
+  X = J_all.transpose();
   H_star_llt_.solveInPlace(X);  // one factorisation of H* for every block
   G.noalias() = J_all * X;
-  for (std::size_t i = 0; i < k; ++i) {
-    Matrix6d Y = R[i].transpose();
+  for (Eigen::Index i = 0; i < k; ++i) {
+    Matrix6d Y = R_all_work_[i].transpose();
     M_a_solveInPlace(Y);
-    for (std::size_t j = 0; j < k; ++j) G.block<6, 6>(6 * j, 6 * i) += R[j] * Y;  // eq. 11
+    for (Eigen::Index j = 0; j < k; ++j) G.block<6, 6>(6 * j, 6 * i).noalias() += R_all_work_[j] * Y;  // eq. 11
   }
   symmetrize(G);
   return E_NOERROR;

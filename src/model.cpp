@@ -63,6 +63,9 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
     } else {
       splitInertia(segment.getInertia(), body);
       if (segment.getJoint().getType() != KDL::Joint::None) {
+        // KDL gives the twist at the tip; the rotation axis (or sliding direction) is fixed in
+        // the parent frame, so at the parent's origin the twist does not depend on q.
+        body.joint_twist = toEigen(segment.twist(0.0, 1.0).RefPoint(-segment.pose(0.0).p));
         body.joint = static_cast<int>(GetTreeElementQNr(item.element->second));
         joint_names_[body.joint] = segment.getJoint().getName();
         joint_body_[body.joint] = static_cast<int>(bodies_.size());

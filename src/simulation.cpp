@@ -28,14 +28,17 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   scratch_.state = State(this->model());
   scratch_.velocity.qdot = KDL::JntArray(n);
   tau_ = KDL::JntArray(n);
+  tau_extra_ = KDL::JntArray(n);
   acc_.qddot = KDL::JntArray(n);
   const int size = 13 + 2 * static_cast<int>(n);
   k_.assign(7, Vector::Zero(size));
+  x_.setZero(size);
   x_tmp_.setZero(size);
   x_new_.setZero(size);
   dynamics_.setGravity(options_.gravity);
-  if (!(options_.step > 0.0) || !(options_.rtol > 0.0) || !(options_.atol > 0.0) || !(options_.max_step > 0.0))
-    throw ModelError("simulation: step, rtol, atol and max_step must be > 0");
+  if (!(options_.step > 0.0) || !(options_.rtol > 0.0) || !(options_.atol > 0.0) || !(options_.max_step > 0.0) ||
+      options_.max_steps <= 0)
+    throw ModelError("simulation: step, rtol, atol, max_step and max_steps must be > 0");
 }
 
 void Simulator::setJointControl(unsigned int joint, const JointControl& control) {
@@ -129,10 +132,10 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
                   : 0.0;
   }
   if (callback_) {
-    KDL::JntArray extra(n);
-    callback_(scratch_, extra);
-    if (extra.rows() != n) return E_SIZE_MISMATCH;
-    tau_.data += extra.data;
+    SetToZero(tau_extra_);
+    callback_(scratch_, tau_extra_);
+    if (tau_extra_.rows() != n) return E_SIZE_MISMATCH;
+    tau_.data += tau_extra_.data;
   }
   if (const int rc = dynamics_.CartToJnt(scratch_.state, scratch_.velocity, tau_, {}, acc_)) return rc;
   const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
@@ -191,18 +194,22 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   double T;
   Vector6d h_O;
   if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
-  Vector x(13 + 2 * n);
+  Vector& x = x_;
   pack(s, h_O, x);
   if (const int rc = unpack(x, s.t, s)) return rc;
   if (observer) observer(s);
 
-  double t = s.t, h = std::min(options_.step, options_.max_step);
+  // RK4 takes `step` as given; max_step bounds only the adaptive method.
+  const bool adaptive = options_.integrator == Integrator::DormandPrince54;
+  double t = s.t, h = adaptive ? std::min(options_.step, options_.max_step) : options_.step;
   long outputs = 1;
   const double t0 = s.t;
   while (t < t_end) {
+    if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return E_MAX_STEPS;
     const double t_out = std::min(t0 + outputs * output_dt, t_end);
-    const double h_try = std::min(h, t_out - t);
-    const bool lands = h_try == t_out - t;
+    // Land exactly on the output time when within round-off of it (no sliver steps).
+    const bool lands = t_out - t <= h * (1.0 + 1e-9);
+    const double h_try = lands ? t_out - t : h;
     if (options_.integrator == Integrator::RK4) {
       if (const int rc = stepRK4(t, h_try, x)) return rc;
     } else {

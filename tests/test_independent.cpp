@@ -209,7 +209,7 @@ TEST(IndependentMultiContact, DualArmBothToolsAgainstVirtualJointTree) {
                                         {"right_tool", KDL::Vector(off(rng), off(rng), off(rng))}};
     const std::vector<Contact> contacts{model->contact(points[0].link, points[0].offset),
                                         model->contact(points[1].link, points[1].offset)};
-    Eigen::MatrixXd G;
+    Eigen::MatrixXd G(12, 12);
     ASSERT_EQ(solver.G_star(contacts, G), E_NOERROR);
     const Eigen::MatrixXd G_ref = route.G(points);  // J_full_all M_full^-1 J_full_all^T, 12 x 12
     EXPECT_TRUE(close(G, G_ref, "G_star 12x12"));

@@ -221,7 +221,7 @@ class ComputeCodes : public ::testing::Test {
     Vector3d p;
     Matrix6d M;
     KDL::Jacobian J(n);
-    Eigen::MatrixXd G;
+    Eigen::MatrixXd G(12, 12);
     EXPECT_EQ(solver.contactPoint(h, p), code) << "contactPoint";
     EXPECT_EQ(solver.R_h(h, M), code) << "R_h";
     EXPECT_EQ(solver.J(h, J), code) << "J";

@@ -136,7 +136,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
       printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels());
     }
   }
-  Eigen::MatrixXd G_all;
+  Eigen::MatrixXd G_all(6 * contacts.size(), 6 * contacts.size());
   solver.G_star(contacts, G_all);
 
   if (o.json) {

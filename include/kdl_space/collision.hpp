@@ -81,6 +81,7 @@ class FloatingSide : public ImpactSide {
   FloatingVelocity before_, after_;
   Vector6d PL_before_, PL_after_, t_before_, t_after_;
   double T_before_ = 0.0, T_after_ = 0.0;
+  KDL::JntArray dqdot_;  ///< workspace
 };
 
 /// \brief A rigid body as an impact side, touched at a world point.

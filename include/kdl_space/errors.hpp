@@ -17,6 +17,7 @@ enum Error : int {
   E_NOT_FINITE = -102,            ///< an input holds NaN or an infinity
   E_NOT_POSITIVE_DEFINITE = -103, ///< H* (or, for the grounded G, H) failed its factorisation
   E_BAD_CONTACT = -104,           ///< a contact refers to no body of this model
+  E_MAX_STEPS = -105,             ///< a simulation spent its step budget (SimulationOptions::max_steps)
 };
 
 /// Human-readable text of a return code.

@@ -110,7 +110,11 @@ class FreeFloatingSolver {
   // --- Several contact points (dual-arm) -------------------------------------------------------
   /// \brief The 6k x 6k G* over contacts h_1..h_k: blocks
   /// G*_ij = J*_i H*^-1 J*_j^T + R_i M_a^-1 R_j^T (eq. 11), one factorisation of H* for all.
+  /// G must be sized 6k x 6k by the caller (else E_SIZE_MISMATCH). Allocation-free for up to the
+  /// reserved number of contacts (2 by default, see reserveContacts).
   int G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G);
+  /// Sizes the multi-contact workspace for k contacts (allocates; call before the loop).
+  void reserveContacts(std::size_t k);
 
  private:
   int ready(const Contact& h) const;
@@ -139,6 +143,8 @@ class FreeFloatingSolver {
   Eigen::LLT<Eigen::MatrixXd> H_star_llt_, H_llt_;
   Matrix6Xd J_work_;            ///< contact-query workspace (6 x n)
   Eigen::MatrixXd X_work_;      ///< H^-1 J^T workspace (n x 6)
+  Eigen::MatrixXd J_all_work_, X_all_work_;  ///< multi-contact workspaces (6k x n, n x 6k)
+  std::vector<Matrix6d> R_all_work_;         ///< multi-contact R_h per contact
 };
 
 }  // namespace kdl_space

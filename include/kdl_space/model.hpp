@@ -25,6 +25,9 @@ struct Body {
   int parent = -1;         ///< index of the parent body; -1 for the base
   int joint = -1;          ///< index of the movable joint from the parent; -1 if fixed or base
   KDL::Segment segment;    ///< joint + pose of this body's frame in the parent body's frame
+  /// Unit joint twist (v; w) in the parent's axes at the parent frame's origin: constant for
+  /// revolute and prismatic joints (zero if fixed). Computed once from KDL's Segment::twist.
+  Eigen::Matrix<double, 6, 1> joint_twist = Eigen::Matrix<double, 6, 1>::Zero();
   double mass = 0.0;       ///< [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< CoM, this body's frame [m]
   Eigen::Matrix3d I_com = Eigen::Matrix3d::Zero();     ///< inertia about the CoM, body axes [kg m^2]

@@ -34,6 +34,7 @@ struct SimulationOptions {
   double rtol = 1e-10;     ///< adaptive: relative tolerance per state component
   double atol = 1e-12;     ///< adaptive: absolute tolerance per state component
   double max_step = 0.05;  ///< adaptive: largest step [s]
+  long max_steps = 1000000;  ///< run() gives up (E_MAX_STEPS) after this many steps, e.g. an unstable controller
   Vector3d gravity = Vector3d::Zero();  ///< world frame; zero in orbit
 };
 
@@ -72,10 +73,13 @@ class Simulator {
 
   /// \brief Brakes on: the locked joints' rates become zero by an internal impulse (momentum
   /// unchanged), as when brakes engage. Call before run() if locked joints may be moving.
+  /// (A set-up call: it allocates, unlike run().)
   int engageBrakes(SimulationState& s);
 
   /// \brief Integrates from s.t to t_end. `observer` (may be empty) sees s.t, every multiple of
-  /// output_dt after it, and t_end. \return 0 or an Error code (state left at the last good step).
+  /// output_dt after it, and t_end. \return 0 or an Error code (state left at the last good
+  /// step): E_MAX_STEPS when options().max_steps are spent, E_NOT_FINITE when the adaptive step
+  /// underflows.
   int run(SimulationState& s, double t_end, double output_dt,
           const std::function<void(const SimulationState&)>& observer);
 
@@ -99,10 +103,10 @@ class Simulator {
   SimulationStats stats_;
   // workspaces
   SimulationState scratch_;
-  KDL::JntArray tau_;
+  KDL::JntArray tau_, tau_extra_;
   FloatingAcceleration acc_;
   std::vector<Vector> k_;
-  Vector x_tmp_, x_new_;
+  Vector x_, x_tmp_, x_new_;
 };
 
 }  // namespace kdl_space

@@ -1,0 +1,63 @@
+// O(n) recursive Ex-IIT and impulse response: articulated-body inertias over the KDL tree
+// (Featherstone's articulated-body algorithm with a floating base) instead of forming and
+// factorising H*. Same results as the paper's dense formula (FreeFloatingSolver), which stays
+// the second route in the tests.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "kdl_space/errors.hpp"
+#include "kdl_space/model.hpp"
+#include "kdl_space/spatial.hpp"
+#include "kdl_space/state.hpp"
+
+namespace kdl_space {
+
+/// \brief G* at one contact point and the velocity jump of the whole robot from an impulse there,
+/// in O(n) per state (plus O(depth of the contact) per contact), allocation-free after
+/// construction.
+///
+/// `compute(state)`: forward kinematics and one backward pass of articulated-body inertias
+/// I^A_i = I_i + sum over children (I^A_c - U_c D_c^-1 U_c^T), U = I^A S, D = S^T U (+ armature),
+/// all in world axes about the base frame's origin. Then, for a unit impulse wrench at h, the
+/// bias forces travel from h's body to the base, the base's velocity jump is -(I^A_0)^-1 p^A_0
+/// and the joints' jumps follow outward: G* = J_full M_full^-1 J_full^T (eq. 11) without any
+/// n x n matrix. Compute calls return 0 or an Error code and never throw.
+class RecursiveExIITSolver {
+ public:
+  explicit RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model);
+  const FloatingModel& model() const { return *model_; }
+
+  /// Forward kinematics and articulated-body inertias. \return 0, E_SIZE_MISMATCH, E_NOT_FINITE
+  /// or E_NOT_POSITIVE_DEFINITE.
+  int compute(const State& state);
+  /// Ex-IIT G* at h (world frame, twist per impulse), eq. 11.
+  int G_star(const Contact& h, Matrix6d& G);
+  /// \brief Velocity jump from an impulse wrench F on the robot at h (world frame): the change of
+  /// the base twist (linear velocity of the base origin; angular velocity) and of the joint
+  /// rates, M_full^-1 J_full^T F by one articulated-body pass.
+  int velocityJump(const Contact& h, const Vector6d& F, Vector6d& d_base_twist, KDL::JntArray& dqdot);
+  /// World pose of body i after compute().
+  const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
+
+ private:
+  /// Marks the bodies from h.body to the base in path_ (root last); returns the count.
+  int walkPath(const Contact& h);
+
+  std::shared_ptr<const FloatingModel> model_;
+  bool computed_ = false;
+  Vector3d p_b_ = Vector3d::Zero();                ///< base origin: the common reference point
+  std::vector<KDL::Frame> world_T_body_;
+  std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
+  std::vector<Matrix6d> IA_;                       ///< per body: articulated inertia at p_b
+  std::vector<Vector6d> U_;                        ///< per body: I^A S
+  std::vector<double> D_;                          ///< per body: S^T I^A S + armature
+  Eigen::LLT<Matrix6d> IA0_llt_;
+  std::vector<int> path_;                          ///< scratch: contact path
+  std::vector<Eigen::Matrix<double, 6, 6>> PA_;    ///< scratch: bias forces along the path (6 columns)
+  std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
+  std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse)
+};
+
+}  // namespace kdl_space

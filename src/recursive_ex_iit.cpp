@@ -1,0 +1,145 @@
+#include "kdl_space/recursive_ex_iit.hpp"
+
+#include <cmath>
+
+namespace kdl_space {
+namespace {
+bool finite(const KDL::Frame& f) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(f.p(i))) return false;
+    for (int j = 0; j < 3; ++j)
+      if (!std::isfinite(f.M(i, j))) return false;
+  }
+  return true;
+}
+}  // namespace
+
+RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
+  if (!model_) throw ModelError("RecursiveExIITSolver: null model");
+  const std::size_t nb = model_->bodies().size();
+  world_T_body_.resize(nb);
+  S_.assign(nb, Vector6d::Zero());
+  IA_.resize(nb);
+  U_.assign(nb, Vector6d::Zero());
+  D_.assign(nb, 0.0);
+  path_.resize(nb);
+  PA_.resize(nb);
+  a_.resize(nb);
+  pa_.resize(nb);
+}
+
+int RecursiveExIITSolver::compute(const State& state) {
+  computed_ = false;
+  const std::vector<Body>& bodies = model_->bodies();
+  if (state.q.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!state.q.data.allFinite() || !finite(state.world_T_base)) return E_NOT_FINITE;
+  p_b_ = toEigen(state.world_T_base.p);
+
+  // Forward kinematics; unit joint twists and body inertias about the base origin.
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    if (b.parent < 0) {
+      world_T_body_[i] = state.world_T_base;
+    } else {
+      const double q = b.joint >= 0 ? state.q(b.joint) : 0.0;
+      const KDL::Frame& world_T_parent = world_T_body_[b.parent];
+      world_T_body_[i] = world_T_parent * b.segment.pose(q);
+      if (b.joint >= 0) {
+        // The joint's unit twist, rotated to world axes and moved from the parent's origin to p_b.
+        const Matrix3d R = toEigen(world_T_parent.M);
+        S_[i].tail<3>().noalias() = R * b.joint_twist.tail<3>();
+        S_[i].head<3>().noalias() = R * b.joint_twist.head<3>();
+        S_[i].head<3>() += S_[i].tail<3>().cross(p_b_ - toEigen(world_T_parent.p));
+      }
+    }
+    if (b.mass == 0.0) {
+      IA_[i].setZero();  // a frame-only link
+      continue;
+    }
+    const Matrix3d R = toEigen(world_T_body_[i].M);
+    const Vector3d c = toEigen(world_T_body_[i] * toKDL(b.com)) - p_b_;
+    IA_[i] = spatialInertia(b.mass, c, R * b.I_com * R.transpose());
+  }
+  // Articulated-body inertias, leaves first.
+  for (std::size_t i = bodies.size(); i-- > 1;) {
+    const Body& b = bodies[i];
+    if (b.joint >= 0) {
+      U_[i].noalias() = IA_[i] * S_[i];
+      D_[i] = S_[i].dot(U_[i]) + model_->armature()[b.joint];
+      if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
+      IA_[b.parent].noalias() += IA_[i] - U_[i] * (U_[i].transpose() / D_[i]);
+    } else {
+      IA_[b.parent] += IA_[i];
+    }
+  }
+  IA0_llt_.compute(IA_[0]);
+  if (IA0_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  computed_ = true;
+  return E_NOERROR;
+}
+
+int RecursiveExIITSolver::walkPath(const Contact& h) {
+  int count = 0;
+  for (int b = h.body; b >= 0; b = model_->bodies()[b].parent) path_[count++] = b;
+  return count;
+}
+
+int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
+  const std::vector<Body>& bodies = model_->bodies();
+  const Vector3d r = toEigen(world_T_body_[h.body] * h.offset) - p_b_;
+  const Matrix6d X = transfer(r);  // twist at p_b -> twist at h; X^T: wrench at h -> at p_b (eq. 8)
+  const int count = walkPath(h);
+
+  // Bias forces of the six unit impulses at h, from h's body to the base.
+  Eigen::Matrix<double, 6, 6> P = -X.transpose();
+  for (int k = 0; k < count - 1; ++k) {
+    const int i = path_[k];
+    PA_[i] = P;
+    if (bodies[i].joint >= 0) P.noalias() -= U_[i] * ((S_[i].transpose() * P) / D_[i]);  // p + U D^-1 u, u = -S^T p
+  }
+  // Base: a_0 = -(I^A_0)^-1 p^A_0; then outward along the path: qdd = D^-1 (u - U^T a_parent).
+  Matrix6d A = -IA0_llt_.solve(P);
+  for (int k = count - 2; k >= 0; --k) {
+    const int i = path_[k];
+    if (bodies[i].joint >= 0) {
+      const Eigen::Matrix<double, 1, 6> qdd = -(S_[i].transpose() * PA_[i] + U_[i].transpose() * A) / D_[i];
+      A.noalias() += S_[i] * qdd;
+    }
+  }
+  G.noalias() = X * A;  // eq. 11: the twist jump at h per unit impulse at h
+  return E_NOERROR;
+}
+
+int RecursiveExIITSolver::velocityJump(const Contact& h, const Vector6d& F, Vector6d& d_base_twist,
+                                       KDL::JntArray& dqdot) {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
+  if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!F.allFinite()) return E_NOT_FINITE;
+  const std::vector<Body>& bodies = model_->bodies();
+  const Vector3d r = toEigen(world_T_body_[h.body] * h.offset) - p_b_;
+  const int count = walkPath(h);
+  for (auto& p : pa_) p.setZero();
+  Vector6d p = -transfer(r).transpose() * F;
+  for (int k = 0; k < count - 1; ++k) {
+    const int i = path_[k];
+    pa_[i] = p;
+    if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) / D_[i]);
+  }
+  a_[0] = -IA0_llt_.solve(p);
+  d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
+  for (std::size_t i = 1; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    a_[i] = a_[b.parent];
+    if (b.joint >= 0) {
+      const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) / D_[i];
+      dqdot(b.joint) = qdd;
+      a_[i] += S_[i] * qdd;
+    }
+  }
+  return E_NOERROR;
+}
+
+}  // namespace kdl_space
