@@ -6,12 +6,21 @@
 namespace kdl_space {
 
 FloatingSide::FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
-                           Response response)
+                           Response response, ExIITMethod method)
     : solver_(solver), h_(h), response_(response), before_(before), after_(before), dqdot_(solver.model().nj()) {
   if (before.qdot.rows() != solver.model().nj())
     throw ModelError("robot: " + std::to_string(before.qdot.rows()) + " joint rates for " +
                      std::to_string(solver.model().nj()) + " joints");
-  if (const int rc = solver_.G(h_, response_, G_)) throw ModelError(std::string("robot: ") + strError(rc));
+  Vector3d p_h;
+  if (const int rc = solver_.contactPoint(h_, p_h)) throw ModelError(std::string("robot: ") + strError(rc));
+  if (response_ == Response::FreeFloating && method == ExIITMethod::Recursive) {
+    recursive_ = std::make_unique<RecursiveExIITSolver>(solver_.sharedModel());
+    int rc = recursive_->compute(solver_.state());
+    if (rc == E_NOERROR) rc = recursive_->G_star(h_, G_);
+    if (rc) throw ModelError(std::string("robot: ") + strError(rc));
+  } else if (const int rc = solver_.G(h_, response_, G_)) {
+    throw ModelError(std::string("robot: ") + strError(rc));
+  }
   if (response_ == Response::Grounded) {
     // The grounded base does not move, whatever twist was given.
     before_.base_twist = after_.base_twist = KDL::Twist::Zero();
@@ -32,6 +41,16 @@ Vector6d FloatingSide::contactTwist(const FloatingVelocity& v) const {
 }
 
 int FloatingSide::applyImpulse(const Vector6d& F) {
+  if (recursive_) {
+    Vector6d d_base;
+    if (const int rc = recursive_->velocityJump(h_, F, d_base, dqdot_)) return rc;
+    after_.qdot.data = before_.qdot.data + dqdot_.data;
+    after_.base_twist = before_.base_twist + toTwist(d_base);
+    solver_.momentum(after_.base_twist, after_.qdot, PL_after_);
+    solver_.kineticEnergy(after_.base_twist, after_.qdot, T_after_);
+    t_after_ = contactTwist(after_);
+    return E_NOERROR;
+  }
   Vector6d dPL;
   if (const int rc = solver_.velocityJump(h_, response_, F, dPL, dqdot_)) return rc;
   after_.qdot.data = before_.qdot.data + dqdot_.data;

@@ -36,6 +36,7 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   const std::size_t nb = model_->bodies().size();
   const unsigned int n = model_->nj();
   world_T_body_.resize(nb);
+  state_ = State(*model_);
   I_c_.resize(nb);
   I_body_.resize(nb);
   S_.resize(n);
@@ -114,20 +115,24 @@ int FreeFloatingSolver::compute(const State& state) {
   Am_work_ = A_m_;
   M_a_solveInPlace(Am_work_);
   H_star_.data = H_.data;
-  H_star_.data.noalias() -= A_m_.transpose() * Am_work_;  // eq. 7
+  H_star_.data.noalias() -= A_m_.transpose().lazyProduct(Am_work_);  // eq. 7
   symmetrize(H_star_.data);
   H_llt_.compute(H_.data);
   H_ok_ = H_llt_.info() == Eigen::Success;
   H_star_llt_.compute(H_star_.data);
   if (H_star_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  state_.world_T_base = state.world_T_base;
+  state_.q.data = state.q.data;
   computed_ = true;
   return E_NOERROR;
 }
 
 void FreeFloatingSolver::M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const {
   x.topRows<3>() /= w();
-  auto angular = x.bottomRows<3>();
-  I_g_llt_.solveInPlace(angular);
+  for (Eigen::Index c = 0; c < x.cols(); ++c) {  // column by column: fixed-size, no allocation
+    const Vector3d angular = I_g_llt_.solve(Vector3d(x.col(c).tail<3>()));
+    x.col(c).tail<3>() = angular;
+  }
 }
 
 int FreeFloatingSolver::momentum(const KDL::Twist& base_twist, const KDL::JntArray& qdot,
@@ -154,7 +159,9 @@ int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::J
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
-  T = 0.5 * y.dot(M_a_ * y) + y.dot(A_m_ * qdot.data) + 0.5 * qdot.data.dot(H_.data * qdot.data);
+  double qHq = 0.0;  // q^T H q without a temporary
+  for (Eigen::Index j = 0; j < H_.data.cols(); ++j) qHq += qdot(j) * H_.data.col(j).dot(qdot.data);
+  T = 0.5 * y.dot(M_a_ * y) + y.dot(A_m_ * qdot.data) + 0.5 * qHq;
   return E_NOERROR;
 }
 
@@ -189,8 +196,11 @@ void FreeFloatingSolver::generalizedJacobian(const Contact& h, Eigen::Ref<Matrix
   fixedBaseJacobian(h, J_star);
   const Vector3d r_gh = toEigen(world_T_body_[h.body] * h.offset) - r_g_;
   // J* = J - R_h M_a^-1 A_m (eq. 4); Am_work_ holds M_a^-1 A_m since compute().
-  J_star.topRows<3>() -= Am_work_.topRows<3>() - skew(r_gh) * Am_work_.bottomRows<3>();
-  J_star.bottomRows<3>() -= Am_work_.bottomRows<3>();
+  for (Eigen::Index j = 0; j < J_star.cols(); ++j) {
+    const Vector6d x = Am_work_.col(j);
+    J_star.col(j).head<3>() -= x.head<3>() - r_gh.cross(x.tail<3>());
+    J_star.col(j).tail<3>() -= x.tail<3>();
+  }
 }
 
 int FreeFloatingSolver::J(const Contact& h, KDL::Jacobian& J) {
@@ -221,8 +231,8 @@ int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
   if (const int rc = G_locked(h, G)) return rc;
   generalizedJacobian(h, J_work_);
   X_work_ = J_work_.transpose();
-  H_star_llt_.solveInPlace(X_work_);
-  G.noalias() += J_work_ * X_work_;  // eq. 11
+  for (int c = 0; c < 6; ++c) H_star_llt_.solveInPlace(X_work_.col(c));  // vector solves: no allocation
+  G.noalias() += J_work_.lazyProduct(X_work_);  // eq. 11
   symmetrize(G);
   return E_NOERROR;
 }
@@ -232,8 +242,8 @@ int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
   if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
   fixedBaseJacobian(h, J_work_);
   X_work_ = J_work_.transpose();
-  H_llt_.solveInPlace(X_work_);
-  G.noalias() = J_work_ * X_work_;  // eq. 22
+  for (int c = 0; c < 6; ++c) H_llt_.solveInPlace(X_work_.col(c));
+  G.noalias() = J_work_.lazyProduct(X_work_);  // eq. 22
   symmetrize(G);
   return E_NOERROR;
 }
@@ -308,8 +318,8 @@ int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::Matr
     J_all.middleRows<6>(6 * i) = J_work_;
   }
   X = J_all.transpose();
-  H_star_llt_.solveInPlace(X);  // one factorisation of H* for every block
-  G.noalias() = J_all * X;
+  for (Eigen::Index c = 0; c < X.cols(); ++c) H_star_llt_.solveInPlace(X.col(c));  // one factorisation of H*
+  G.noalias() = J_all.lazyProduct(X);
   for (Eigen::Index i = 0; i < k; ++i) {
     Matrix6d Y = R_all_work_[i].transpose();
     M_a_solveInPlace(Y);

@@ -7,6 +7,7 @@
 
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/impact.hpp"
+#include "kdl_space/recursive_ex_iit.hpp"
 
 namespace kdl_space {
 
@@ -46,14 +47,21 @@ class ImpactSide {
   virtual int applyImpulse(const Vector6d& F) = 0;
 };
 
+/// How a free-floating side computes G* and its velocity jump.
+enum class ExIITMethod {
+  Recursive,  ///< O(n) articulated-body recursion (RecursiveExIITSolver): the default, faster
+  Dense,      ///< the paper's J* H*^-1 J*^T + R_h M_a^-1 R_h^T with a factorised H* (eq. 11)
+};
+
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
 /// The solver must have computed the state; the side keeps a reference to it (and uses it).
 class FloatingSide : public ImpactSide {
  public:
   /// \throws ModelError if the solver's compute() failed, the contact is unknown, qdot has the
   /// wrong size, or the response is unavailable (grounded with a singular H).
+  /// `method` applies to the free-floating response (grounded and locked use their closed forms).
   FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
-               Response response = Response::FreeFloating);
+               Response response = Response::FreeFloating, ExIITMethod method = ExIITMethod::Recursive);
 
   const Matrix6d& G() const override { return G_; }
   const Vector6d& contactTwistBefore() const override { return t_before_; }
@@ -75,6 +83,7 @@ class FloatingSide : public ImpactSide {
   Vector6d aboutOrigin(const Vector6d& PL_g) const;
   Vector6d contactTwist(const FloatingVelocity& v) const;
   FreeFloatingSolver& solver_;
+  std::unique_ptr<RecursiveExIITSolver> recursive_;  ///< set for the recursive free-floating response
   Contact h_;
   Response response_;
   Matrix6d G_;

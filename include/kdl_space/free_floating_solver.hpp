@@ -39,6 +39,7 @@ class FreeFloatingSolver {
   explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model);
 
   const FloatingModel& model() const { return *model_; }
+  const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
 
   /// \brief Forward kinematics, centroid terms, H, A_m, H*; factorises H* and H.
   /// \return E_NOERROR, E_SIZE_MISMATCH (q), E_NOT_FINITE, or E_NOT_POSITIVE_DEFINITE if H* is
@@ -60,6 +61,8 @@ class FreeFloatingSolver {
   const KDL::JntSpaceInertiaMatrix& H() const { return H_; }
   /// Generalized inertia H* = H - A_m^T M_a^-1 A_m (eq. 7).
   const KDL::JntSpaceInertiaMatrix& H_star() const { return H_star_; }
+  /// The state of the last successful compute().
+  const State& state() const { return state_; }
   /// World pose of body i (model().bodies() order).
   const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
   /// Unit twist of joint j (model order), world frame, at the point r_g.
@@ -129,6 +132,7 @@ class FreeFloatingSolver {
   bool computed_ = false;
   bool H_ok_ = false;
   KDL::Frame world_T_base_;
+  State state_;                           ///< copy of the last computed state
   std::vector<KDL::Frame> world_T_body_;  ///< per body
   std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world
   std::vector<Matrix6d> I_body_;          ///< per body: its spatial inertia about r_g

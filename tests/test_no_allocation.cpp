@@ -1,0 +1,231 @@
+// Every compute call of every solver allocates nothing on the heap after construction.
+// Counting: this executable replaces operator new/delete and interposes malloc, calloc, realloc,
+// posix_memalign, aligned_alloc and memalign (glibc's __libc_* do the work), so allocations made
+// inside libkdl_space, KDL and Eigen are all seen. EIGEN_RUNTIME_NO_MALLOC also arms Eigen's own
+// check for the Eigen code compiled in this file (active when assertions are).
+#define EIGEN_RUNTIME_NO_MALLOC
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <new>
+
+#include "kdl_space/collision.hpp"
+#include "kdl_space/forward_dynamics.hpp"
+#include "kdl_space/recursive_ex_iit.hpp"
+#include "kdl_space/simulation.hpp"
+#include "kdl_space/urdf_loader.hpp"
+#include "../benchmarks/generated_chain.hpp"
+#include "test_util.hpp"
+
+extern "C" {
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void* __libc_memalign(size_t, size_t);
+void __libc_free(void*);
+}
+
+namespace {
+long g_allocations = 0;
+bool g_counting = false;
+inline void count() {
+  if (g_counting) ++g_allocations;
+}
+}  // namespace
+
+extern "C" {
+void* malloc(size_t n) {
+  count();
+  return __libc_malloc(n);
+}
+void* calloc(size_t k, size_t n) {
+  count();
+  return __libc_calloc(k, n);
+}
+void* realloc(void* p, size_t n) {
+  count();
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+int posix_memalign(void** p, size_t alignment, size_t n) {
+  count();
+  *p = __libc_memalign(alignment, n);
+  return *p ? 0 : ENOMEM;
+}
+void* aligned_alloc(size_t alignment, size_t n) {
+  count();
+  return __libc_memalign(alignment, n);
+}
+void* memalign(size_t alignment, size_t n) {
+  count();
+  return __libc_memalign(alignment, n);
+}
+}
+
+void* operator new(std::size_t n) {
+  count();
+  if (void* p = __libc_malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void* operator new(std::size_t n, std::align_val_t a) {
+  count();
+  if (void* p = __libc_memalign(static_cast<size_t>(a), n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n, std::align_val_t a) { return operator new(n, a); }
+void operator delete(void* p) noexcept { __libc_free(p); }
+void operator delete[](void* p) noexcept { __libc_free(p); }
+void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { __libc_free(p); }
+
+namespace kdl_space::test {
+namespace {
+
+/// Heap allocations made while `f` runs (Eigen's own check armed too).
+template <typename F>
+long allocationsDuring(F&& f) {
+  g_allocations = 0;
+  Eigen::internal::set_is_malloc_allowed(false);
+  g_counting = true;
+  f();
+  g_counting = false;
+  Eigen::internal::set_is_malloc_allowed(true);
+  return g_allocations;
+}
+
+TEST(NoAllocation, TheCounterSeesAllocations) {
+  // The counting can fail: an allocation in this file, and one inside a library (KDL).
+  EXPECT_GE(allocationsDuring([] { delete new int(3); }), 1);
+  EXPECT_GE(allocationsDuring([] { KDL::JntArray q(7); }), 1);
+  EXPECT_GE(allocationsDuring([] { void* p = std::malloc(16); std::free(p); }), 1);
+}
+
+class EveryComputeCall : public ::testing::TestWithParam<std::string> {};
+
+/// A bundled model, or "chainN": a generated N-link chain (large n exercises Eigen's blocked paths).
+std::shared_ptr<const FloatingModel> load(const std::string& name) {
+  if (name.rfind("chain", 0) == 0)
+    return std::make_shared<const FloatingModel>(loadUrdfString(bench::generatedChainUrdf(std::stoi(name.substr(5))), name));
+  return std::make_shared<const FloatingModel>(loadUrdfFile(urdfDir() + "/" + name));
+}
+
+TEST_P(EveryComputeCall, AllocatesNothing) {
+  const auto model = load(GetParam());
+  const unsigned int n = model->nj();
+  std::mt19937 rng(5);
+  const State state = randomState(*model, rng), other = randomState(*model, rng);
+  const Contact h = model->contact(model->bodies().back().name, KDL::Vector(0.05, -0.02, 0.1));
+  const Contact h2 = model->contact(model->bodies()[model->bodies().size() / 2].name);
+  const std::vector<Contact> contacts{h, h2};
+
+  // Everything constructed (and warmed up once) before counting.
+  FreeFloatingSolver solver(model);
+  RecursiveExIITSolver recursive(model);
+  ForwardDynamicsSolver fd(model);
+  fd.setGravity(Vector3d(0, 0, -9.81));
+  KDL::JntArray qdot(n), tau(n), dqdot(n);
+  for (unsigned int j = 0; j < n; ++j) qdot(j) = 0.1 * j, tau(j) = 0.5 - 0.1 * j;
+  const KDL::Twist base_twist(KDL::Vector(0.01, 0.02, -0.01), KDL::Vector(0.03, -0.01, 0.02));
+  KDL::Jacobian J(n);
+  Matrix6d G;
+  Eigen::MatrixXd G_all(12, 12);
+  Vector6d PL, dPL, d_base, F;
+  F << 1, -2, 0.5, 0.1, 0.2, -0.3;
+  Vector3d p;
+  KDL::Twist t;
+  double T = 0.0;
+  FloatingVelocity v{base_twist, qdot};
+  FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(n)};
+  const std::vector<KDL::Wrench> no_wrenches, wrenches(model->bodies().size(), KDL::Wrench(KDL::Vector(1, 0, 0), KDL::Vector(0, 0.1, 0)));
+  ASSERT_EQ(solver.compute(state), E_NOERROR);
+  ASSERT_EQ(recursive.compute(state), E_NOERROR);
+  const RigidBody box{50.0, Matrix3d::Identity() * 2.0, Vector3d(1.0, 0.5, 0.2), Vector6d::Constant(0.01)};
+  Vector3d p_h;
+  solver.contactPoint(h, p_h);
+  FloatingSide robot(solver, h, v);
+  FloatingSide robot_dense(solver, h, v, Response::FreeFloating, ExIITMethod::Dense);
+  FloatingSide robot_grounded(solver, h, v, Response::Grounded);
+  RigidBodySide target(box, p_h);
+  const Matrix6d G_B = target.G();
+
+  // Each call twice: the first may not allocate either (everything is sized at construction),
+  // the second proves it. A failure names the call.
+#define NO_ALLOCATION(call)                                                                  \
+  do {                                                                                       \
+    call;                                                                                    \
+    EXPECT_EQ(allocationsDuring([&] { call; }), 0) << "allocates: " #call;                  \
+  } while (false)
+  for (const State* s : {&state, &other}) {
+    NO_ALLOCATION(EXPECT_EQ(solver.compute(*s), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(recursive.compute(*s), E_NOERROR));
+  }
+  NO_ALLOCATION(EXPECT_EQ(solver.momentum(base_twist, qdot, PL), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.baseTwist(PL, qdot, t), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.kineticEnergy(base_twist, qdot, T), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.contactPoint(h, p), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.R_h(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.J(h, J), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.J_star(h, J), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.G_star(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.G_grounded(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.G_locked(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.handTwist(h, qdot, PL, t), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(solver.G_star(contacts, G_all), E_NOERROR));
+  for (Response r : {Response::FreeFloating, Response::Grounded, Response::JointsLocked}) {
+    NO_ALLOCATION(EXPECT_EQ(solver.G(h, r, G), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(solver.velocityJump(h, r, F, dPL, dqdot), E_NOERROR));
+  }
+  NO_ALLOCATION(EXPECT_EQ(recursive.G_star(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, F, d_base, dqdot), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(state, v, tau, no_wrenches, a), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(other, v, tau, wrenches, a), E_NOERROR));
+  NO_ALLOCATION(G = rigidBodyG(20.0, Matrix3d::Identity(), Vector3d(0.1, 0.2, 0.3)));
+  NO_ALLOCATION(EXPECT_GT(spectralFigures(G).rank, 0));
+  NO_ALLOCATION(EXPECT_GT(virtualMass(G, Vector3d::UnitX()), 0.0));
+  for (ImpactKind kind : {ImpactKind::Capture, ImpactKind::PointImpact, ImpactKind::FrictionalImpact,
+                          ImpactKind::TranslationalCapture}) {
+    const ImpactLaw law{kind, Vector3d(0.6, 0.0, 0.8), 0.5, 0.4};
+    Impulse impulse;
+    NO_ALLOCATION(impulse = solveImpact(robot.G(), G_B, robot.contactTwistBefore(), target.contactTwistBefore(), law));
+    EXPECT_TRUE(impulse.F.allFinite());
+    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded})
+      NO_ALLOCATION(EXPECT_EQ(side->applyImpulse(impulse.F), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(target.applyImpulse(-impulse.F), E_NOERROR));
+    NO_ALLOCATION((void)collide(robot, target, law));
+  }
+#undef NO_ALLOCATION
+}
+
+TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
+  const auto model = load(GetParam());
+  std::mt19937 rng(6);
+  for (Integrator integrator : {Integrator::RK4, Integrator::DormandPrince54}) {
+    SimulationOptions options;
+    options.integrator = integrator;
+    options.step = 0.01;
+    Simulator sim(model, options);
+    sim.setJointControl(0, {JointControl::Mode::PD, 10.0, 5.0, 0.2});
+    if (model->nj() > 2) sim.setJointControl(1, {JointControl::Mode::Locked});
+    sim.setTorqueCallback([](const SimulationState& s, KDL::JntArray& tau) { tau.data = -0.1 * s.velocity.qdot.data; });
+    SimulationState s;
+    s.state = randomState(*model, rng);
+    s.velocity.qdot = KDL::JntArray(model->nj());
+    ASSERT_EQ(sim.engageBrakes(s), E_NOERROR);  // a set-up call, outside the count
+    const auto observer = [&](const SimulationState& x) { EXPECT_TRUE(x.state.q.data.allFinite()); };
+    const std::function<void(const SimulationState&)> watch = observer;  // constructed before counting
+    ASSERT_EQ(sim.run(s, 0.05, 0.01, watch), E_NOERROR);                  // warm-up
+    EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, s.t + 0.2, 0.05, watch), E_NOERROR); }), 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, EveryComputeCall,
+                         ::testing::Values("space_arm7.urdf", "dual_arm.urdf", "chain50", "chain100"));
+
+}  // namespace
+}  // namespace kdl_space::test
