@@ -100,7 +100,8 @@ int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
     if (bodies[i].joint >= 0) P.noalias() -= U_[i] * ((S_[i].transpose() * P) / D_[i]);  // p + U D^-1 u, u = -S^T p
   }
   // Base: a_0 = -(I^A_0)^-1 p^A_0; then outward along the path: qdd = D^-1 (u - U^T a_parent).
-  Matrix6d A = -IA0_llt_.solve(P);
+  Matrix6d A;
+  for (int c = 0; c < 6; ++c) A.col(c) = -IA0_llt_.solve(Vector6d(P.col(c)));  // vector solves: no blocked path
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
     if (bodies[i].joint >= 0) {
@@ -109,6 +110,8 @@ int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
     }
   }
   G.noalias() = X * A;  // eq. 11: the twist jump at h per unit impulse at h
+  for (int i = 0; i < 6; ++i)  // symmetric up to round-off: make it exactly so, as the dense route does
+    for (int j = i + 1; j < 6; ++j) G(i, j) = G(j, i) = 0.5 * (G(i, j) + G(j, i));
   return E_NOERROR;
 }
 
