@@ -16,11 +16,6 @@ Vector6d crossForce(const Vector6d& V, const Vector6d& F) {
   r.tail<3>() = V.tail<3>().cross(F.tail<3>()) + V.head<3>().cross(F.head<3>());
   return r;
 }
-Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {  // reference point moved by r
-  Vector6d s = t;
-  s.head<3>() += t.tail<3>().cross(r);
-  return s;
-}
 
 }  // namespace
 

@@ -5,27 +5,11 @@
 namespace kdl_space {
 namespace {
 
-bool finite(const KDL::Frame& f) {
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(f.p(i))) return false;
-    for (int j = 0; j < 3; ++j)
-      if (!std::isfinite(f.M(i, j))) return false;
-  }
-  return true;
-}
-
 /// Averages a square matrix with its transpose in place (removes round-off asymmetry).
 template <typename Derived>
 void symmetrize(Eigen::MatrixBase<Derived>& A) {
   for (Eigen::Index i = 0; i < A.rows(); ++i)
     for (Eigen::Index j = i + 1; j < A.cols(); ++j) A(i, j) = A(j, i) = 0.5 * (A(i, j) + A(j, i));
-}
-
-/// Moves the reference point of a twist by r (from the old point to the new one).
-Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {
-  Vector6d s = t;
-  s.head<3>() += t.tail<3>().cross(r);
-  return s;
 }
 
 }  // namespace
@@ -57,7 +41,7 @@ int FreeFloatingSolver::compute(const State& state) {
   const std::vector<Body>& bodies = model_->bodies();
   const unsigned int n = model_->nj();
   if (state.q.rows() != n) return E_SIZE_MISMATCH;
-  if (!state.q.data.allFinite() || !finite(state.world_T_base)) return E_NOT_FINITE;
+  if (!state.q.data.allFinite() || !allFinite(state.world_T_base)) return E_NOT_FINITE;
   world_T_base_ = state.world_T_base;
   H_.data.setZero();
 

@@ -13,12 +13,6 @@ namespace {
 bool finite(const KDL::Vector& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
-bool finite(const KDL::Frame& f) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (!std::isfinite(f.M(i, j))) return false;
-  return finite(f.p);
-}
 
 /// Mass, CoM and inertia about the CoM of a KDL inertia (KDL keeps the inertia about the
 /// reference frame's origin).
@@ -121,7 +115,7 @@ void FloatingModel::validate() {
     const bool base = b.parent < 0;
     if (!base) {
       const KDL::Joint& joint = b.segment.getJoint();
-      if (!finite(b.segment.pose(0.0)))
+      if (!allFinite(b.segment.pose(0.0)))
         fail("link", link, "the pose of its frame (joint origin) holds NaN or infinite values");
       if (joint.getType() != KDL::Joint::None) {
         const KDL::Vector axis = joint.JointAxis();

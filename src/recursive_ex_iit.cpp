@@ -3,17 +3,6 @@
 #include <cmath>
 
 namespace kdl_space {
-namespace {
-bool finite(const KDL::Frame& f) {
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(f.p(i))) return false;
-    for (int j = 0; j < 3; ++j)
-      if (!std::isfinite(f.M(i, j))) return false;
-  }
-  return true;
-}
-}  // namespace
-
 RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("RecursiveExIITSolver: null model");
   const std::size_t nb = model_->bodies().size();
@@ -32,7 +21,7 @@ int RecursiveExIITSolver::compute(const State& state) {
   computed_ = false;
   const std::vector<Body>& bodies = model_->bodies();
   if (state.q.rows() != model_->nj()) return E_SIZE_MISMATCH;
-  if (!state.q.data.allFinite() || !finite(state.world_T_base)) return E_NOT_FINITE;
+  if (!state.q.data.allFinite() || !allFinite(state.world_T_base)) return E_NOT_FINITE;
   p_b_ = toEigen(state.world_T_base.p);
 
   // Forward kinematics; unit joint twists and body inertias about the base origin.

@@ -1,6 +1,7 @@
 #include "kdl_space/spatial.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <limits>
 
 namespace kdl_space {
@@ -47,6 +48,15 @@ SpectralFigures spectralFigures(const Matrix6d& G, double tolerance) {
   for (int i = 0; i < 6; ++i) f.rank += lambda(i) > threshold ? 1 : 0;
   f.condition = f.rank == 6 ? lambda(5) / lambda(0) : std::numeric_limits<double>::infinity();
   return f;
+}
+
+bool allFinite(const KDL::Frame& f) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(f.p(i))) return false;
+    for (int j = 0; j < 3; ++j)
+      if (!std::isfinite(f.M(i, j))) return false;
+  }
+  return true;
 }
 
 Matrix3d toEigen(const KDL::Rotation& R) {

@@ -5,18 +5,9 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${KDL_SPACE_BENCH_BUILD_DIR:-$root/build-release}"
-"$root/tools/deps.sh"
-missing=()
-for p in libdart-dev libdart-utils-urdf-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "tools/bench.sh: installing ${missing[*]} (for the DART comparison)" >&2
-  sudo_cmd=()
-  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null ||
-    echo "tools/bench.sh: DART could not be installed; benchmarking without it" >&2
-fi
+# DART only for the comparison: the benchmark runs without it if it cannot be installed.
+"$root/tools/deps.sh" libdart-dev libdart-utils-urdf-dev ||
+  { echo "tools/bench.sh: DART could not be installed; benchmarking without it" >&2; "$root/tools/deps.sh"; }
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF >/dev/null
 cmake --build "$build" -j"$(nproc)" --target kdl_space_bench >/dev/null
 

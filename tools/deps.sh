@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages kdl_space needs to build, test and run, when missing.
-# Used by tools/demo.sh and tools/test.sh; safe to run again (installs nothing if all present).
+# Installs the Debian 12 packages kdl_space needs to build, test and run, when missing, plus any
+# packages given as arguments. Used by tools/demo.sh, tools/test.sh and tools/bench.sh; safe to
+# run again (installs nothing if all are present).
 set -euo pipefail
 
 packages=(
@@ -8,6 +9,7 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   gnuplot-nox
+  "$@"
 )
 
 missing=()

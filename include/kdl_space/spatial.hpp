@@ -24,6 +24,17 @@ Matrix3d skew(const Vector3d& r);
 /// at a + r to the same wrench at a (eq. 8).
 Matrix6d transfer(const Vector3d& r);
 
+/// \brief The same rigid twist with its reference point moved by r (from the old point to the
+/// new one): v' = v + w x r. (transfer(r) t, without the 6x6 product.)
+inline Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {
+  Vector6d s = t;
+  s.head<3>() += t.tail<3>().cross(r);
+  return s;
+}
+
+/// True when every number of the frame is finite.
+bool allFinite(const KDL::Frame& f);
+
 /// \brief Spatial inertia (6x6, (v; w) order) of a rigid body about a reference point, world
 /// axes: mass m, CoM at c relative to the reference point, inertia I_c about the CoM.
 /// Maps a twist at the reference point to the momentum (P; L about the reference point).
