@@ -14,20 +14,22 @@ cmake --build "$build" -j"$(nproc)" --target kdl_space_bench >/dev/null
 flags=(--benchmark_repetitions=5 --benchmark_min_time=0.2 --benchmark_report_aggregates_only=true)
 chains=$(mktemp) model=$(mktemp)
 "$build/kdl_space_bench" "${flags[@]}" --markdown "$chains"
-"$build/kdl_space_bench" "${flags[@]}" --model "$root/urdf/space_arm7.urdf" --tip end_effector --markdown "$model"
+(cd "$root" && "$build/kdl_space_bench" "${flags[@]}" --model urdf/space_arm7.urdf --tip end_effector --markdown "$model")
 
 out="$root/docs/benchmarks.md"
 {
   echo "# Benchmarks"
   echo
   echo "Written by \`tools/bench.sh\` on $(date -u +%Y-%m-%d): \`kdl_space_bench\`, Release build,"
-  echo "medians of 5 repetitions, every method timed side by side in one run on the same URDF."
+  echo "medians of 5 repetitions of the CPU time per call, every method timed side by side in one run on"
+  echo "the same URDF."
   echo "A call includes everything from joint positions to the result (forward kinematics included);"
   echo "every method alternates between two configurations so that no library reuses a cached result."
   echo
   echo "- ours_G_star: \`RecursiveExIITSolver\` compute + G_star (O(n) articulated-body recursion);"
   echo "- ours_J_star, ours_H_star: \`FreeFloatingSolver\` compute (composite-rigid-body pass, Cholesky of H* and H) + query;"
   echo "- ours_capture_state: G*, the capture impulse of a 50 kg box and the velocity jumps of base and joints;"
+  echo "- ours_capture_solve: the capture impulse alone for a given G* and target (eq. 24);"
   echo "- ours_forward_dynamics: \`ForwardDynamicsSolver::CartToJnt\` (dense, O(n^3));"
   echo "- naive_KDL_G_star: six virtual base joints + \`ChainDynParam::JntToMass\` + \`ChainJntToJacSolver\` + Eigen LLT;"
   echo "- DART_G_star: DART's \`getWorldJacobian\` and \`getInvMassMatrix\` on the same URDF with a free root joint."
