@@ -39,7 +39,7 @@ class RecursiveExIITSolver {
   /// rates, M_full^-1 J_full^T F by one articulated-body pass.
   int velocityJump(const Contact& h, const Vector6d& F, Vector6d& d_base_twist, KDL::JntArray& dqdot);
   /// World pose of body i after compute().
-  const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
+  KDL::Frame bodyPose(int i) const;
 
  private:
   /// Marks the bodies from h.body to the base in path_ (root last); returns the count.
@@ -48,7 +48,19 @@ class RecursiveExIITSolver {
   std::shared_ptr<const FloatingModel> model_;
   bool computed_ = false;
   Vector3d p_b_ = Vector3d::Zero();                ///< base origin: the common reference point
-  std::vector<KDL::Frame> world_T_body_;
+  /// A joint's motion, from KDL's segment once: pose(q) = screw(q) * pose(0), the screw about the
+  /// joint's axis (revolute: rotation by scale q about the line through `point`; prismatic:
+  /// translation by scale q), so that compute() needs no KDL call per body.
+  struct LocalJoint {
+    int kind = 0;  ///< 0 fixed, 1 revolute, 2 prismatic
+    Vector3d axis = Vector3d::UnitZ(), point = Vector3d::Zero();  ///< parent frame
+    double scale = 1.0;
+    Matrix3d R0 = Matrix3d::Identity();  ///< pose(0), parent frame
+    Vector3d p0 = Vector3d::Zero();
+  };
+  std::vector<LocalJoint> joints_;      ///< per body
+  std::vector<Matrix3d> R_;             ///< per body: world rotation
+  std::vector<Vector3d> p_;             ///< per body: world position of the frame origin
   std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
   std::vector<Matrix6d> IA_;                       ///< per body: articulated inertia at p_b
   std::vector<Vector6d> U_;                        ///< per body: I^A S
