@@ -3,17 +3,6 @@
 #include <cmath>
 
 namespace kdl_space {
-namespace {
-
-/// Averages a square matrix with its transpose in place (removes round-off asymmetry).
-template <typename Derived>
-void symmetrize(Eigen::MatrixBase<Derived>& A) {
-  for (Eigen::Index i = 0; i < A.rows(); ++i)
-    for (Eigen::Index j = i + 1; j < A.cols(); ++j) A(i, j) = A(j, i) = 0.5 * (A(i, j) + A(j, i));
-}
-
-}  // namespace
-
 FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
     : model_(std::move(model)) {
   if (!model_) throw ModelError("FreeFloatingSolver: null model");

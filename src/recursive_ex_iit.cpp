@@ -136,8 +136,7 @@ int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
     }
   }
   G.noalias() = X * A;  // eq. 11: the twist jump at h per unit impulse at h
-  for (int i = 0; i < 6; ++i)  // symmetric up to round-off: make it exactly so, as the dense route does
-    for (int j = i + 1; j < 6; ++j) G(i, j) = G(j, i) = 0.5 * (G(i, j) + G(j, i));
+  symmetrize(G);  // symmetric up to round-off: exactly so, as the dense route's
   return E_NOERROR;
 }
 

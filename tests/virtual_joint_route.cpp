@@ -101,15 +101,22 @@ KDL::Tree buildVirtualTree(const FloatingModel& model, const KDL::Frame& world_T
 
 // --- Tree -----------------------------------------------------------------------------------
 
-VirtualJointTree::VirtualJointTree(const FloatingModel& model, const State& state)
-    : tree_(buildVirtualTree(model, state.world_T_base)), n_(static_cast<int>(model.nj())) {
+namespace {
+/// The KDL tree's joint number (q_nr) of every movable joint, by joint name.
+std::map<std::string, int> jointNumbers(const KDL::Tree& tree) {
   std::map<std::string, int> by_name;
-  for (const auto& [name, element] : tree_.getSegments()) {
+  for (const auto& [name, element] : tree.getSegments()) {
     const KDL::Segment& seg = GetTreeElementSegment(element);
     if (seg.getJoint().getType() != KDL::Joint::None)
       by_name[seg.getJoint().getName()] = static_cast<int>(GetTreeElementQNr(element));
   }
-  index_ = coordinateIndex(model, by_name);
+  return by_name;
+}
+}  // namespace
+
+VirtualJointTree::VirtualJointTree(const FloatingModel& model, const State& state)
+    : tree_(buildVirtualTree(model, state.world_T_base)), n_(static_cast<int>(model.nj())) {
+  index_ = coordinateIndex(model, jointNumbers(tree_));
   const unsigned int nt = tree_.getNrOfJoints();
   if (nt != 6 + model.nj()) throw std::runtime_error("virtual route: joint count mismatch");
 
@@ -217,13 +224,7 @@ struct VirtualJointDynamics::Solvers {
 
 VirtualJointDynamics::VirtualJointDynamics(const FloatingModel& model, const KDL::Frame& offset)
     : tree_(buildVirtualTree(model, offset)), n_(static_cast<int>(model.nj())) {
-  std::map<std::string, int> by_name;
-  for (const auto& [name, element] : tree_.getSegments()) {
-    const KDL::Segment& seg = GetTreeElementSegment(element);
-    if (seg.getJoint().getType() != KDL::Joint::None)
-      by_name[seg.getJoint().getName()] = static_cast<int>(GetTreeElementQNr(element));
-  }
-  index_ = coordinateIndex(model, by_name);
+  index_ = coordinateIndex(model, jointNumbers(tree_));
   if (tree_.getNrOfJoints() != 6 + model.nj()) throw std::runtime_error("virtual route: joint count mismatch");
   armature_ = Eigen::VectorXd::Zero(6 + n_);
   for (int j = 0; j < n_; ++j) armature_(6 + j) = model.armature()[j];

@@ -32,6 +32,13 @@ inline Vector6d shiftTwist(const Vector6d& t, const Vector3d& r) {
   return s;
 }
 
+/// Averages a square matrix with its transpose in place: a symmetric result exactly symmetric.
+template <typename Derived>
+void symmetrize(Eigen::MatrixBase<Derived>& A) {
+  for (Eigen::Index i = 0; i < A.rows(); ++i)
+    for (Eigen::Index j = i + 1; j < A.cols(); ++j) A(i, j) = A(j, i) = 0.5 * (A(i, j) + A(j, i));
+}
+
 /// True when every number of the frame is finite.
 bool allFinite(const KDL::Frame& f);
 
