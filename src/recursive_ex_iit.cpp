@@ -3,6 +3,15 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+// The recursions are small dense 6x6 algebra: compiled twice, for the x86-64 baseline and for
+// x86-64-v3 (AVX2, FMA), the loader picking the one the CPU runs (GCC's target_clones, an ifunc).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define KDL_SPACE_MULTIVERSION __attribute__((target_clones("default", "arch=x86-64-v3")))
+#else
+#define KDL_SPACE_MULTIVERSION
+#endif
+
 namespace kdl_space {
 RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("RecursiveExIITSolver: null model");
@@ -22,7 +31,12 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
       j.kind = 1;
       j.scale = w.norm();
       j.axis = w / j.scale;
-      j.point = w.cross(v) / w.squaredNorm();  // the axis' point nearest the parent's origin
+      const Vector3d point = w.cross(v) / w.squaredNorm();  // the axis' point nearest the parent's origin
+      const Matrix3d a = skew(j.axis), a2 = a * a;
+      j.K1 = a * j.R0;
+      j.K2 = a2 * j.R0;
+      j.k1 = a * (j.p0 - point);
+      j.k2 = a2 * (j.p0 - point);
     } else {
       j.kind = 2;
       j.scale = v.norm();
@@ -34,12 +48,11 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   U_.assign(nb, Vector6d::Zero());
   D_.assign(nb, 0.0);
   path_.resize(nb);
-  PA_.resize(nb);
   a_.resize(nb);
   pa_.resize(nb);
 }
 
-int RecursiveExIITSolver::compute(const State& state) {
+KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const State& state) {
   computed_ = false;
   const std::vector<Body>& bodies = model_->bodies();
   if (state.q.rows() != model_->nj()) return E_SIZE_MISMATCH;
@@ -56,14 +69,15 @@ int RecursiveExIITSolver::compute(const State& state) {
       const LocalJoint& j = joints_[i];
       const Matrix3d& R_parent = R_[b.parent];
       const Vector3d& p_parent = p_[b.parent];
-      if (j.kind == 1) {  // revolute: rotation about the line (axis, point), then pose(0)
-        const Matrix3d R = Eigen::AngleAxisd(j.scale * state.q(b.joint), j.axis).toRotationMatrix();
-        const Matrix3d RR = R_parent * R;
-        R_[i].noalias() = RR * j.R0;
-        p_[i] = p_parent + RR * (j.p0 - j.point) + R_parent * j.point;
+      if (j.kind == 1) {  // revolute: rotation about the joint's axis line, then pose(0)
+        const double t = j.scale * state.q.data(b.joint), s = std::sin(t), c1 = 1.0 - std::cos(t);
+        const Matrix3d R_local = j.R0 + s * j.K1 + c1 * j.K2;
+        R_[i].noalias() = R_parent * R_local;
+        p_[i] = p_parent;
+        p_[i].noalias() += R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
       } else {
         R_[i].noalias() = R_parent * j.R0;
-        p_[i] = p_parent + R_parent * (j.kind == 2 ? Vector3d(j.p0 + j.scale * state.q(b.joint) * j.axis) : j.p0);
+        p_[i] = p_parent + R_parent * (j.kind == 2 ? Vector3d(j.p0 + j.scale * state.q.data(b.joint) * j.axis) : j.p0);
       }
       if (b.joint >= 0) {
         // The joint's unit twist, rotated to world axes and moved from the parent's origin to p_b.
@@ -72,26 +86,25 @@ int RecursiveExIITSolver::compute(const State& state) {
         S_[i].head<3>() += S_[i].tail<3>().cross(p_b_ - p_parent);
       }
     }
-    if (b.mass == 0.0) {
-      IA_[i].setZero();  // a frame-only link
-      continue;
+    IA_[i].setZero();
+    if (b.mass > 0.0) {  // else a frame-only link
+      const Matrix3d& R = R_[i];
+      const Matrix3d RI = R * b.I_com;
+      IA_[i].addRigidBody(b.mass, R * b.com + p_[i] - p_b_, RI * R.transpose());
     }
-    const Matrix3d& R = R_[i];
-    IA_[i] = spatialInertia(b.mass, R * b.com + p_[i] - p_b_, R * b.I_com * R.transpose());
   }
   // Articulated-body inertias, leaves first.
   for (std::size_t i = bodies.size(); i-- > 1;) {
     const Body& b = bodies[i];
+    IA_[b.parent] += IA_[i];
     if (b.joint >= 0) {
-      U_[i].noalias() = IA_[i] * S_[i];
+      U_[i] = IA_[i] * S_[i];
       D_[i] = S_[i].dot(U_[i]) + model_->armature()[b.joint];
       if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
-      IA_[b.parent].noalias() += IA_[i] - U_[i] * (U_[i].transpose() / D_[i]);
-    } else {
-      IA_[b.parent] += IA_[i];
+      IA_[b.parent].subtractRank1(U_[i], 1.0 / D_[i]);
     }
   }
-  IA0_llt_.compute(IA_[0]);
+  IA0_llt_.compute(IA_[0].toDense());
   if (IA0_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
   computed_ = true;
   return E_NOERROR;
@@ -110,32 +123,36 @@ int RecursiveExIITSolver::walkPath(const Contact& h) {
   return count;
 }
 
-int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
+KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
   if (!computed_) return E_NOT_COMPUTED;
   if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
   const std::vector<Body>& bodies = model_->bodies();
-  const Vector3d r = R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_;
-  const Matrix6d X = transfer(r);  // twist at p_b -> twist at h; X^T: wrench at h -> at p_b (eq. 8)
   const int count = walkPath(h);
-
-  // Bias forces of the six unit impulses at h, from h's body to the base.
-  Eigen::Matrix<double, 6, 6> P = -X.transpose();
-  for (int k = 0; k < count - 1; ++k) {
-    const int i = path_[k];
-    PA_[i] = P;
-    if (bodies[i].joint >= 0) P.noalias() -= U_[i] * ((S_[i].transpose() * P) / D_[i]);  // p + U D^-1 u, u = -S^T p
+  // Outward along the path, the inverse inertia a wrench at body i meets (about p_b):
+  // Omega_0 = (I^A_0)^-1, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T with
+  // T_i = 1 - S_i D_i^-1 U_i^T (an impulse's bias force crossing joint i inward is T_i^T times it).
+  // Expanded with w = Omega U, c = U^T w: Omega - (S y^T + y S^T), y = w/D - (c/D^2 + 1/D) S / 2.
+  Symmetric6d Omega;
+  for (int c = 0; c < 6; ++c) {  // vector solves: no blocked path
+    const Vector6d col = IA0_llt_.solve(Vector6d::Unit(c));
+    for (int r = c; r < 6; ++r) Omega.a[Symmetric6d::index(r, c)] = col(r);
   }
-  // Base: a_0 = -(I^A_0)^-1 p^A_0; then outward along the path: qdd = D^-1 (u - U^T a_parent).
-  Matrix6d A;
-  for (int c = 0; c < 6; ++c) A.col(c) = -IA0_llt_.solve(Vector6d(P.col(c)));  // vector solves: no blocked path
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
-    if (bodies[i].joint >= 0) {
-      const Eigen::Matrix<double, 1, 6> qdd = -(S_[i].transpose() * PA_[i] + U_[i].transpose() * A) / D_[i];
-      A.noalias() += S_[i] * qdd;
-    }
+    if (bodies[i].joint < 0) continue;
+    const double d = 1.0 / D_[i];
+    const Vector6d w = Omega * U_[i];
+    Omega.subtractRank2(S_[i], d * w - (0.5 * d * (d * U_[i].dot(w) + 1.0)) * S_[i]);
   }
-  G.noalias() = X * A;  // eq. 11: the twist jump at h per unit impulse at h
+  // G* = X Omega X^T, X = transfer(r) = [E, -r^; 0, E] (eq. 5, 11), by 3x3 blocks: with
+  // Omega = [a, b; b^T, c], G* = [a - r^ b^T + e r^, e; e^T, c], e = b - r^ c.
+  const Matrix3d rx = skew(R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_);
+  const Matrix6d O = Omega.toDense();
+  const Matrix3d e = O.topRightCorner<3, 3>() - rx * O.bottomRightCorner<3, 3>();
+  G.topLeftCorner<3, 3>() = O.topLeftCorner<3, 3>() - rx * O.bottomLeftCorner<3, 3>() + e * rx;
+  G.topRightCorner<3, 3>() = e;
+  G.bottomLeftCorner<3, 3>() = e.transpose();
+  G.bottomRightCorner<3, 3>() = O.bottomRightCorner<3, 3>();
   symmetrize(G);  // symmetric up to round-off: exactly so, as the dense route's
   return E_NOERROR;
 }

@@ -398,6 +398,37 @@ INSTANTIATE_TEST_SUITE_P(RecursiveModels, RecursiveBundled, ::testing::ValuesIn(
 
 // --- Random trees ----------------------------------------------------------------------------
 
+// The packed symmetric 6x6 of the recursions against the dense spatial algebra it replaces.
+TEST(Symmetric6d, AgreesWithDenseAlgebra) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double m = 1.0 + 10.0 * std::abs(U(rng));
+    const Vector3d c(U(rng), U(rng), U(rng));
+    Matrix3d B = Matrix3d::NullaryExpr([&] { return U(rng); });
+    const Matrix3d I_c = B * B.transpose() + Matrix3d::Identity();
+    Vector6d u, v, x;
+    for (int k = 0; k < 6; ++k) u(k) = U(rng), v(k) = U(rng), x(k) = U(rng);
+    const double alpha = U(rng);
+
+    Symmetric6d S;
+    S.setZero();
+    S.addRigidBody(m, c, I_c);
+    Matrix6d D = spatialInertia(m, c, I_c);
+    EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "addRigidBody";
+    EXPECT_LT((S * x - D * x).norm(), 1e-14 * D.norm() * x.norm()) << "product";
+    S += S;
+    D += D;
+    S.subtractRank1(u, alpha);
+    D -= alpha * u * u.transpose();
+    S.subtractRank2(u, v);
+    D -= u * v.transpose() + v * u.transpose();
+    EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "+=, rank-1 and rank-2 updates";
+    for (int r = 0; r < 6; ++r)
+      for (int k = 0; k < 6; ++k) EXPECT_EQ(S(r, k), S(k, r));
+  }
+}
+
 TEST(RecursiveRandomTrees, GeneratorCoversTheCases) {
   std::mt19937 rng(kTreeSeed);
   Coverage total;

@@ -51,23 +51,24 @@ class RecursiveExIITSolver {
   /// A joint's motion, from KDL's segment once: pose(q) = screw(q) * pose(0), the screw about the
   /// joint's axis (revolute: rotation by scale q about the line through `point`; prismatic:
   /// translation by scale q), so that compute() needs no KDL call per body.
+  /// Revolute, by Rodrigues' formula Rot(a, t) = E + sin t a^ + (1 - cos t) a^ a^ folded into
+  /// pose(0): pose(q) = (R0 + s K1 + (1 - c) K2, p0 + s k1 + (1 - c) k2), t = scale q.
   struct LocalJoint {
     int kind = 0;  ///< 0 fixed, 1 revolute, 2 prismatic
-    Vector3d axis = Vector3d::UnitZ(), point = Vector3d::Zero();  ///< parent frame
+    Vector3d axis = Vector3d::UnitZ();  ///< parent frame
     double scale = 1.0;
-    Matrix3d R0 = Matrix3d::Identity();  ///< pose(0), parent frame
-    Vector3d p0 = Vector3d::Zero();
+    Matrix3d R0 = Matrix3d::Identity(), K1 = Matrix3d::Zero(), K2 = Matrix3d::Zero();  ///< parent frame
+    Vector3d p0 = Vector3d::Zero(), k1 = Vector3d::Zero(), k2 = Vector3d::Zero();
   };
   std::vector<LocalJoint> joints_;      ///< per body
   std::vector<Matrix3d> R_;             ///< per body: world rotation
   std::vector<Vector3d> p_;             ///< per body: world position of the frame origin
   std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
-  std::vector<Matrix6d> IA_;                       ///< per body: articulated inertia at p_b
+  std::vector<Symmetric6d> IA_;                    ///< per body: articulated inertia at p_b
   std::vector<Vector6d> U_;                        ///< per body: I^A S
   std::vector<double> D_;                          ///< per body: S^T I^A S + armature
   Eigen::LLT<Matrix6d> IA0_llt_;
   std::vector<int> path_;                          ///< scratch: contact path
-  std::vector<Eigen::Matrix<double, 6, 6>> PA_;    ///< scratch: bias forces along the path (6 columns)
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse)
 };

@@ -47,6 +47,78 @@ bool allFinite(const KDL::Frame& f);
 /// Maps a twist at the reference point to the momentum (P; L about the reference point).
 Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c);
 
+/// \brief A symmetric 6x6 (spatial or articulated inertia, inverse inertia) stored as the 21
+/// numbers of its lower triangle: half the arithmetic of a Matrix6d in the O(n) recursions.
+struct Symmetric6d {
+  double a[21];
+
+  static constexpr int index(int r, int c) { return r >= c ? r * (r + 1) / 2 + c : c * (c + 1) / 2 + r; }
+  double operator()(int r, int c) const { return a[index(r, c)]; }
+  void setZero() {
+    for (double& x : a) x = 0.0;
+  }
+  Symmetric6d& operator+=(const Symmetric6d& o) {
+    for (int k = 0; k < 21; ++k) a[k] += o.a[k];
+    return *this;
+  }
+  /// this * x (each stored number used twice off the diagonal)
+  Vector6d operator*(const Vector6d& x) const {
+    Vector6d y = Vector6d::Zero();
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+      const int row = r * (r + 1) / 2;
+#pragma GCC unroll 6
+      for (int c = 0; c < r; ++c) {
+        y(r) += a[row + c] * x(c);
+        y(c) += a[row + c] * x(r);
+      }
+      y(r) += a[row + r] * x(r);
+    }
+    return y;
+  }
+  /// this -= alpha u u^T
+  void subtractRank1(const Vector6d& u, double alpha) {
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+      const double ur = alpha * u(r);
+      const int row = r * (r + 1) / 2;
+#pragma GCC unroll 6
+      for (int c = 0; c <= r; ++c) a[row + c] -= ur * u(c);
+    }
+  }
+  /// this -= u v^T + v u^T
+  void subtractRank2(const Vector6d& u, const Vector6d& v) {
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+      const int row = r * (r + 1) / 2;
+#pragma GCC unroll 6
+      for (int c = 0; c <= r; ++c) a[row + c] -= u(r) * v(c) + v(r) * u(c);
+    }
+  }
+  /// Adds the spatial inertia of a rigid body about the reference point, world axes: mass m,
+  /// CoM at c relative to the point, inertia I_c about the CoM (as spatialInertia).
+  void addRigidBody(double m, const Vector3d& c, const Matrix3d& I_c) {
+    const double mx = m * c.x(), my = m * c.y(), mz = m * c.z();
+    a[0] += m, a[2] += m, a[5] += m;                           // m E
+    a[7] += -mz, a[8] += my;                                   // m skew(c), rows 3-5, columns 0-2
+    a[10] += mz, a[12] += -mx;
+    a[15] += -my, a[16] += mx;
+    // I_c + m (|c|^2 E - c c^T)
+    a[9] += I_c(0, 0) + my * c.y() + mz * c.z();
+    a[13] += I_c(1, 0) - mx * c.y();
+    a[14] += I_c(1, 1) + mx * c.x() + mz * c.z();
+    a[18] += I_c(2, 0) - mx * c.z();
+    a[19] += I_c(2, 1) - my * c.z();
+    a[20] += I_c(2, 2) + mx * c.x() + my * c.y();
+  }
+  Matrix6d toDense() const {
+    Matrix6d M;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) M(r, c) = a[index(r, c)];
+    return M;
+  }
+};
+
 /// \brief Centroid inertia M_a = diag(w E, I_g) (eq. 12).
 Matrix6d centroidInertia(double w, const Matrix3d& I_g);
 
