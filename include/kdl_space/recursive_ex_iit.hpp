@@ -20,10 +20,14 @@ namespace kdl_space {
 ///
 /// `compute(state)`: forward kinematics and one backward pass of articulated-body inertias
 /// I^A_i = I_i + sum over children (I^A_c - U_c D_c^-1 U_c^T), U = I^A S, D = S^T U (+ armature),
-/// all in world axes about the base frame's origin. Then, for a unit impulse wrench at h, the
-/// bias forces travel from h's body to the base, the base's velocity jump is -(I^A_0)^-1 p^A_0
-/// and the joints' jumps follow outward: G* = J_full M_full^-1 J_full^T (eq. 11) without any
-/// n x n matrix. Compute calls return 0 or an Error code and never throw.
+/// all in world axes about the base frame's origin (packed symmetric, Symmetric6d).
+/// `G_star(h)`: the inverse inertia a wrench on body i meets, outward along the path from the
+/// base to h's body: Omega_0 = (I^A_0)^-1, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T,
+/// T_i = 1 - S_i D_i^-1 U_i^T (sums of positive terms: no cancellation), then
+/// G* = R_h Omega R_h^T (eq. 5, 11) = J_full M_full^-1 J_full^T without any n x n matrix.
+/// `velocityJump`: the impulse's bias forces from h's body to the base, the base's jump
+/// -(I^A_0)^-1 p^A_0, and the joints' jumps outward.
+/// Compute calls return 0 or an Error code and never throw.
 class RecursiveExIITSolver {
  public:
   explicit RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model);
