@@ -30,7 +30,7 @@ ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel
   c_.setZero(6 + n);
   rhs_.setZero(6 + n);
   M_.setZero(6 + n, 6 + n);
-  M_llt_ = Eigen::LLT<Eigen::MatrixXd>(6 + n);
+  M_llt_.compute(Eigen::MatrixXd::Identity(6 + n, 6 + n));  // sized; see FreeFloatingSolver's constructor
 }
 
 int ForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
@@ -50,6 +50,8 @@ int ForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity&
     return E_SIZE_MISMATCH;
   if (!velocity.qdot.data.allFinite() || !tau.data.allFinite() || !toEigen(velocity.base_twist).allFinite())
     return E_NOT_FINITE;
+  for (const KDL::Wrench& f : f_ext)
+    if (!toEigen(f).allFinite()) return E_NOT_FINITE;
   if (const int rc = kinematics_.compute(state)) return rc;
   const FreeFloatingSolver& k = kinematics_;
   const Vector3d& P = k.r_g();  // the fixed point of this instant
@@ -102,12 +104,16 @@ int ForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity&
   M_llt_.compute(M_);
   if (M_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
   M_llt_.solveInPlace(rhs_);
+  if (!rhs_.allFinite()) return E_NOT_FINITE;
 
   // Base: spatial acceleration at P -> acceleration of the base origin.
   const Vector6d a_g = rhs_.head<6>();
   const Vector3d w = toEigen(velocity.base_twist.rot), v_b = toEigen(velocity.base_twist.vel);
-  acceleration.base.head<3>() = a_g.head<3>() + a_g.tail<3>().cross(p_b - P) + w.cross(v_b);
-  acceleration.base.tail<3>() = a_g.tail<3>();
+  Vector6d base;
+  base.head<3>() = a_g.head<3>() + a_g.tail<3>().cross(p_b - P) + w.cross(v_b);
+  base.tail<3>() = a_g.tail<3>();
+  if (!base.allFinite()) return E_NOT_FINITE;
+  acceleration.base = base;
   acceleration.qddot.data = rhs_.tail(n);
   return E_NOERROR;
 }

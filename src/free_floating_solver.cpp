@@ -3,6 +3,11 @@
 #include <cmath>
 
 namespace kdl_space {
+namespace {
+bool finite(const KDL::Vector& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+bool finite(const KDL::Twist& t) { return finite(t.vel) && finite(t.rot); }
+}  // namespace
+
 FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
     : model_(std::move(model)) {
   if (!model_) throw ModelError("FreeFloatingSolver: null model");
@@ -17,10 +22,13 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   Am_work_.setZero(6, n);
   J_work_.setZero(6, n);
   X_work_.setZero(n, 6);
+  dqdot_work_.setZero(n);
   H_.resize(n);
   H_star_.resize(n);
-  H_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
-  H_star_llt_ = Eigen::LLT<Eigen::MatrixXd>(n);
+  // Sized by factorising the identity: assigning Eigen::LLT(n) would copy its uninitialised
+  // info member (undefined behaviour, reported by UBSan in tools/sanitize.sh).
+  H_llt_.compute(Eigen::MatrixXd::Identity(n, n));
+  H_star_llt_.compute(Eigen::MatrixXd::Identity(n, n));
   reserveContacts(2);  // dual-arm without allocation
 }
 
@@ -82,6 +90,8 @@ int FreeFloatingSolver::compute(const State& state) {
 
   I_g_ = I_c_[0].bottomRightCorner<3, 3>();  // eq. 3 (about r_g the coupling block vanishes)
   M_a_ = centroidInertia(w(), I_g_);          // eq. 12
+  // Finite inputs of absurd magnitude (a base 1e300 m away) overflow here: refuse, not factorise.
+  if (!r_g_.allFinite() || !I_g_.allFinite() || !H_.data.allFinite() || !A_m_.allFinite()) return E_NOT_FINITE;
   I_g_llt_.compute(I_g_);
   if (I_g_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
 
@@ -90,6 +100,7 @@ int FreeFloatingSolver::compute(const State& state) {
   H_star_.data = H_.data;
   H_star_.data.noalias() -= A_m_.transpose().lazyProduct(Am_work_);  // eq. 7
   symmetrize(H_star_.data);
+  if (!H_star_.data.allFinite()) return E_NOT_FINITE;
   H_llt_.compute(H_.data);
   H_ok_ = H_llt_.info() == Eigen::Success;
   H_star_llt_.compute(H_star_.data);
@@ -112,8 +123,12 @@ int FreeFloatingSolver::momentum(const KDL::Twist& base_twist, const KDL::JntArr
                                  Vector6d& PL_g) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!finite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
-  PL_g.noalias() = M_a_ * y + A_m_ * qdot.data;  // eq. 2
+  Vector6d PL;
+  PL.noalias() = M_a_ * y + A_m_ * qdot.data;  // eq. 2
+  if (!PL.allFinite()) return E_NOT_FINITE;
+  PL_g = PL;
   return E_NOERROR;
 }
 
@@ -121,9 +136,12 @@ int FreeFloatingSolver::baseTwist(const Vector6d& PL_g, const KDL::JntArray& qdo
                                   KDL::Twist& base_twist) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!PL_g.allFinite() || !qdot.data.allFinite()) return E_NOT_FINITE;
   Vector6d y = PL_g - A_m_ * qdot.data;
   M_a_solveInPlace(y);
-  base_twist = toTwist(shiftTwist(y, toEigen(world_T_base_.p) - r_g_));
+  y = shiftTwist(y, toEigen(world_T_base_.p) - r_g_);
+  if (!y.allFinite()) return E_NOT_FINITE;
+  base_twist = toTwist(y);
   return E_NOERROR;
 }
 
@@ -131,29 +149,37 @@ int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::J
                                       double& T) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!finite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
   double qHq = 0.0;  // q^T H q without a temporary
   for (Eigen::Index j = 0; j < H_.data.cols(); ++j) qHq += qdot(j) * H_.data.col(j).dot(qdot.data);
-  T = 0.5 * y.dot(M_a_ * y) + y.dot(A_m_ * qdot.data) + 0.5 * qHq;
+  const double energy = 0.5 * y.dot(M_a_ * y) + y.dot(A_m_ * qdot.data) + 0.5 * qHq;
+  if (!std::isfinite(energy)) return E_NOT_FINITE;
+  T = energy;
   return E_NOERROR;
 }
 
 int FreeFloatingSolver::ready(const Contact& h) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
+  if (!finite(h.offset)) return E_NOT_FINITE;
   return E_NOERROR;
 }
 
 int FreeFloatingSolver::contactPoint(const Contact& h, Vector3d& p_h) const {
   if (const int rc = ready(h)) return rc;
-  p_h = toEigen(world_T_body_[h.body] * h.offset);
+  const Vector3d p = toEigen(world_T_body_[h.body] * h.offset);
+  if (!p.allFinite()) return E_NOT_FINITE;
+  p_h = p;
   return E_NOERROR;
 }
 
 int FreeFloatingSolver::R_h(const Contact& h, Matrix6d& R) const {
   Vector3d p_h;
   if (const int rc = contactPoint(h, p_h)) return rc;
-  R = transfer(p_h - r_g_);  // eq. 5
+  const Vector3d r_gh = p_h - r_g_;
+  if (!r_gh.allFinite()) return E_NOT_FINITE;
+  R = transfer(r_gh);  // eq. 5
   return E_NOERROR;
 }
 
@@ -179,14 +205,18 @@ void FreeFloatingSolver::generalizedJacobian(const Contact& h, Eigen::Ref<Matrix
 int FreeFloatingSolver::J(const Contact& h, KDL::Jacobian& J) {
   if (const int rc = ready(h)) return rc;
   if (J.columns() != model_->nj()) return E_SIZE_MISMATCH;
-  fixedBaseJacobian(h, J.data);
+  fixedBaseJacobian(h, J_work_);
+  if (!J_work_.allFinite()) return E_NOT_FINITE;
+  J.data = J_work_;
   return E_NOERROR;
 }
 
 int FreeFloatingSolver::J_star(const Contact& h, KDL::Jacobian& J_star) {
   if (const int rc = ready(h)) return rc;
   if (J_star.columns() != model_->nj()) return E_SIZE_MISMATCH;
-  generalizedJacobian(h, J_star.data);
+  generalizedJacobian(h, J_work_);
+  if (!J_work_.allFinite()) return E_NOT_FINITE;
+  J_star.data = J_work_;
   return E_NOERROR;
 }
 
@@ -195,18 +225,24 @@ int FreeFloatingSolver::G_locked(const Contact& h, Matrix6d& G) const {
   if (const int rc = R_h(h, R)) return rc;
   Matrix6d X = R.transpose();
   M_a_solveInPlace(X);
-  G.noalias() = R * X;  // eq. 20
-  symmetrize(G);
+  Matrix6d G_locked;
+  G_locked.noalias() = R * X;  // eq. 20
+  symmetrize(G_locked);
+  if (!G_locked.allFinite()) return E_NOT_FINITE;
+  G = G_locked;
   return E_NOERROR;
 }
 
 int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
-  if (const int rc = G_locked(h, G)) return rc;
+  Matrix6d G_star;
+  if (const int rc = G_locked(h, G_star)) return rc;
   generalizedJacobian(h, J_work_);
   X_work_ = J_work_.transpose();
   for (int c = 0; c < 6; ++c) H_star_llt_.solveInPlace(X_work_.col(c));  // vector solves: no allocation
-  G.noalias() += J_work_.lazyProduct(X_work_);  // eq. 11
-  symmetrize(G);
+  G_star.noalias() += J_work_.lazyProduct(X_work_);  // eq. 11
+  symmetrize(G_star);
+  if (!G_star.allFinite()) return E_NOT_FINITE;
+  G = G_star;
   return E_NOERROR;
 }
 
@@ -216,8 +252,11 @@ int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
   fixedBaseJacobian(h, J_work_);
   X_work_ = J_work_.transpose();
   for (int c = 0; c < 6; ++c) H_llt_.solveInPlace(X_work_.col(c));
-  G.noalias() = J_work_.lazyProduct(X_work_);  // eq. 22
-  symmetrize(G);
+  Matrix6d G_grounded;
+  G_grounded.noalias() = J_work_.lazyProduct(X_work_);  // eq. 22
+  symmetrize(G_grounded);
+  if (!G_grounded.allFinite()) return E_NOT_FINITE;
+  G = G_grounded;
   return E_NOERROR;
 }
 
@@ -226,10 +265,15 @@ int FreeFloatingSolver::handTwist(const Contact& h, const KDL::JntArray& qdot, c
   Matrix6d R;
   if (const int rc = R_h(h, R)) return rc;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!qdot.data.allFinite() || !PL_g.allFinite()) return E_NOT_FINITE;
   generalizedJacobian(h, J_work_);
   Vector6d v_g = PL_g;
   M_a_solveInPlace(v_g);
-  t_h = toTwist(J_work_ * qdot.data + R * v_g);  // eq. 4
+  Vector6d t;
+  t.noalias() = J_work_ * qdot.data;
+  t.noalias() += R * v_g;  // eq. 4
+  if (!t.allFinite()) return E_NOT_FINITE;
+  t_h = toTwist(t);
   return E_NOERROR;
 }
 
@@ -239,7 +283,7 @@ int FreeFloatingSolver::G(const Contact& h, Response response, Matrix6d& G) {
     case Response::Grounded: return G_grounded(h, G);
     case Response::JointsLocked: return G_locked(h, G);
   }
-  return E_BAD_CONTACT;
+  return E_BAD_ARGUMENT;  // not one of the enumerators
 }
 
 int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const Vector6d& F,
@@ -248,25 +292,30 @@ int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const 
   if (const int rc = R_h(h, R)) return rc;
   if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!F.allFinite()) return E_NOT_FINITE;
-  dPL_g.setZero();
-  SetToZero(dqdot);
+  Vector6d dPL = Vector6d::Zero();
+  dqdot_work_.setZero();
   switch (response) {
     case Response::FreeFloating:
       generalizedJacobian(h, J_work_);
-      dqdot.data.noalias() = J_work_.transpose() * F;
-      H_star_llt_.solveInPlace(dqdot.data);  // eq. 18: dqdot = H*^-1 J*^T F
-      dPL_g.noalias() = R.transpose() * F;   // eq. 8
+      dqdot_work_.noalias() = J_work_.transpose() * F;
+      H_star_llt_.solveInPlace(dqdot_work_);  // eq. 18: dqdot = H*^-1 J*^T F
+      dPL.noalias() = R.transpose() * F;      // eq. 8
       break;
     case Response::Grounded:
       if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
       fixedBaseJacobian(h, J_work_);
-      dqdot.data.noalias() = J_work_.transpose() * F;
-      H_llt_.solveInPlace(dqdot.data);  // eq. 23
+      dqdot_work_.noalias() = J_work_.transpose() * F;
+      H_llt_.solveInPlace(dqdot_work_);  // eq. 23
       break;
     case Response::JointsLocked:
-      dPL_g.noalias() = R.transpose() * F;  // eq. 21
+      dPL.noalias() = R.transpose() * F;  // eq. 21
       break;
+    default:
+      return E_BAD_ARGUMENT;  // not one of the enumerators
   }
+  if (!dPL.allFinite() || !dqdot_work_.allFinite()) return E_NOT_FINITE;
+  dPL_g = dPL;
+  dqdot.data = dqdot_work_;
   return E_NOERROR;
 }
 
@@ -274,6 +323,7 @@ void FreeFloatingSolver::reserveContacts(std::size_t k) {
   if (static_cast<Eigen::Index>(6 * k) <= J_all_work_.rows()) return;
   J_all_work_.resize(6 * k, model_->nj());
   X_all_work_.resize(model_->nj(), 6 * k);
+  G_all_work_.resize(6 * k, 6 * k);
   R_all_work_.resize(k);
 }
 
@@ -292,13 +342,16 @@ int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::Matr
   }
   X = J_all.transpose();
   for (Eigen::Index c = 0; c < X.cols(); ++c) H_star_llt_.solveInPlace(X.col(c));  // one factorisation of H*
-  G.noalias() = J_all.lazyProduct(X);
+  auto G_all = G_all_work_.topLeftCorner(6 * k, 6 * k);
+  G_all.noalias() = J_all.lazyProduct(X);
   for (Eigen::Index i = 0; i < k; ++i) {
     Matrix6d Y = R_all_work_[i].transpose();
     M_a_solveInPlace(Y);
-    for (Eigen::Index j = 0; j < k; ++j) G.block<6, 6>(6 * j, 6 * i).noalias() += R_all_work_[j] * Y;  // eq. 11
+    for (Eigen::Index j = 0; j < k; ++j) G_all.block<6, 6>(6 * j, 6 * i).noalias() += R_all_work_[j] * Y;  // eq. 11
   }
-  symmetrize(G);
+  symmetrize(G_all);
+  if (!G_all.allFinite()) return E_NOT_FINITE;
+  G = G_all;
   return E_NOERROR;
 }
 

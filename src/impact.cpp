@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "kdl_space/errors.hpp"
+
 namespace kdl_space {
 namespace {
 
@@ -240,7 +242,63 @@ Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_
   return out;
 }
 
+int solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
+                const ImpactLaw& law, Impulse& impulse) {
+  if (!G_A.allFinite() || !G_B.allFinite() || !t_A.allFinite() || !t_B.allFinite()) return E_NOT_FINITE;
+  const Matrix6d G = G_A + G_B;
+  if (!G.allFinite()) return E_NOT_FINITE;
+  const Matrix3d W = G.topLeftCorner<3, 3>();
+  switch (law.kind) {
+    case ImpactKind::Capture:
+      if (G.llt().info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+      break;
+    case ImpactKind::TranslationalCapture:
+      if (W.llt().info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+      break;
+    case ImpactKind::PointImpact:
+    case ImpactKind::FrictionalImpact: {
+      const bool friction = law.kind == ImpactKind::FrictionalImpact;
+      if (!law.normal.allFinite() || !std::isfinite(law.restitution) || (friction && !std::isfinite(law.friction)))
+        return E_NOT_FINITE;
+      if (!(law.normal.norm() > 0.0) || law.restitution < 0.0 || law.restitution > 1.0 || (friction && law.friction < 0.0))
+        return E_BAD_ARGUMENT;
+      const Vector3d n = law.normal.normalized();
+      if (!(n.dot(W * n) > 0.0)) return E_NOT_POSITIVE_DEFINITE;
+      if (friction && law.friction > 0.0 && W.llt().info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+      break;
+    }
+    default:
+      return E_BAD_ARGUMENT;  // not one of the enumerators
+  }
+  const Impulse result = solveImpact(G_A, G_B, t_A, t_B, law);
+  if (!result.F.allFinite()) return E_NOT_FINITE;
+  impulse = result;
+  return E_NOERROR;
+}
+
+int virtualMass(const Matrix6d& G, const Vector3d& n, double& m) {
+  if (!G.allFinite() || !n.allFinite()) return E_NOT_FINITE;
+  if (!(n.norm() > 0.0)) return E_BAD_ARGUMENT;
+  const Vector3d u = n.normalized();
+  const double inverse = u.dot(G.topLeftCorner<3, 3>() * u);
+  if (!(inverse > 0.0)) return E_NOT_POSITIVE_DEFINITE;
+  const double mass = 1.0 / inverse;
+  if (!std::isfinite(mass)) return E_NOT_FINITE;
+  m = mass;
+  return E_NOERROR;
+}
+
 double virtualMass(const Matrix6d& G, const Vector3d& n) { return 1.0 / n.dot(G.topLeftCorner<3, 3>() * n); }
+
+int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B) {
+  if (!std::isfinite(m) || !I_com.allFinite() || !r_bc.allFinite()) return E_NOT_FINITE;
+  if (!(m > 0.0)) return E_BAD_ARGUMENT;
+  if ((0.5 * (I_com + I_com.transpose())).llt().info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  const Matrix6d G = rigidBodyG(m, I_com, r_bc);
+  if (!G.allFinite()) return E_NOT_FINITE;
+  G_B = G;
+  return E_NOERROR;
+}
 
 Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc) {
   const Matrix6d R_b = transfer(r_bc);  // eq. 16: twist at the CoM -> twist at c

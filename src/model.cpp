@@ -1,11 +1,10 @@
 #include "kdl_space/model.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
-#include <sstream>
 
 #include "kdl_space/errors.hpp"
 #include "kdl_space/spatial.hpp"
+#include "model_rules.hpp"
 
 namespace kdl_space {
 namespace {
@@ -107,13 +106,12 @@ void FloatingModel::checkArmature() const {
 }
 
 void FloatingModel::validate() {
-
-  std::vector<double> subtree_mass(bodies_.size(), 0.0);
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    const Body& b = bodies_[i];
+  // KDL-level checks of the frames, then the shared rules (model_rules.hpp) on the inertias.
+  std::vector<Finding> findings;
+  std::vector<rules::MassNode> nodes;
+  for (const Body& b : bodies_) {
     const std::string& link = b.name;
-    const bool base = b.parent < 0;
-    if (!base) {
+    if (b.parent >= 0) {
       const KDL::Joint& joint = b.segment.getJoint();
       if (!allFinite(b.segment.pose(0.0)))
         fail("link", link, "the pose of its frame (joint origin) holds NaN or infinite values");
@@ -123,46 +121,19 @@ void FloatingModel::validate() {
           fail("joint", joint.getName(), "its axis is zero, NaN or infinite");
       }
     }
-    if (!std::isfinite(b.mass) || !b.com.allFinite() || !b.I_com.allFinite())
-      fail("link", link, "its inertial values hold NaN or infinite numbers");
-    if (b.mass < 0.0) fail("link", link, "negative mass " + std::to_string(b.mass) + " kg");
-    if (base && b.mass <= 0.0)
-      fail("base link", link,
-           "has no mass: a free-floating base needs its mass and inertia (kdl_space reads the "
-           "root link's <inertial>, which kdl_parser drops)");
-    if (b.mass == 0.0) {
-      if (!b.I_com.isZero(0.0)) fail("link", link, "has rotational inertia but zero mass");
-      // Whether a massless link is acceptable is decided below from its subtree.
-    } else {
-      Eigen::SelfAdjointEigenSolver<Matrix3d> eig(0.5 * (b.I_com + b.I_com.transpose()),
-                                                  Eigen::EigenvaluesOnly);
-      const Vector3d l = eig.eigenvalues();  // ascending
-      std::ostringstream moments;
-      moments << "(principal moments " << l(0) << ", " << l(1) << ", " << l(2) << " kg m^2)";
-      if (!(l(0) > 0.0))
-        fail("link", link, "its inertia about the CoM is not positive definite " + moments.str());
-      if (l(0) + l(1) < l(2) * (1.0 - 1e-9))
-        fail("link", link,
-             "its principal moments break the triangle inequality I1 + I2 >= I3 " + moments.str());
-    }
-    subtree_mass[i] = b.mass;
+    if (!b.com.allFinite()) fail("link", link, "its inertial values hold NaN or infinite numbers");
+    const std::size_t before = findings.size();
+    rules::checkInertia(link, b.mass, b.I_com, findings);
+    if (b.parent < 0 && findings.size() == before) rules::checkBaseMass(link, b.mass, findings);
+    if (const Finding* e = rules::firstError(findings)) throw ModelError(describe(*e));
+    nodes.push_back({link, b.parent, b.joint >= 0 ? joint_names_[b.joint] : std::string(), b.joint >= 0, b.mass});
   }
-  for (std::size_t i = bodies_.size(); i-- > 1;) subtree_mass[bodies_[i].parent] += subtree_mass[i];
-  total_mass_ = subtree_mass[0];
+  rules::checkMassDistribution(nodes, findings);
+  if (const Finding* e = rules::firstError(findings)) throw ModelError(describe(*e));
+  for (const Finding& f : findings) diagnostics_.push_back({f.element, f.message});
 
-  for (std::size_t i = 1; i < bodies_.size(); ++i) {
-    const Body& b = bodies_[i];
-    if (b.joint >= 0 && subtree_mass[i] == 0.0)
-      fail("joint", joint_names_[b.joint],
-           "moves only massless links (" + quoted(b.name) +
-               " and below): its inertia is zero and the dynamics are singular");
-    if (b.mass == 0.0) {
-      const bool leaf = subtree_mass[i] == 0.0;
-      diagnostics_.push_back(
-          {b.name, leaf ? "massless link: it only carries a frame"
-                        : "massless link: it carries no inertia of its own"});
-    }
-  }
+  total_mass_ = 0.0;
+  for (const Body& b : bodies_) total_mass_ += b.mass;
 }
 
 int FloatingModel::jointIndex(const std::string& name) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace kdl_space {
 namespace {
@@ -18,6 +19,7 @@ constexpr double kA[7][6] = {
     {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
 constexpr double kB5[7] = {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0.0};
 constexpr double kB4[7] = {5179.0 / 57600, 0.0, 7571.0 / 16695, 393.0 / 640, -92097.0 / 339200, 187.0 / 2100, 1.0 / 40};
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
@@ -35,14 +37,23 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   x_.setZero(size);
   x_tmp_.setZero(size);
   x_new_.setZero(size);
-  dynamics_.setGravity(options_.gravity);
-  if (!(options_.step > 0.0) || !(options_.rtol > 0.0) || !(options_.atol > 0.0) || !(options_.max_step > 0.0) ||
-      options_.max_steps <= 0)
-    throw ModelError("simulation: step, rtol, atol, max_step and max_steps must be > 0");
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  if (!positive(options_.step) || !positive(options_.rtol) || !positive(options_.atol) ||
+      !positive(options_.max_step) || options_.max_steps <= 0)
+    throw ModelError("simulation: step, rtol, atol, max_step and max_steps must be finite and > 0");
+  if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54)
+    throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54");
+  if (dynamics_.setGravity(options_.gravity) != E_NOERROR)
+    throw ModelError("simulation: gravity must be finite");
 }
 
 void Simulator::setJointControl(unsigned int joint, const JointControl& control) {
-  if (joint >= controls_.size()) throw ModelError("simulation: joint index " + std::to_string(joint) + " out of range");
+  if (joint >= controls_.size())
+    throw ModelError("simulation: joint index " + std::to_string(joint) + " out of range (the model has " +
+                     std::to_string(controls_.size()) + " joints)");
+  if (control.mode != JointControl::Mode::Free && control.mode != JointControl::Mode::Locked &&
+      control.mode != JointControl::Mode::PD)
+    throw ModelError("simulation: joint '" + model().jointNames()[joint] + "': the mode is not one of Free, Locked, PD");
   if (control.kp < 0.0 || control.kd < 0.0 || !std::isfinite(control.kp) || !std::isfinite(control.kd) ||
       !std::isfinite(control.set_point))
     throw ModelError("simulation: joint '" + model().jointNames()[joint] + "': gains must be finite and >= 0");
@@ -56,14 +67,21 @@ int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& 
   FreeFloatingSolver& k = dynamics_.kinematics();
   if (const int rc = k.compute(s.state)) return rc;
   Vector6d PL_g;
+  double energy = 0.0;
   if (const int rc = k.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
-  h_O = PL_g;
-  h_O.tail<3>() += k.r_g().cross(PL_g.head<3>());  // L_O = L_g + r_g x P
-  return k.kineticEnergy(s.velocity.base_twist, s.velocity.qdot, T);
+  if (const int rc = k.kineticEnergy(s.velocity.base_twist, s.velocity.qdot, energy)) return rc;
+  Vector6d momentum = PL_g;
+  momentum.tail<3>() += k.r_g().cross(PL_g.head<3>());  // L_O = L_g + r_g x P
+  if (!momentum.allFinite()) return E_NOT_FINITE;
+  h_O = momentum;
+  T = energy;
+  return E_NOERROR;
 }
 
 int Simulator::engageBrakes(SimulationState& s) {
   const unsigned int n = model().nj();
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!s.velocity.qdot.data.allFinite() || !toEigen(s.velocity.base_twist).allFinite()) return E_NOT_FINITE;
   std::vector<unsigned int> locked;
   for (unsigned int j = 0; j < n; ++j)
     if (controls_[j].mode == JointControl::Mode::Locked && s.velocity.qdot(j) != 0.0) locked.push_back(j);
@@ -88,6 +106,7 @@ int Simulator::engageBrakes(SimulationState& s) {
   const Eigen::VectorXd lambda = (Gt.transpose() * X).llt().solve(Gt.transpose() * nu);
   nu -= X * lambda;
   for (unsigned int j : locked) nu(6 + j) = 0.0;  // exactly
+  if (!nu.allFinite()) return E_NOT_FINITE;
   y = nu.head<6>();
   y.head<3>() += y.tail<3>().cross(p_b - k.r_g());
   s.velocity.base_twist = toTwist(y);
@@ -134,7 +153,10 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   if (callback_) {
     SetToZero(tau_extra_);
     callback_(scratch_, tau_extra_);
-    if (tau_extra_.rows() != n) return E_SIZE_MISMATCH;
+    if (tau_extra_.rows() != n) {
+      tau_extra_.resize(n);  // the callback resized it: size it back for the next call
+      return E_SIZE_MISMATCH;
+    }
     tau_.data += tau_extra_.data;
   }
   if (const int rc = dynamics_.CartToJnt(scratch_.state, scratch_.velocity, tau_, {}, acc_)) return rc;
@@ -164,11 +186,15 @@ int Simulator::stepRK4(double t, double h, Vector& x) {
   return E_NOERROR;
 }
 
-int Simulator::stepDP54(double t, double h, Vector& x, double& error) {
+int Simulator::stepDP54(double t, double h, Vector& x, double& error, bool& trial_failed) {
+  trial_failed = false;
   for (int i = 0; i < 7; ++i) {
     x_tmp_ = x;
     for (int j = 0; j < i; ++j) x_tmp_ += h * kA[i][j] * k_[j];
-    if (int rc = derivative(t + kC[i] * h, x_tmp_, k_[i])) return rc;
+    if (int rc = derivative(t + kC[i] * h, x_tmp_, k_[i])) {
+      trial_failed = i > 0;  // a stage away from x: a smaller step may not reach that state
+      return rc;
+    }
   }
   x_new_ = x;
   x_tmp_.setZero();  // the error estimate
@@ -182,7 +208,18 @@ int Simulator::stepDP54(double t, double h, Vector& x, double& error) {
     sum += (x_tmp_(i) / scale) * (x_tmp_(i) / scale);
   }
   error = std::sqrt(sum / static_cast<double>(x.size()));
-  return std::isfinite(error) ? E_NOERROR : E_NOT_FINITE;
+  trial_failed = !std::isfinite(error);
+  return trial_failed ? E_NOT_FINITE : E_NOERROR;
+}
+
+int Simulator::publish(const Vector& x, double t, SimulationState& s) {
+  if (const int rc = unpack(x, t, scratch_)) return rc;
+  s.t = scratch_.t;
+  s.state.world_T_base = scratch_.state.world_T_base;
+  s.state.q.data = scratch_.state.q.data;  // sizes checked by run(): no allocation
+  s.velocity.base_twist = scratch_.velocity.base_twist;
+  s.velocity.qdot.data = scratch_.velocity.qdot.data;
+  return E_NOERROR;
 }
 
 int Simulator::run(SimulationState& s, double t_end, double output_dt,
@@ -190,13 +227,14 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   stats_ = {};
   const unsigned int n = model().nj();
   if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
-  if (!std::isfinite(t_end) || !std::isfinite(s.t) || !(output_dt > 0.0) || t_end < s.t) return E_NOT_FINITE;
+  if (!std::isfinite(t_end) || !std::isfinite(s.t) || std::isnan(output_dt)) return E_NOT_FINITE;
+  if (!(output_dt > 0.0) || t_end < s.t) return E_BAD_ARGUMENT;
   double T;
   Vector6d h_O;
   if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
   Vector& x = x_;
   pack(s, h_O, x);
-  if (const int rc = unpack(x, s.t, s)) return rc;
+  if (const int rc = publish(x, s.t, s)) return rc;
   if (observer) observer(s);
 
   // RK4 takes `step` as given; max_step bounds only the adaptive method.
@@ -204,22 +242,32 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   double t = s.t, h = adaptive ? std::min(options_.step, options_.max_step) : options_.step;
   long outputs = 1;
   const double t0 = s.t;
+  // On an error, s is left at the last accepted step if its state can be evaluated (else at the
+  // last output), so that the caller sees how far the run got.
+  const auto failed = [&](int rc) {
+    publish(x, t, s);
+    return rc;
+  };
   while (t < t_end) {
-    if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return E_MAX_STEPS;
+    if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return failed(E_MAX_STEPS);
     const double t_out = std::min(t0 + outputs * output_dt, t_end);
     // Land exactly on the output time when within round-off of it (no sliver steps).
     const bool lands = t_out - t <= h * (1.0 + 1e-9);
     const double h_try = lands ? t_out - t : h;
     if (options_.integrator == Integrator::RK4) {
-      if (const int rc = stepRK4(t, h_try, x)) return rc;
+      if (const int rc = stepRK4(t, h_try, x)) return failed(rc);
     } else {
       double error = 0.0;
-      if (const int rc = stepDP54(t, h_try, x, error)) return rc;
+      bool trial_failed = false;
+      if (const int rc = stepDP54(t, h_try, x, error, trial_failed)) {
+        if (!trial_failed) return failed(rc);
+        error = kInf;  // the trial step went where the dynamics are undefined: a rejected step
+      }
       const double factor = error == 0.0 ? 5.0 : std::clamp(0.9 * std::pow(error, -0.2), 0.2, 5.0);
       if (error > 1.0) {
         ++stats_.rejected_steps;
         h = h_try * factor;
-        if (h < 1e-14 * std::max(1.0, std::abs(t))) return E_NOT_FINITE;  // step size underflow
+        if (h < 1e-14 * std::max(1.0, std::abs(t))) return failed(E_STEP_UNDERFLOW);
         continue;
       }
       x = x_new_;
@@ -229,12 +277,12 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
     x.segment<4>(3).normalize();  // the orientation stays a unit quaternion
     t = lands ? t_out : t + h_try;
     if (lands) {
-      if (const int rc = unpack(x, t, s)) return rc;
+      if (const int rc = publish(x, t, s)) return rc;
       if (observer) observer(s);
       ++outputs;
     }
   }
-  return unpack(x, t, s);
+  return publish(x, t, s);
 }
 
 }  // namespace kdl_space

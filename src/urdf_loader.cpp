@@ -7,9 +7,11 @@
 #include <cmath>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <sstream>
 
 #include "kdl_space/errors.hpp"
+#include "model_rules.hpp"
 
 namespace kdl_space {
 namespace {
@@ -62,12 +64,17 @@ KDL::RigidBodyInertia baseInertia(const urdf::Link& base) {
   return KDL::RigidBodyInertia(in.mass, KDL::Vector(c.x, c.y, c.z), in_link_axes.getRotationalInertia());
 }
 
-bool isFreeJoint(const urdf::Joint& j) {
-  return j.type == urdf::Joint::FLOATING || j.type == urdf::Joint::PLANAR;
-}
-
+/// The URDF name of a joint type, as the shared rules (model_rules.hpp) take it.
 std::string typeName(const urdf::Joint& j) {
-  return j.type == urdf::Joint::FLOATING ? "floating" : j.type == urdf::Joint::PLANAR ? "planar" : "unknown";
+  switch (j.type) {
+    case urdf::Joint::REVOLUTE: return "revolute";
+    case urdf::Joint::CONTINUOUS: return "continuous";
+    case urdf::Joint::PRISMATIC: return "prismatic";
+    case urdf::Joint::FLOATING: return "floating";
+    case urdf::Joint::PLANAR: return "planar";
+    case urdf::Joint::FIXED: return "fixed";
+    default: return "unknown";
+  }
 }
 
 }  // namespace
@@ -79,39 +86,50 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
 
   // The base: the root link, or the child of a floating joint hanging from a massless root.
   urdf::LinkConstSharedPtr base = model->getRoot();
-  std::string dropped_joint;
   if (!base) fail("no root link");
-  if (base->child_joints.size() == 1 && base->child_joints[0]->type == urdf::Joint::FLOATING &&
-      (!base->inertial || base->inertial->mass == 0.0)) {
-    const urdf::JointSharedPtr& free_joint = base->child_joints[0];
+  const urdf::LinkConstSharedPtr root = base;
+  std::string dropped_joint;
+  if (rules::dropsRootJoint(!root->inertial || root->inertial->mass == 0.0, root->child_joints.size(),
+                            root->child_joints.empty() ? "" : typeName(*root->child_joints[0]))) {
+    const urdf::JointSharedPtr& free_joint = root->child_joints[0];
     dropped_joint = free_joint->name;
     diagnostics.push_back(
-        {free_joint->name, "floating joint from the massless root " + quoted(base->name) +
+        {free_joint->name, "floating joint from the massless root " + quoted(root->name) +
                                " dropped: link " + quoted(free_joint->child_link_name) +
                                " is the free-floating base"});
     base = model->getLink(free_joint->child_link_name);
   }
 
+  // The shared rules (the same as checkUrdfFile's); the first error refuses the file.
+  std::vector<Finding> findings;
   for (const auto& [name, joint] : model->joints_) {
     if (name == dropped_joint) continue;
-    if (isFreeJoint(*joint))
-      fail("joint " + quoted(name) + ": a " + typeName(*joint) +
-           " joint inside the tree is not supported (only the base floats; use revolute, "
-           "continuous, prismatic or fixed joints)");
-    if (joint->type == urdf::Joint::REVOLUTE || joint->type == urdf::Joint::CONTINUOUS ||
-        joint->type == urdf::Joint::PRISMATIC) {
-      const urdf::Vector3& a = joint->axis;
-      const double norm = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
-      if (!std::isfinite(norm) || norm == 0.0)
-        fail("joint " + quoted(name) + ": its axis has zero length (or is not finite)");
-      if (std::abs(norm - 1.0) > 1e-9)
-        diagnostics.push_back({name, "axis is not unit length (norm " + std::to_string(norm) +
-                                         "): normalised"});
+    const std::string type = typeName(*joint);
+    rules::checkJointType(name, type, findings);
+    if (rules::isMovable(type))
+      rules::checkAxis(name, Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z), findings);
+    if ((type == "revolute" || type == "prismatic") && joint->limits)
+      rules::checkLimits(name, joint->limits->lower, joint->limits->upper, findings);
+  }
+  if (base == root) rules::checkRootInertia(root->name, root->inertial != nullptr, findings);
+  // Depth below the base, breadth first (no recursion: the depth is what is being checked), and
+  // links reached twice: urdfdom accepts a link with several parent joints.
+  std::vector<std::pair<urdf::LinkConstSharedPtr, int>> level{{base, 0}};
+  std::set<std::string> reached{base->name};
+  for (std::size_t i = 0; i < level.size() && !rules::firstError(findings); ++i) {
+    rules::checkDepth(level[i].first->name, level[i].second, findings);
+    for (const urdf::LinkSharedPtr& child : level[i].first->child_links) {
+      if (!reached.insert(child->name).second) {
+        findings.push_back(rules::error("loop", ElementType::Link, child->name,
+                                        "reached twice from the base: its joints close a loop, and a URDF "
+                                        "describes a tree"));
+        break;
+      }
+      level.push_back({child, level[i].second + 1});
     }
   }
-  if (base->inertial)
-    diagnostics.push_back({base->name, "root link inertia kept as the base body's inertia "
-                                       "(kdl_parser drops it)"});
+  if (const Finding* e = rules::firstError(findings)) fail(describe(*e));
+  for (const Finding& f : findings) diagnostics.push_back({f.element, f.message});
 
   // kdl_parser on a copy prepared so it has nothing to warn about (PITFALLS.md #2): no root
   // inertia, the dropped floating joint gone.
@@ -120,6 +138,12 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
   for_kdl->root_link_->inertial.reset();
   KDL::Tree tree;
   if (!kdl_parser::treeFromUrdfModel(*for_kdl, tree)) fail("kdl_parser could not build a KDL tree");
+  // urdfdom accepts joints that form a loop no root reaches (e.g. a joint whose parent is its own
+  // child); kdl_parser, walking from the base, would leave those links out silently.
+  for (const auto& [name, link] : model->links_)
+    if (name != root->name && !tree.getSegments().count(name))
+      fail("link " + quoted(name) + " is not connected to the base " + quoted(base->name) +
+           ": its joints form a loop (a URDF describes a tree)");
 
   try {
     return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics));

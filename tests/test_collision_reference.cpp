@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "kdl_space/collision.hpp"
+#include "impact_util.hpp"
 #include "reference_case.hpp"
 
 namespace kdl_space::test {
@@ -48,7 +49,7 @@ TEST_P(CollisionReference, Capture) {
   FloatingSide robot(s.solver, s.c.contact, {s.c.base_twist, s.c.qdot});
   RigidBodySide body(s.target, s.p_h);
   EXPECT_TRUE(near(robot.contactTwistBefore(), ReferenceCase::mat(e.at("contact_twist_before")), kRel, kAbs, "contact_twist_before"));
-  const Impulse impulse = collide(robot, body, ImpactLaw{ImpactKind::Capture});
+  const Impulse impulse = collideOk(robot, body, ImpactLaw{ImpactKind::Capture});
   EXPECT_TRUE(near(impulse.F, ReferenceCase::mat(e.at("impulse_on_robot")), kRel, kAbs, "impulse_on_robot"));
   s.expectRobotAfter(robot, body, e);
   Vector6d momentum;
@@ -63,7 +64,7 @@ TEST_P(CollisionReference, PointImpact) {
   FloatingSide robot(s.solver, s.c.contact, {s.c.base_twist, s.c.qdot});
   RigidBodySide body(s.target, s.p_h);
   ImpactLaw law{ImpactKind::PointImpact, ReferenceCase::mat(e.at("normal")), e.at("restitution").get<double>()};
-  const Impulse impulse = collide(robot, body, law);
+  const Impulse impulse = collideOk(robot, body, law);
   EXPECT_EQ(!impulse.separating, e.at("approaching").get<bool>());
   const double lambda = e.at("impulse_magnitude_on_target").get<double>();
   EXPECT_TRUE(near(-impulse.F, (Vector6d() << lambda * law.normal, Vector3d::Zero()).finished(), kRel, kAbs, "impulse"));

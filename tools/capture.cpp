@@ -2,6 +2,7 @@
 
 #include <iomanip>
 #include <memory>
+#include <sstream>
 
 #include "cli_common.hpp"
 #include "scenario.hpp"
@@ -9,18 +10,21 @@
 namespace kdl_space::cli {
 namespace {
 
-/// A solver at the system's state, or an InputError naming the URDF.
-std::unique_ptr<FreeFloatingSolver> computed(const ScenarioSystem& s) {
+/// A solver at the system's state, or an InputError naming the scenario's fields.
+std::unique_ptr<FreeFloatingSolver> computed(const std::string& file, const std::string& who, const ScenarioSystem& s) {
   auto solver = std::make_unique<FreeFloatingSolver>(s.model);
-  if (const int rc = solver->compute(s.state)) throw InputError(s.urdf + ": " + strError(rc));
+  if (const int rc = solver->compute(s.state))
+    throw InputError(file + ": " + who + ": the free-floating quantities cannot be computed at this state (" + who +
+                     ".base, " + who + ".q): " + strError(rc));
   return solver;
 }
 
-std::unique_ptr<FloatingSide> side(FreeFloatingSolver& solver, const ScenarioSystem& s, const std::string& who) {
+std::unique_ptr<FloatingSide> side(FreeFloatingSolver& solver, const std::string& file, const ScenarioSystem& s,
+                                   const std::string& who) {
   try {
     return std::make_unique<FloatingSide>(solver, s.contact, s.velocity, s.response);
   } catch (const ModelError& e) {
-    throw InputError(who + ": " + e.what());
+    throw InputError(file + ": " + who + ": " + e.what());
   }
 }
 
@@ -54,8 +58,8 @@ CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
 
 CaptureRun solveCapture(const Scenario& sc) {
   CaptureRun run;
-  run.robot_solver = computed(sc.robot);
-  run.robot = side(*run.robot_solver, sc.robot, "robot");
+  run.robot_solver = computed(sc.file, "robot", sc.robot);
+  run.robot = side(*run.robot_solver, sc.file, sc.robot, "robot");
   run.robot_solver->contactPoint(sc.robot.contact, run.p_h);
   if (sc.rigid_target) {
     try {
@@ -64,15 +68,31 @@ CaptureRun solveCapture(const Scenario& sc) {
       throw InputError(sc.file + ": " + e.what());
     }
   } else {
-    run.target_solver = computed(*sc.floating_target);
-    run.target = side(*run.target_solver, *sc.floating_target, "target");
+    run.target_solver = computed(sc.file, "target", *sc.floating_target);
+    run.target = side(*run.target_solver, sc.file, *sc.floating_target, "target");
     Vector3d p_c;
     run.target_solver->contactPoint(sc.floating_target->contact, p_c);
-    if ((p_c - run.p_h).norm() > 1e-3)
-      throw InputError(sc.file + ": target.contact: the target's contact point is " +
-                       std::to_string((p_c - run.p_h).norm()) + " m from the robot's; they must touch (within 1 mm)");
+    if ((p_c - run.p_h).norm() > 1e-3) {
+      std::ostringstream why;
+      why << sc.file << ": target.contact: the target's contact point is " << std::setprecision(6)
+          << (p_c - run.p_h).norm() << " m from the robot's; they must touch (within 1 mm)";
+      throw InputError(why.str());
+    }
   }
-  run.impulse = collide(*run.robot, *run.target, sc.law);
+  ImpactFault fault = ImpactFault::None;
+  if (const int rc = collide(*run.robot, *run.target, sc.law, run.impulse, &fault)) {
+    switch (fault) {
+      case ImpactFault::SideA:
+        throw InputError(sc.file + ": robot: the impulse cannot be applied to the robot: " + strError(rc));
+      case ImpactFault::SideB:
+        throw InputError(sc.file + ": target: the impulse cannot be applied to the target: " + strError(rc));
+      default:
+        throw InputError(sc.file + ": law: the impact cannot be solved: " + std::string(strError(rc)) +
+                         (rc == E_NOT_POSITIVE_DEFINITE ? " (the robot's and the target's inverse inertias at the "
+                                                          "contact point, G_robot + G_target, are singular there)"
+                                                        : ""));
+    }
+  }
   return run;
 }
 
@@ -121,7 +141,9 @@ Json captureJson(const Scenario& sc, const CaptureRun& r) {
   j["energy_before"] = T0;
   j["energy_after"] = T1;
   j["energy_lost"] = T0 - T1;
-  j["virtual_mass"] = sc.has_normal ? Json(virtualMass(robot.G(), sc.law.normal)) : Json(nullptr);
+  double m_v = 0.0;
+  // null without a normal, and where the robot cannot move its contact point along it (infinite)
+  j["virtual_mass"] = sc.has_normal && virtualMass(robot.G(), sc.law.normal, m_v) == E_NOERROR ? Json(m_v) : Json(nullptr);
   j["G_star"] = toJson(robot.G());
   j["G_B"] = toJson(target.G());
   return j;
@@ -163,7 +185,14 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRun
       << "                                        after  " << row(momentum_after) << "\n";
   out << "Kinetic energy: before " << T0 << " J, after " << T1 << " J, lost " << T0 - T1 << " J ("
       << (T0 > 0 ? 100.0 * (T0 - T1) / T0 : 0.0) << " %)\n";
-  if (sc.has_normal) out << "Virtual mass of the robot along the normal: " << virtualMass(robot.G(), sc.law.normal) << " kg\n";
+  if (sc.has_normal) {
+    double m_v = 0.0;
+    out << "Virtual mass of the robot along the normal: ";
+    if (virtualMass(robot.G(), sc.law.normal, m_v) == E_NOERROR)
+      out << m_v << " kg\n";
+    else
+      out << "infinite (the robot cannot move its contact point along the normal here)\n";
+  }
 }
 
 void runCapture(const CaptureOptions& o, std::ostream& out) {

@@ -1,6 +1,16 @@
 #include "cli_common.hpp"
 
+#include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 
 namespace kdl_space::cli {
@@ -49,16 +59,115 @@ std::pair<std::string, double> parseAssignment(const std::string& text, const st
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
     throw UsageError(option + " expects NAME=VALUE, got '" + text + "'");
   const std::string name = text.substr(0, eq), value = text.substr(eq + 1);
-  std::size_t used = 0;
   double v = 0.0;
-  try {
-    v = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != value.size() || !std::isfinite(v))
-    throw UsageError(option + " " + name + ": '" + value + "' is not a finite number");
+  std::string why;
+  if (!parseFiniteNumber(value, v, why)) throw UsageError(option + " " + name + ": " + why);
   return {name, v};
+}
+
+bool parseFiniteNumber(const std::string& text, double& value, std::string& why) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = text.empty() || std::isspace(static_cast<unsigned char>(text[0])) ? 0.0 : std::strtod(begin, &end);
+  if (text.empty() || end != begin + text.size()) {
+    why = "'" + text + "' is not a number";
+    return false;
+  }
+  if (errno == ERANGE && std::isinf(v)) {
+    why = "'" + text + "' is too large (not a finite number)";
+    return false;
+  }
+  if (!std::isfinite(v)) {
+    why = "'" + text + "' is not a finite number";
+    return false;
+  }
+  value = v;  // (a denormal underflow to 0 or a tiny value is a number: accepted)
+  return true;
+}
+
+CLI::Validator finiteNumber() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v;
+        std::string why;
+        return parseFiniteNumber(text, v, why) ? std::string() : why;
+      },
+      "", "finite number");
+}
+
+CLI::Validator positiveNumber() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v;
+        std::string why;
+        if (!parseFiniteNumber(text, v, why)) return why;
+        return v > 0.0 ? std::string() : "'" + text + "' is not > 0";
+      },
+      "", "positive number");
+}
+
+namespace {
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+}  // namespace
+
+void checkInputFile(const std::string& path, const std::string& kind) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throw InputError(path + ": no such file");
+  if (fs::is_directory(status)) throw InputError(path + ": is a folder, not a " + kind);
+  // A device, FIFO or socket could block or never end (/dev/zero): only regular files are read.
+  if (!fs::is_regular_file(status)) throw InputError(path + ": is not a regular file; expected a " + kind);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file: " + std::strerror(errno));
+  if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(path + ": the file is empty; expected a " + kind);
+}
+
+void checkOutputFile(const std::string& path, const std::string& option) {
+  const std::string where = option + " " + path + ": ";
+  if (path.empty()) throw UsageError(option + ": the file name is empty");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(where + "is a folder; give a file name");
+  // The finished file is renamed over the name: that would replace a device such as /dev/null.
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    throw InputError(where + "exists and is not a regular file; give the name of a file");
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  const fs::file_status status = fs::status(folder, ec);
+  if (ec || !fs::exists(status)) throw InputError(where + "the folder " + quoted(folder.string()) + " does not exist");
+  if (!fs::is_directory(status)) throw InputError(where + quoted(folder.string()) + " is not a folder");
+  // Whether a file can be created there is known only by creating one (access() says yes to
+  // root on a read-only /sys).
+  const fs::path probe = folder / ("." + fs::path(path).filename().string() + ".probe" + std::to_string(getpid()));
+  const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0)
+    throw InputError(where + "cannot create a file in the folder " + quoted(folder.string()) + ": " + std::strerror(errno));
+  close(fd);
+  unlink(probe.c_str());
+}
+
+AtomicFile::AtomicFile(std::string path, std::string option)
+    : path_(std::move(path)), option_(std::move(option)) {
+  // Same folder (the rename is atomic there), a name that says what it is.
+  const fs::path p(path_);
+  tmp_ = (p.parent_path() / ("." + p.filename().string() + ".tmp" + std::to_string(getpid()))).string();
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) std::remove(tmp_.c_str());
+}
+
+void AtomicFile::commit() {
+  std::error_code ec;
+  fs::rename(tmp_, path_, ec);
+  if (ec) throw InputError(option_ + " " + path_ + ": cannot write: " + ec.message());
+  committed_ = true;
+}
+
+void AtomicFile::retract() {
+  if (committed_) std::remove(path_.c_str());
 }
 
 }  // namespace kdl_space::cli

@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class Validator;
+}
+
 namespace kdl_space::cli {
 
 /// Exit codes of every subcommand.
@@ -36,5 +40,44 @@ void printMatrix(std::ostream& os, const std::string& title, const Eigen::Matrix
 
 /// Parses "NAME=VALUE"; throws UsageError naming `option` if malformed.
 std::pair<std::string, double> parseAssignment(const std::string& text, const std::string& option);
+
+/// \brief Parses a whole string as a finite double ("1e400", "nan", "1.5x" are refused).
+/// \return false, with `why` saying what is wrong (e.g. "'abc' is not a number").
+bool parseFiniteNumber(const std::string& text, double& value, std::string& why);
+
+/// CLI11 validators with messages a user can act on (CLI11's own Range prints 300-digit bounds).
+CLI::Validator finiteNumber();   ///< any finite number
+CLI::Validator positiveNumber(); ///< a finite number > 0
+
+/// \brief Refuses an input file that cannot be read: missing, a directory, unreadable or empty.
+/// Throws InputError "PATH: what is wrong"; `kind` names what the file should be ("URDF file").
+void checkInputFile(const std::string& path, const std::string& kind);
+
+/// \brief Refuses, before any work, an output file that could not be written: its folder is
+/// missing, not a folder or not writable, or the path is a folder. Throws InputError naming the
+/// option (e.g. "--csv run.csv: the folder 'out' does not exist").
+void checkOutputFile(const std::string& path, const std::string& option);
+
+/// \brief A file written under a temporary name in the same folder and renamed into place by
+/// commit(), so that a failed run never leaves a partial file that looks complete; the temporary
+/// is removed if the object is destroyed without a commit.
+class AtomicFile {
+ public:
+  /// `option` names the file in messages (e.g. "--csv").
+  AtomicFile(std::string path, std::string option);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  const std::string& path() const { return path_; }
+  const std::string& tmp() const { return tmp_; }
+  /// Renames the temporary to the final name; throws InputError if that fails.
+  void commit();
+  /// Removes the final file after a commit (a later output failed); best effort.
+  void retract();
+
+ private:
+  std::string path_, option_, tmp_;
+  bool committed_ = false;
+};
 
 }  // namespace kdl_space::cli

@@ -44,6 +44,21 @@ std::vector<ContactRequest> pairContacts(const CLI::App& command, const InspectO
 
 std::string describe(const Diagnostic& d) { return d.element.empty() ? d.message : d.element + ": " + d.message; }
 
+/// "a, b, c" of names, for messages that list what the model has.
+std::string listNames(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list.empty() ? "none" : list;
+}
+
+/// The --tip (and --offset) options of a contact, for messages.
+std::string contactOption(const ContactRequest& r) {
+  std::ostringstream s;
+  s << "--tip " << r.link;
+  if (r.has_offset) s << " --offset " << r.offset.x() << " " << r.offset.y() << " " << r.offset.z();
+  return s.str();
+}
+
 }  // namespace
 
 CLI::App* addInspect(CLI::App& app, InspectOptions& o) {
@@ -52,11 +67,11 @@ CLI::App* addInspect(CLI::App& app, InspectOptions& o) {
   cmd->add_option("--tip", o.tips, "Contact link (repeat for several contact points)")->required()
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--offset", o.offsets, "Contact point offset X Y Z in the preceding --tip's frame [m]")
-      ->expected(3)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->type_size(3);
+      ->expected(3)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->type_size(3)->check(finiteNumber());
   cmd->add_option("--q", o.q, "Joint position NAME=VALUE [rad or m]; unnamed joints are 0")
       ->expected(1, -1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_option("--base-pos", o.base_pos, "Base position X Y Z in the world [m]")->expected(3);
-  cmd->add_option("--base-rpy", o.base_rpy, "Base roll pitch yaw about fixed axes [rad]")->expected(3);
+  cmd->add_option("--base-pos", o.base_pos, "Base position X Y Z in the world [m]")->expected(3)->check(finiteNumber());
+  cmd->add_option("--base-rpy", o.base_rpy, "Base roll pitch yaw about fixed axes [rad]")->expected(3)->check(finiteNumber());
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the report");
   return cmd;
 }
@@ -74,8 +89,25 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   std::shared_ptr<const FloatingModel> model;
   State state;
   std::vector<Contact> contacts;
+  checkInputFile(o.urdf, "URDF file");
   try {
     model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
+  } catch (const ModelError& e) {
+    throw InputError(e.what());
+  }
+  for (const auto& [name, value] : q_by_name)
+    if (model->jointIndex(name) < 0)
+      throw InputError("--q " + name + ": " + o.urdf + " has no movable joint '" + name + "' (its movable joints: " +
+                       listNames(model->jointNames()) + ")");
+  for (const ContactRequest& r : requests) {
+    if (model->bodyIndex(r.link) < 0) {
+      std::vector<std::string> links;
+      for (const Body& b : model->bodies()) links.push_back(b.name);
+      throw InputError("--tip " + r.link + ": " + o.urdf + " has no link '" + r.link + "' (its links: " +
+                       listNames(links) + ")");
+    }
+  }
+  try {
     state = State(*model);
     state.q = jointsByName(*model, q_by_name);
     for (const ContactRequest& r : requests) contacts.push_back(model->contact(r.link, r.offset));
@@ -86,7 +118,9 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
                                 o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
 
   FreeFloatingSolver solver(model);
-  if (const int rc = solver.compute(state)) throw InputError(o.urdf + ": " + strError(rc));
+  if (const int rc = solver.compute(state))
+    throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
+                     "--base-rpy): " + strError(rc));
 
   std::vector<std::string> diagnostics;
   for (const Diagnostic& d : model->diagnostics()) diagnostics.push_back(describe(d));
@@ -101,11 +135,15 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     Vector3d p_h;
     KDL::Jacobian J_star(n);
     Matrix6d G_star, G_grounded, G_locked;
-    solver.contactPoint(h, p_h);
-    solver.J_star(h, J_star);
-    solver.G_star(h, G_star);
-    solver.G_locked(h, G_locked);
-    const bool grounded = solver.G_grounded(h, G_grounded) == E_NOERROR;
+    int rc = solver.contactPoint(h, p_h);
+    if (rc == E_NOERROR) rc = solver.J_star(h, J_star);
+    if (rc == E_NOERROR) rc = solver.G_star(h, G_star);
+    if (rc == E_NOERROR) rc = solver.G_locked(h, G_locked);
+    if (rc) throw InputError(contactOption(requests[i]) + ": the contact quantities cannot be computed: " + strError(rc));
+    const int rc_grounded = solver.G_grounded(h, G_grounded);
+    if (rc_grounded != E_NOERROR && rc_grounded != E_NOT_POSITIVE_DEFINITE)
+      throw InputError(contactOption(requests[i]) + ": the grounded G cannot be computed: " + strError(rc_grounded));
+    const bool grounded = rc_grounded == E_NOERROR;
     if (grounded) {
       const SpectralFigures f = spectralFigures(G_grounded);
       if (f.rank < 6) {
@@ -137,7 +175,8 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     }
   }
   Eigen::MatrixXd G_all(6 * contacts.size(), 6 * contacts.size());
-  solver.G_star(contacts, G_all);
+  if (const int rc = solver.G_star(contacts, G_all))
+    throw InputError("--tip: G* over all contact points cannot be computed: " + std::string(strError(rc)));
 
   if (o.json) {
     Json j;

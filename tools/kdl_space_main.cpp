@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "capture.hpp"
+#include "check.hpp"
 #include "cli_common.hpp"
 #include "inspect.hpp"
 #include "simulate.hpp"
@@ -18,19 +19,36 @@ int main(int argc, char** argv) {
   CLI::App* capture = addCapture(app, capture_options);
   SimulateOptions simulate_options;
   CLI::App* simulate = addSimulate(app, simulate_options);
+  CheckOptions check_options;
+  CLI::App* check = addCheck(app, check_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help
   } catch (const CLI::ParseError& e) {
-    std::cerr << "kdl_space: " << e.what() << "\n(run 'kdl_space --help' or 'kdl_space <command> --help')\n";
+    std::string what = e.what();
+    if (argc > 1 && argv[1][0] != '-') {  // CLI11 says "A subcommand is required" for a misspelt one
+      std::string names;
+      bool known = false;
+      for (const CLI::App* sub : app.get_subcommands({})) {
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+        known |= sub->get_name() == argv[1];
+      }
+      if (!known) what = "unknown command '" + std::string(argv[1]) + "' (commands: " + names + ")";
+    }
+    std::cerr << "kdl_space: " << what << "\n(run 'kdl_space --help' or 'kdl_space <command> --help')\n";
     return kUsage;
   }
   try {
     if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
     if (capture->parsed()) runCapture(capture_options, std::cout);
     if (simulate->parsed()) runSimulate(simulate_options, std::cout);
-    return kOk;
+    const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
+    if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
+      std::cerr << "kdl_space: cannot write the output to stdout\n";
+      return kUnusable;
+    }
+    return rc;
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";
     return kUsage;
@@ -39,6 +57,9 @@ int main(int argc, char** argv) {
     return kUnusable;
   } catch (const std::exception& e) {
     std::cerr << "kdl_space: cannot complete: " << e.what() << "\n";
+    return kUnusable;
+  } catch (...) {
+    std::cerr << "kdl_space: cannot complete: an unexpected error\n";
     return kUnusable;
   }
 }

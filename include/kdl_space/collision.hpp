@@ -42,8 +42,10 @@ class ImpactSide {
   /// Kinetic energy before / after [J].
   virtual double energyBefore() const = 0;
   virtual double energyAfter() const = 0;
-  /// \brief Applies the impulse wrench F received by this side at the contact point.
-  /// \return 0 or an Error code.
+  /// \brief Applies the impulse wrench F received by this side at the contact point: the state
+  /// after becomes the state before plus the jump from F (a second call replaces the first).
+  /// \return 0 or an Error code (E_NOT_FINITE for a non-finite F or a jump that overflows); on an
+  /// error the state after is untouched. Never throws.
   virtual int applyImpulse(const Vector6d& F) = 0;
 };
 
@@ -54,11 +56,15 @@ enum class ExIITMethod {
 };
 
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
-/// The solver must have computed the state; the side keeps a reference to it (and uses it).
+/// The solver must have computed the state; the side keeps a reference to it (and uses it in
+/// applyImpulse), so the solver must stay at that state while the side is used (applyImpulse
+/// returns E_NOT_COMPUTED if a later compute() of the solver failed).
 class FloatingSide : public ImpactSide {
  public:
-  /// \throws ModelError if the solver's compute() failed, the contact is unknown, qdot has the
-  /// wrong size, or the response is unavailable (grounded with a singular H).
+  /// \throws ModelError (a set-up call) if the solver's compute() has not succeeded, the contact
+  /// is no body of the model or its offset is not finite, qdot has the wrong size, the velocity
+  /// is not finite, `response` is no enumerator, or the response is unavailable (grounded with a
+  /// singular H). The message starts with "FloatingSide: ".
   /// `method` applies to the free-floating response (grounded and locked use their closed forms).
   FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
                Response response = Response::FreeFloating, ExIITMethod method = ExIITMethod::Recursive);
@@ -76,27 +82,31 @@ class FloatingSide : public ImpactSide {
   /// The base twist and joint rates after the last applyImpulse (before it: equal to before()).
   const FloatingVelocity& after() const { return after_; }
   /// Locked twist at the system CoM before / after: (v_g; w_g) = M_a^-1 (P_g; L_g).
-  Vector6d centroidTwistBefore() const;
-  Vector6d centroidTwistAfter() const;
+  const Vector6d& centroidTwistBefore() const { return v_g_before_; }
+  const Vector6d& centroidTwistAfter() const { return v_g_after_; }
 
  private:
   Vector6d aboutOrigin(const Vector6d& PL_g) const;
-  Vector6d contactTwist(const FloatingVelocity& v) const;
+  /// Contact twist (eq. 4) and locked CoM twist of a velocity; 0 or an Error code.
+  int contactAndCentroidTwists(const FloatingVelocity& v, const Vector6d& PL_g, Vector6d& t_h, Vector6d& v_g) const;
   FreeFloatingSolver& solver_;
   std::unique_ptr<RecursiveExIITSolver> recursive_;  ///< set for the recursive free-floating response
   Contact h_;
   Response response_;
   Matrix6d G_;
+  Vector3d r_g_;  ///< system CoM at the side's state
   FloatingVelocity before_, after_;
-  Vector6d PL_before_, PL_after_, t_before_, t_after_;
+  Vector6d PL_before_, PL_after_, t_before_, t_after_, v_g_before_, v_g_after_;
   double T_before_ = 0.0, T_after_ = 0.0;
-  KDL::JntArray dqdot_;  ///< workspace
+  KDL::JntArray dqdot_;      ///< workspace
+  FloatingVelocity trial_;   ///< workspace: the state after, until it is known to be good
 };
 
 /// \brief A rigid body as an impact side, touched at a world point.
 class RigidBodySide : public ImpactSide {
  public:
-  /// \throws ModelError if the mass is not > 0 or the inertia is not positive definite.
+  /// \throws ModelError (a set-up call) if the mass is not a finite value > 0, the inertia is not
+  /// symmetric positive definite, or an input is not finite. The message starts with "target: ".
   RigidBodySide(const RigidBody& body, const Vector3d& contact_point);
 
   const Matrix6d& G() const override { return G_; }
@@ -121,9 +131,21 @@ class RigidBodySide : public ImpactSide {
   Vector6d t_before_, twist_after_;
 };
 
-/// \brief Solves the impact between A (the robot) and B (the target) with `law`, and applies
-/// the impulse: F to A, -F to B. Afterwards each side reports its state after.
-/// \return the impulse (on A), or throws ModelError if a side rejects it.
-Impulse collide(ImpactSide& A, ImpactSide& B, const ImpactLaw& law);
+/// Which part of collide() refused, for a message that names it.
+enum class ImpactFault {
+  None,   ///< no error
+  Law,    ///< solveImpact: the law's parameters, or G_A + G_B (see solveImpact)
+  SideA,  ///< A refused the impulse F (A.applyImpulse)
+  SideB,  ///< B refused the impulse -F (B.applyImpulse)
+};
+
+/// \brief Solves the impact between A (the robot) and B (the target) with `law` (the checked
+/// solveImpact), and applies the impulse: F to A, -F to B. Afterwards each side reports its state
+/// after. Never throws.
+/// \param impulse the impulse on A; untouched on an error
+/// \param fault if not null, set to the part that refused (ImpactFault::None on success)
+/// \return 0, or the code of the part that refused. On an error neither side keeps the impulse:
+/// if B refuses it, A is reset to its state before (as by A.applyImpulse of a zero impulse).
+int collide(ImpactSide& A, ImpactSide& B, const ImpactLaw& law, Impulse& impulse, ImpactFault* fault = nullptr);
 
 }  // namespace kdl_space

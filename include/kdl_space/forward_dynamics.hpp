@@ -31,7 +31,12 @@ class ForwardDynamicsSolver {
 
   const FloatingModel& model() const { return kinematics_.model(); }
   /// Gravity acceleration (world frame); zero by default (orbit). For ground test beds.
-  void setGravity(const Vector3d& g) { gravity_ = g; }
+  /// \return 0, or E_NOT_FINITE (and the gravity unchanged) for a NaN or infinite g.
+  int setGravity(const Vector3d& g) {
+    if (!g.allFinite()) return E_NOT_FINITE;
+    gravity_ = g;
+    return E_NOERROR;
+  }
   const Vector3d& gravity() const { return gravity_; }
   /// Joints whose brakes are on (model order, size nj()). \return E_SIZE_MISMATCH or 0.
   int setLocked(const std::vector<bool>& locked);
@@ -40,7 +45,9 @@ class ForwardDynamicsSolver {
   /// \brief Accelerations from state, velocity, joint torques tau (model order) and external
   /// wrenches f_ext (one per body in model().bodies() order, world axes, moment about the body
   /// frame's origin; empty for none).
-  /// \return 0, E_SIZE_MISMATCH, E_NOT_FINITE or E_NOT_POSITIVE_DEFINITE.
+  /// \return 0, E_SIZE_MISMATCH (qdot, tau, acceleration.qddot, a non-empty f_ext of another
+  /// size than bodies()), E_NOT_FINITE (an input, or accelerations that overflow) or
+  /// E_NOT_POSITIVE_DEFINITE; `acceleration` is untouched on an error.
   int CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
 

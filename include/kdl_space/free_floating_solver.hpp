@@ -32,8 +32,15 @@ enum class Response {
 /// over the KDL tree, factorisation of H* and H), then any number of contact queries, which
 /// read the result of the last successful `compute`. Every vector and matrix is in the world
 /// frame; twists are (v; w), wrenches (f; n). Compute calls never throw: they return 0 or an
-/// Error code (errors.hpp). Workspaces are sized in the constructor; contact queries use
+/// Error code (errors.hpp) and leave their outputs untouched on an error. Every query returns
+/// E_NOT_COMPUTED before a successful compute(); a contact query returns E_BAD_CONTACT for a
+/// body index outside bodies() and E_NOT_FINITE for a non-finite offset; a joint-indexed input
+/// or output of the wrong size gives E_SIZE_MISMATCH, a NaN or infinite input E_NOT_FINITE, and
+/// so does a result that overflows. Workspaces are sized in the constructor; contact queries use
 /// them, so one solver serves one thread (build one per thread: the model is shared).
+///
+/// The accessors that take an index (bodyPose, S, bodyInertia) are not checked: the index must
+/// lie in [0, bodies().size()) or [0, nj()).
 class FreeFloatingSolver {
  public:
   explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model);
@@ -42,8 +49,10 @@ class FreeFloatingSolver {
   const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
 
   /// \brief Forward kinematics, centroid terms, H, A_m, H*; factorises H* and H.
-  /// \return E_NOERROR, E_SIZE_MISMATCH (q), E_NOT_FINITE, or E_NOT_POSITIVE_DEFINITE if H* is
-  /// not (then nothing that needs H* is available).
+  /// \return E_NOERROR, E_SIZE_MISMATCH (q), E_NOT_FINITE (q or the base pose, or a base pose so
+  /// far away that the centroid terms overflow), or E_NOT_POSITIVE_DEFINITE if H* is not. On any
+  /// error the previous result is discarded: every query returns E_NOT_COMPUTED until the next
+  /// successful compute().
   int compute(const State& state);
 
   // --- Results of the last compute() (world frame) ------------------------------------------
@@ -102,11 +111,14 @@ class FreeFloatingSolver {
 
   // --- Impulses (section 4) -------------------------------------------------------------------
   /// \brief The inverse inertia seen at h for a response: G*, the grounded G or the locked G.
+  /// \return as the three calls; E_BAD_ARGUMENT for a value of `response` that is no enumerator.
   int G(const Contact& h, Response response, Matrix6d& G);
   /// \brief Velocity jump from an impulse wrench F (on the robot, at h, world frame):
   /// FreeFloating: dqdot = H*^-1 J*^T F, d(P_g; L_g) = R_h^T F (eq. 8, 18);
   /// Grounded: dqdot = H^-1 J^T F, no momentum change of the base (the ground takes it);
   /// JointsLocked: dqdot = 0, d(P_g; L_g) = R_h^T F.
+  /// \return 0, E_SIZE_MISMATCH (dqdot), E_NOT_FINITE (F), E_NOT_POSITIVE_DEFINITE (grounded with
+  /// a singular H), E_BAD_ARGUMENT (`response` no enumerator), or a contact query's code.
   int velocityJump(const Contact& h, Response response, const Vector6d& F, Vector6d& dPL_g,
                    KDL::JntArray& dqdot);
 
@@ -147,7 +159,8 @@ class FreeFloatingSolver {
   Eigen::LLT<Eigen::MatrixXd> H_star_llt_, H_llt_;
   Matrix6Xd J_work_;            ///< contact-query workspace (6 x n)
   Eigen::MatrixXd X_work_;      ///< H^-1 J^T workspace (n x 6)
-  Eigen::MatrixXd J_all_work_, X_all_work_;  ///< multi-contact workspaces (6k x n, n x 6k)
+  Eigen::VectorXd dqdot_work_;  ///< velocityJump's joint-rate jump before it is returned (n)
+  Eigen::MatrixXd J_all_work_, X_all_work_, G_all_work_;  ///< multi-contact workspaces (6k x n, n x 6k, 6k x 6k)
   std::vector<Matrix6d> R_all_work_;         ///< multi-contact R_h per contact
 };
 

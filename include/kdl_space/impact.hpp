@@ -1,6 +1,9 @@
 // Impact laws between two bodies that touch at one point (section 4 of the paper, MATH.md).
 // Pure functions of the two sides' inverse inertias at the contact point and their contact
-// twists: stateless, allocation-free.
+// twists: stateless, allocation-free. Each has a checked form that returns 0 or an Error code
+// (errors.hpp) and leaves its output untouched on an error, and a value form: the bare formula,
+// for inputs the caller has already checked (its result is unspecified, NaN or infinite, for
+// inputs the checked form refuses; it never throws).
 //
 // Sign convention: F is the impulse wrench on side A (the robot) at the contact point, world
 // frame; side B (the target) receives -F. The unit normal n points from A's contact point toward
@@ -45,14 +48,32 @@ struct Impulse {
 /// impulse space, sticking while the sticking impulse rate lies in the cone and sliding against
 /// the slip otherwise, with Stronge's energetic restitution e (Stronge 2000, ch. 5). Never adds
 /// energy, always in the cone; with mu = 0 it is PointImpact (Newton's and Stronge's e agree).
+/// \return 0, or: E_NOT_FINITE if an input holds NaN or an infinity (law parameters included) or
+/// the impulse overflows; E_BAD_ARGUMENT if `law.kind` is no enumerator, or for a point or
+/// frictional impact the normal has zero length or the restitution lies outside [0, 1], or for a
+/// frictional impact the friction is negative; E_NOT_POSITIVE_DEFINITE if the law's block of
+/// G_A + G_B cannot be factorised (capture: the 6x6 sum; translational capture and friction: its
+/// translational 3x3 block; point impact: n^T G_vv n <= 0). `impulse` is untouched on an error.
+int solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
+                const ImpactLaw& law, Impulse& impulse);
+/// The same, unchecked (see the top of this header).
 Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
                     const ImpactLaw& law);
 
-/// \brief Virtual mass of a side along a unit direction n: 1 / (n^T G_vv n) (the seed's ref. 3).
+/// \brief Virtual mass of a side along a direction n: 1 / (n^T G_vv n) with n made unit (the
+/// seed's ref. 3). \return 0, E_NOT_FINITE (G or n), E_BAD_ARGUMENT (n of zero length), or
+/// E_NOT_POSITIVE_DEFINITE when n^T G_vv n <= 0 (the side cannot be moved along n: a grounded arm
+/// at a singular configuration has an infinite virtual mass there). `m` untouched on an error.
+int virtualMass(const Matrix6d& G, const Vector3d& n, double& m);
+/// The same for a unit n, unchecked: +inf where n^T G_vv n = 0.
 double virtualMass(const Matrix6d& G, const Vector3d& n);
 
 /// \brief Inverse inertia of a rigid body B at a point c: G_B = R_b M_b^-1 R_b^T (eq. 15-17),
 /// mass m, inertia I_com about the CoM (world axes), r_bc = p_c - p_b.
+/// \return 0, E_NOT_FINITE (an input, or the result overflows), E_BAD_ARGUMENT (m <= 0) or
+/// E_NOT_POSITIVE_DEFINITE (I_com). `G_B` untouched on an error.
+int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B);
+/// The same, unchecked (m > 0 and I_com symmetric positive definite are the caller's).
 Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
 
 }  // namespace kdl_space

@@ -62,28 +62,39 @@ struct SimulationStats {
 /// Runge-Kutta step; the orientation is renormalised after every step (no Euler angles).
 class Simulator {
  public:
+  /// \throws ModelError unless step, rtol, atol, max_step are finite and > 0, max_steps > 0,
+  /// gravity finite and the integrator an enumerator.
   explicit Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options = {});
 
   const FloatingModel& model() const { return dynamics_.model(); }
   const SimulationOptions& options() const { return options_; }
-  /// \throws ModelError for a joint index out of range or a negative gain.
+  /// \throws ModelError (a set-up call) for a joint index out of range, a mode that is no
+  /// enumerator, or a gain or set point that is negative or not finite.
   void setJointControl(unsigned int joint, const JointControl& control);
   const std::vector<JointControl>& jointControls() const { return controls_; }
   void setTorqueCallback(TorqueCallback callback) { callback_ = std::move(callback); }
 
   /// \brief Brakes on: the locked joints' rates become zero by an internal impulse (momentum
   /// unchanged), as when brakes engage. Call before run() if locked joints may be moving.
-  /// (A set-up call: it allocates, unlike run().)
+  /// (A set-up call: it allocates, unlike run(); it never throws.)
+  /// \return 0, E_SIZE_MISMATCH (q or qdot), E_NOT_FINITE, E_NOT_POSITIVE_DEFINITE; s untouched on
+  /// an error.
   int engageBrakes(SimulationState& s);
 
   /// \brief Integrates from s.t to t_end. `observer` (may be empty) sees s.t, every multiple of
-  /// output_dt after it, and t_end. \return 0 or an Error code (state left at the last good
-  /// step): E_MAX_STEPS when options().max_steps are spent, E_NOT_FINITE when the adaptive step
-  /// underflows.
+  /// output_dt after it, and t_end. An exception thrown by the observer or the torque callback
+  /// propagates (the run stops there); run() itself never throws.
+  /// \return 0 or an Error code: E_SIZE_MISMATCH (s.state.q or s.velocity.qdot, or a callback
+  /// that resized tau), E_NOT_FINITE (an input, the time bounds, or a state that blew up),
+  /// E_BAD_ARGUMENT (output_dt <= 0 or t_end < s.t), E_MAX_STEPS when options().max_steps are
+  /// spent, E_STEP_UNDERFLOW when the adaptive step falls to round-off, or a code of the
+  /// dynamics. On an error found before the first step s is untouched; later, s is left at the
+  /// last accepted step whose state can be evaluated (s.t tells how far the run got).
   int run(SimulationState& s, double t_end, double output_dt,
           const std::function<void(const SimulationState&)>& observer);
 
-  /// Kinetic energy and momentum (P; L about the world origin) of a state.
+  /// Kinetic energy and momentum (P; L about the world origin) of a state. \return 0 or the code
+  /// of FreeFloatingSolver::compute / momentum; T and h_O untouched on an error.
   int energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O);
 
   const SimulationStats& stats() const { return stats_; }
@@ -92,9 +103,13 @@ class Simulator {
   using Vector = Eigen::VectorXd;
   void pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const;
   int unpack(const Vector& x, double t, SimulationState& s);
+  /// unpack() into the scratch state, then copied into s only if it succeeds.
+  int publish(const Vector& x, double t, SimulationState& s);
   int derivative(double t, const Vector& x, Vector& dx);
   int stepRK4(double t, double h, Vector& x);
-  int stepDP54(double t, double h, Vector& x, double& error);
+  /// One trial step; `trial_failed` when a stage away from x (or the error estimate) could not be
+  /// evaluated, which the caller treats as a rejected step.
+  int stepDP54(double t, double h, Vector& x, double& error, bool& trial_failed);
 
   ForwardDynamicsSolver dynamics_;
   SimulationOptions options_;

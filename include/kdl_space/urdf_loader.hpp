@@ -13,7 +13,8 @@ namespace kdl_space {
 /// base inertia. A `floating` joint from a massless root (e.g. "world") to its only child is
 /// dropped and the child becomes the base (reported as a diagnostic); any other floating or
 /// planar joint is refused. Nothing is printed: urdfdom's and kdl_parser's messages are
-/// captured into the error or the diagnostics.
+/// captured into the error or the diagnostics. The rules are checkUrdfFile's (urdf_check.hpp),
+/// which reports every problem of a file at once; this throws at the first.
 /// \throws ModelError whose message starts with the file name and names the link or joint.
 FloatingModel loadUrdfFile(const std::string& path);
 

@@ -1,0 +1,89 @@
+// Checking a URDF file for use as a free-floating model: every problem, not only the first.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kdl_space {
+
+/// Whether a finding stops the model from being used (error) or only deserves attention.
+enum class Severity { Error, Warning };
+
+/// What `Finding::element` names.
+enum class ElementType {
+  File,   ///< the file as a whole (`element` is empty)
+  Robot,  ///< the <robot> element (`element` is the robot's name)
+  Link,
+  Joint,
+  Tip,    ///< a contact link asked for by the caller
+};
+
+/// \brief One problem found in a URDF description.
+struct Finding {
+  Severity severity = Severity::Error;
+  /// A short, stable, machine-readable identifier: `not_xml`, `not_urdf`, `malformed`,
+  /// `duplicate_name`, `unknown_joint_type`, `no_root`, `several_roots`, `loop`,
+  /// `missing_link`, `free_joint_inside`, `non_positive_mass`, `inertia_not_positive_definite`,
+  /// `triangle_inequality`, `not_finite`, `bad_number`, `zero_axis`, `unknown_tip`,
+  /// `base_without_mass`, `too_deep`, `singular_inertia`, `unreadable`, `refused_by_loader` (errors);
+  /// `root_inertia_dropped_by_kdl_parser`, `massless_link`, `axis_not_unit`,
+  /// `limits_exclude_zero`, `mass_ratio` (warnings).
+  std::string kind;
+  ElementType element_type = ElementType::File;
+  std::string element;  ///< link, joint or tip name; the robot's name; "" for the file
+  std::string message;  ///< what is wrong and, where it helps, what to do; without the element
+};
+
+/// The element and the message in one line: "link 'forearm': inertia is not positive definite
+/// (...)"; only the message for a finding about the file as a whole.
+std::string describe(const Finding& finding);
+
+/// \brief Figures of the model, as far as the file could be read.
+struct ModelSummary {
+  std::string robot;   ///< the <robot> name ("" if unknown)
+  std::string base;    ///< the free-floating base link ("" if it could not be decided)
+  int links = 0;       ///< <link> elements in the file, less a dropped massless root
+  int joints = 0;      ///< <joint> elements in the file, less the dropped floating joint
+  /// True when the loader built the model (no errors); the fields below are set only then.
+  bool loaded = false;
+  std::vector<std::string> joint_names;  ///< movable joints, model order
+  double total_mass = 0.0;               ///< [kg]
+  /// Condition number (largest / smallest eigenvalue) of H* at q = 0, base at the origin;
+  /// NaN without movable joints, +inf when singular.
+  double condition_H_star = 0.0;
+  /// Condition number of G* at each contact link (the requested tips, else every link that
+  /// carries no other link), at q = 0.
+  std::vector<std::pair<std::string, double>> condition_G_star;
+};
+
+/// \brief Everything `checkUrdfFile` found.
+struct UrdfReport {
+  std::string source;             ///< file name (or the name given to checkUrdfString)
+  std::vector<Finding> errors;    ///< the model cannot be used until these are fixed
+  std::vector<Finding> warnings;  ///< the model loads; these deserve a look
+  ModelSummary model;
+};
+
+/// \brief Reads a URDF file and reports every problem that keeps it from being used as a
+/// free-floating model (errors) or that deserves attention (warnings).
+///
+/// Errors: not readable, not XML, not URDF; no root, several roots, a loop; a joint naming a
+/// link that does not exist; a floating or planar joint below the root; a moving link of zero
+/// or negative mass, an inertia that is not positive definite or that breaks the triangle
+/// inequality; NaN, infinite or malformed numbers (every number attribute is checked); a
+/// zero-length axis; a tip that is not a link; a base without mass. Warnings: the root link's
+/// inertia that kdl_parser would drop (kdl_space keeps it), massless links, an axis that is
+/// not unit length, limits that exclude 0, a base more than 1e6 times heavier than the lightest
+/// moving link (with the condition numbers of H* and G* at q = 0).
+///
+/// The rules are the ones loadUrdfFile applies (one implementation): a file without errors
+/// loads. Never throws (beyond std::bad_alloc) and never prints.
+/// \param tips contact links to check and to compute G* at.
+UrdfReport checkUrdfFile(const std::string& path, const std::vector<std::string>& tips = {});
+
+/// Same as checkUrdfFile for a URDF document in memory; `source` names it in the report.
+UrdfReport checkUrdfString(const std::string& xml, const std::string& source = "<urdf string>",
+                           const std::vector<std::string>& tips = {});
+
+}  // namespace kdl_space

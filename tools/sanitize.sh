@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds the library, the tool and the tests with AddressSanitizer and
+# UndefinedBehaviorSanitizer (KDL_SPACE_SANITIZE=ON, assertions on) into build-asan/ (or
+# $KDL_SPACE_ASAN_BUILD_DIR), and runs the whole test suite there. Any sanitizer report fails the
+# test that triggered it. Third-party libraries (KDL, urdfdom, yaml-cpp) are not instrumented.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${KDL_SPACE_ASAN_BUILD_DIR:-$root/build-asan}"
+"$root/tools/deps.sh"
+# -O1 -g without NDEBUG: Eigen's and our assertions stay armed, stacks stay readable.
+cmake -S "$root" -B "$build" -DKDL_SPACE_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" "$@" >/dev/null
+cmake --build "$build" -j"$(nproc)" >/dev/null
+# Every report is fatal (UBSan too: -fno-sanitize-recover at compile time, halt_on_error here);
+# leaks are reported at exit. Suppressions, each with its reason: tools/sanitizers/.
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:abort_on_error=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+ctest --test-dir "$build" --output-on-failure -j"$(nproc)"
