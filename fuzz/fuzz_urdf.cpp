@@ -1,9 +1,13 @@
-// libFuzzer target: URDF text -> kdl_space::loadUrdfString -> both G* solvers at the zero state.
-// Expected outcomes: a model, or kdl_space::ModelError (a clean refusal). Anything else -- a
-// crash, another exception, a sanitizer report, a hang or a runaway allocation -- is a bug.
+// libFuzzer target: URDF text -> kdl_space::loadUrdfString -> both G* solvers at the zero state;
+// and the same text -> kdl_space::checkUrdfString (`kdl_space check`), which never throws.
+// Expected outcomes: a model, or kdl_space::ModelError (a clean refusal); a report. Anything
+// else -- a crash, another exception, a sanitizer report, a hang or a runaway allocation -- is a
+// bug, and so is a report without errors for a text the loader refuses.
 // Built by KDL_SPACE_FUZZ=ON, run by tools/fuzz.sh on fuzz/corpus/urdf/ with fuzz/urdf.dict.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -11,11 +15,13 @@
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/state.hpp"
+#include "kdl_space/urdf_check.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace kdl_space;
   const std::string xml(reinterpret_cast<const char*>(data), size);
+  bool loaded = false;
   try {
     const auto model = std::make_shared<const FloatingModel>(loadUrdfString(xml, "fuzz.urdf"));
     const State state(*model);  // base at the origin, joints at 0
@@ -33,8 +39,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     RecursiveExIITSolver recursive(model);
     if (recursive.compute(state) == E_NOERROR) recursive.G_star(h, G);
+    loaded = true;
   } catch (const ModelError&) {
     // A refused model: the expected outcome for most inputs.
+  }
+  // The checker applies the loader's rules ("a file without errors loads").
+  const UrdfReport report = checkUrdfString(xml, "fuzz.urdf");
+  if (!loaded && report.errors.empty()) {
+    std::fprintf(stderr, "fuzz_urdf: the loader refuses this text, checkUrdfString reports no error\n");
+    std::abort();
   }
   return 0;
 }

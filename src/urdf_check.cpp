@@ -754,7 +754,8 @@ UrdfReport Checker::run(const std::string& xml) {
     return report_;
   }
   TiXmlDocument doc;
-  doc.Parse(xml.c_str());
+  const std::string padded = xml + "    ";  // TinyXML reads past a final UTF-8 lead byte: see urdf_loader.cpp
+  doc.Parse(padded.c_str());
   if (doc.Error()) {
     std::string why = doc.ErrorDesc();  // e.g. "Error reading end tag."
     if (!why.empty() && why.back() == '.') why.pop_back();

@@ -562,8 +562,10 @@ TEST(Capture, CapturedTargetStaysAttached) {
   Vector6d h0;
   ASSERT_EQ(sim.energyAndMomentum(m, T0, h0), E_NOERROR);
   // (a) the merged system's momentum and energy at t = 0 are those of robot + target after.
-  EXPECT_TRUE(momentumNear(h0, h_post, 1e-12, lever));
-  EXPECT_TRUE(momentumNear(h0, h_pre, 1e-12, lever)) << "capture conserves momentum";
+  // 1e-11: the x86-64 baseline build (no FMA: CPUs without AVX2, and tools/sanitize.sh, where
+  // recursive_ex_iit.cpp has no x86-64-v3 clone) differs here by 1.3e-12 relative.
+  EXPECT_TRUE(momentumNear(h0, h_post, 1e-11, lever));
+  EXPECT_TRUE(momentumNear(h0, h_pre, 1e-11, lever)) << "capture conserves momentum";
   EXPECT_NEAR(T0, T_post, 1e-10 * T_post);
   // The target's implied motion at t = 0: the material point of the merged end_effector at the
   // target's CoM moves with the target's twist after the capture.
@@ -586,7 +588,7 @@ TEST(Capture, CapturedTargetStaysAttached) {
                       double T;
                       Vector6d h;
                       ASSERT_EQ(sim.energyAndMomentum(x, T, h), E_NOERROR);
-                      EXPECT_TRUE(momentumNear(h, h_pre, 1e-12, lever)) << "t = " << x.t;
+                      EXPECT_TRUE(momentumNear(h, h_pre, 1e-11, lever)) << "t = " << x.t;
                       worst_T = std::max(worst_T, relative(T, T_post));
                     }),
             E_NOERROR);
