@@ -21,14 +21,10 @@ Matrix6d transfer(const Vector3d& r) {
 }
 
 Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c) {
-  Matrix6d M;
-  const Matrix3d mC = m * skew(c);
-  M.topLeftCorner<3, 3>() = m * Matrix3d::Identity();
-  M.topRightCorner<3, 3>() = -mC;
-  M.bottomLeftCorner<3, 3>() = mC;
-  // eq. 3 for one body: I_c - m skew(c)^2 = I_c + m (|c|^2 E - c c^T)
-  M.bottomRightCorner<3, 3>() = I_c + m * (c.squaredNorm() * Matrix3d::Identity() - c * c.transpose());
-  return M;
+  Symmetric6d M;  // one formula for the packed and the dense form
+  M.setZero();
+  M.addRigidBody(m, c, I_c);
+  return M.toDense();
 }
 
 Matrix6d centroidInertia(double w, const Matrix3d& I_g) {

@@ -199,6 +199,11 @@ class Checker {
   void readShape(const TiXmlElement* geometry, const Owner& owner, const std::string& path);
   void readLink(const TiXmlElement* e);
   void readJoint(const TiXmlElement* e);
+  /// The name of a <link> or <joint>, entered in `index` as the next of `entered`; null
+  /// (reported) when it has none or is taken.
+  template <typename Info>
+  const char* registerName(const TiXmlElement* e, const char* tag, ElementType type,
+                           std::map<std::string, int>& index, const std::vector<Info>& entered);
   void checkGraph();
   void checkTree();
   void checkTips();
@@ -330,23 +335,32 @@ void Checker::readShape(const TiXmlElement* geometry, const Owner& owner, const 
   }
 }
 
-void Checker::readLink(const TiXmlElement* e) {
-  ++report_.model.links;
+template <typename Info>
+const char* Checker::registerName(const TiXmlElement* e, const char* tag, ElementType type,
+                                  std::map<std::string, int>& index, const std::vector<Info>& entered) {
   const char* name = e->Attribute("name");
   if (!name) {
-    error("malformed", robot_, "the <link> at line " + std::to_string(e->Row()) + " has no name attribute");
+    error("malformed", robot_, std::string("the <") + tag + "> at line " + std::to_string(e->Row()) +
+                                   " has no name attribute");
     graph_ok_ = false;
-    return;
+    return nullptr;
   }
+  if (const auto it = index.find(name); it != index.end()) {
+    error("duplicate_name", Owner{type, name},
+          "defined twice (lines " + std::to_string(entered[it->second].row) + " and " + std::to_string(e->Row()) + "): " +
+              tag + " names must be unique");
+    graph_ok_ = false;
+    return nullptr;
+  }
+  index[name] = static_cast<int>(entered.size());
+  return name;
+}
+
+void Checker::readLink(const TiXmlElement* e) {
+  ++report_.model.links;
+  const char* name = registerName(e, "link", ElementType::Link, link_index_, links_);
+  if (!name) return;
   const Owner owner{ElementType::Link, name};
-  if (const auto it = link_index_.find(name); it != link_index_.end()) {
-    error("duplicate_name", owner,
-          "defined twice (lines " + std::to_string(links_[it->second].row) + " and " + std::to_string(e->Row()) +
-              "): link names must be unique");
-    graph_ok_ = false;
-    return;
-  }
-  link_index_[name] = static_cast<int>(links_.size());
   LinkInfo link;
   link.name = name;
   link.row = e->Row();
@@ -397,21 +411,9 @@ void Checker::readLink(const TiXmlElement* e) {
 
 void Checker::readJoint(const TiXmlElement* e) {
   ++report_.model.joints;
-  const char* name = e->Attribute("name");
-  if (!name) {
-    error("malformed", robot_, "the <joint> at line " + std::to_string(e->Row()) + " has no name attribute");
-    graph_ok_ = false;
-    return;
-  }
+  const char* name = registerName(e, "joint", ElementType::Joint, joint_index_, joints_);
+  if (!name) return;
   const Owner owner{ElementType::Joint, name};
-  if (const auto it = joint_index_.find(name); it != joint_index_.end()) {
-    error("duplicate_name", owner,
-          "defined twice (lines " + std::to_string(joints_[it->second].row) + " and " + std::to_string(e->Row()) +
-              "): joint names must be unique");
-    graph_ok_ = false;
-    return;
-  }
-  joint_index_[name] = static_cast<int>(joints_.size());
   JointInfo joint;
   joint.name = name;
   joint.row = e->Row();

@@ -37,6 +37,8 @@
 #include <string>
 #include <vector>
 
+#include <kdl/rigidbodyinertia.hpp>
+
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/urdf_loader.hpp"
@@ -414,7 +416,14 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     Symmetric6d S;
     S.setZero();
     S.addRigidBody(m, c, I_c);
-    Matrix6d D = spatialInertia(m, c, I_c);
+    // Independently: KDL's rigid-body inertia about the reference point, [m E, -m c^; m c^, I_o].
+    KDL::RotationalInertia I_kdl(I_c(0, 0), I_c(1, 1), I_c(2, 2), I_c(0, 1), I_c(0, 2), I_c(1, 2));
+    const KDL::RigidBodyInertia rb(m, toKDL(c), I_kdl);
+    Matrix6d D = Matrix6d::Zero();
+    D.topLeftCorner<3, 3>() = m * Matrix3d::Identity();
+    D.bottomLeftCorner<3, 3>() = skew(toEigen(rb.getCOG() * m));
+    D.topRightCorner<3, 3>() = -D.bottomLeftCorner<3, 3>();
+    D.bottomRightCorner<3, 3>() = Eigen::Map<const Matrix3d>(rb.getRotationalInertia().data);
     EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "addRigidBody";
     EXPECT_LT((S * x - D * x).norm(), 1e-14 * D.norm() * x.norm()) << "product";
     S += S;
