@@ -1,6 +1,9 @@
 #include "model_rules.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <expat.h>
+
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -148,6 +151,87 @@ const Finding* firstError(const Findings& findings) {
   for (const Finding& f : findings)
     if (f.severity == Severity::Error) return &f;
   return nullptr;
+}
+
+}  // namespace kdl_space::rules
+
+// --- XML nesting ------------------------------------------------------------------------------
+
+namespace kdl_space::rules {
+namespace {
+
+/// \brief An upper bound of TinyXML's nesting depth: TinyXML 2.6.2 (TiXmlNode::Identify) opens
+/// an element only at a '<' followed by a letter, '_' or a byte of 127 or more, so the number
+/// of such places bounds the elements it can open, whatever it makes of the rest of the text.
+std::size_t elementTags(const std::string& xml) {
+  std::size_t n = 0;
+  for (std::size_t i = xml.find('<'); i != std::string::npos && i + 1 < xml.size(); i = xml.find('<', i + 1)) {
+    const unsigned char c = static_cast<unsigned char>(xml[i + 1]);
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c >= 127) ++n;
+  }
+  return n;
+}
+
+/// Expat's view of the document: element depth, and the constructs TinyXML reads otherwise.
+struct Nesting {
+  XML_Parser parser = nullptr;
+  int depth = 0;
+  int deepest = 0;
+  std::string refused;  ///< a construct met that makes the measurement unsafe
+};
+
+void XMLCALL onStart(void* data, const XML_Char*, const XML_Char**) {
+  auto* n = static_cast<Nesting*>(data);
+  n->deepest = std::max(n->deepest, ++n->depth);
+  if (n->deepest > kMaxXmlDepth) XML_StopParser(n->parser, XML_FALSE);
+}
+
+void XMLCALL onEnd(void* data, const XML_Char*) { --static_cast<Nesting*>(data)->depth; }
+
+void refuse(Nesting* n, const std::string& what) {
+  n->refused = what + " at line " + std::to_string(XML_GetCurrentLineNumber(n->parser)) +
+               " (a URDF needs none; TinyXML reads it differently from XML)";
+  XML_StopParser(n->parser, XML_FALSE);
+}
+
+void XMLCALL onDoctype(void* data, const XML_Char*, const XML_Char*, const XML_Char*, int) {
+  refuse(static_cast<Nesting*>(data), "a DOCTYPE");
+}
+
+void XMLCALL onInstruction(void* data, const XML_Char*, const XML_Char*) {
+  refuse(static_cast<Nesting*>(data), "a processing instruction");
+}
+
+}  // namespace
+
+std::string xmlDepthProblem(const std::string& xml) {
+  if (elementTags(xml) <= static_cast<std::size_t>(kMaxXmlDepth)) return "";
+  Nesting n;
+  n.parser = XML_ParserCreate(nullptr);
+  if (!n.parser) return "out of memory while measuring the element nesting";
+  XML_SetUserData(n.parser, &n);
+  XML_SetElementHandler(n.parser, onStart, onEnd);
+  XML_SetStartDoctypeDeclHandler(n.parser, onDoctype);
+  XML_SetProcessingInstructionHandler(n.parser, onInstruction);
+  constexpr std::size_t kChunk = std::size_t{1} << 30;  // XML_Parse takes an int length
+  XML_Status status;
+  std::size_t at = 0;
+  do {
+    const std::size_t len = std::min(kChunk, xml.size() - at);
+    at += len;
+    status = XML_Parse(n.parser, xml.data() + at - len, static_cast<int>(len), at == xml.size());
+  } while (status == XML_STATUS_OK && at < xml.size());
+  std::string problem;
+  if (n.deepest > kMaxXmlDepth)
+    problem = "elements nested more than " + std::to_string(kMaxXmlDepth) + " deep (a URDF nests 4 or 5)";
+  else if (!n.refused.empty())
+    problem = n.refused + ", in a file of more than " + std::to_string(kMaxXmlDepth) + " elements";
+  else if (status != XML_STATUS_OK)
+    problem = "line " + std::to_string(XML_GetCurrentLineNumber(n.parser)) + ": " +
+              XML_ErrorString(XML_GetErrorCode(n.parser)) + " (a file of more than " +
+              std::to_string(kMaxXmlDepth) + " elements is read only when it is well-formed XML)";
+  XML_ParserFree(n.parser);
+  return problem;
 }
 
 }  // namespace kdl_space::rules

@@ -68,6 +68,17 @@ constexpr int kMaxTreeDepth = 1000;
 /// \brief `too_deep` for `link`, `depth` joints below the base, beyond kMaxTreeDepth.
 void checkDepth(const std::string& link, int depth, Findings& out);
 
+/// The deepest XML element nesting read: TinyXML (urdfdom's parser, and checkUrdfFile's)
+/// recurses once per level, and a deeper document overflows the stack. A URDF nests 4 or 5.
+constexpr int kMaxXmlDepth = 2000;
+
+/// \brief Empty when TinyXML can read `xml` without nesting deeper than kMaxXmlDepth; otherwise
+/// why not, a sentence that follows "not XML that can be read safely: ". A text with at most
+/// kMaxXmlDepth element tags is safe whatever it holds; a larger one is measured by expat, and
+/// must then be well-formed and free of DOCTYPE and processing instructions (the constructs
+/// TinyXML reads differently from XML, where elements could hide from the measurement).
+std::string xmlDepthProblem(const std::string& xml);
+
 /// The first error of `findings`, or nullptr.
 const Finding* firstError(const Findings& findings);
 

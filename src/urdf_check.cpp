@@ -27,8 +27,6 @@ namespace {
 
 /// Above this ratio of the base mass to the lightest moving link's, H* and G* are ill-conditioned.
 constexpr double kMassRatioLimit = 1e6;
-/// Deeper XML is refused before parsing (tinyxml parses recursively; a URDF is 4 or 5 deep).
-constexpr int kMaxXmlDepth = 2000;
 
 std::string named(const std::string& s) { return "'" + s + "'"; }
 
@@ -106,34 +104,6 @@ std::vector<std::string> pieces(const std::string& text) {
     start = end + 1;
   }
   return out;
-}
-
-/// A rough count of the element nesting of an XML text (comments, CDATA, declarations skipped).
-int nestingDepth(const std::string& xml) {
-  int depth = 0, deepest = 0;
-  std::size_t i = 0;
-  auto skipPast = [&](const char* end) {
-    const std::size_t at = xml.find(end, i);
-    i = at == std::string::npos ? xml.size() : at + std::strlen(end);
-  };
-  while ((i = xml.find('<', i)) != std::string::npos) {
-    if (xml.compare(i, 4, "<!--") == 0) {
-      skipPast("-->");
-    } else if (xml.compare(i, 9, "<![CDATA[") == 0) {
-      skipPast("]]>");
-    } else if (xml.compare(i, 2, "<?") == 0 || xml.compare(i, 2, "<!") == 0) {
-      skipPast(">");
-    } else if (xml.compare(i, 2, "</") == 0) {
-      --depth;
-      skipPast(">");
-    } else {
-      const std::size_t close = xml.find('>', i);
-      if (close == std::string::npos) break;
-      if (xml[close - 1] != '/') deepest = std::max(deepest, ++depth);
-      i = close + 1;
-    }
-  }
-  return deepest;
 }
 
 // --- The walk over the document ---------------------------------------------------------------
@@ -750,9 +720,8 @@ UrdfReport Checker::run(const std::string& xml) {
     fileError("not_xml", "not XML: the file is empty");
     return report_;
   }
-  if (nestingDepth(xml) > kMaxXmlDepth) {
-    fileError("not_xml", "not XML that can be read safely: elements nested more than " + std::to_string(kMaxXmlDepth) +
-                             " deep (a URDF nests 4 or 5)");
+  if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty()) {
+    fileError("not_xml", "not XML that can be read safely: " + problem);
     return report_;
   }
   TiXmlDocument doc;

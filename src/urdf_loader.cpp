@@ -31,6 +31,8 @@ class CapturedLog : public console_bridge::OutputHandler {
 /// after some errors (an unparsable number in <inertial> leaves the link massless): any logged
 /// error refuses the file.
 urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& source) {
+  if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty())
+    throw ModelError(source + ": not XML that can be read safely: " + problem);
   static std::mutex console_mutex;  // console_bridge's handler is process-wide
   std::lock_guard<std::mutex> lock(console_mutex);
   CapturedLog log;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <set>
 
@@ -297,6 +298,29 @@ TEST_F(HostileFiles, UrdfFilesThatAreNoUrdf) {
   EXPECT_EQ(r.rc, 3);
   EXPECT_EQ(r.err.rfind("kdl_space: " + garbage + ": ", 0), 0u) << r.err;
   expectCleanFailure(r, garbage);
+}
+
+// TinyXML descends once per nesting level and overflowed the stack at 200,000 levels: every
+// command that reads a URDF must refuse such a file with the loader's message.
+TEST_F(HostileFiles, DeeplyNestedUrdfIsRefusedByEveryCommand) {
+  std::string xml = "<robot name=\"deep\">";
+  for (int i = 0; i < 200000; ++i) xml += "<a>";
+  const std::string urdf = write("nested.urdf", xml + "</robot>");
+  const std::string why = ": not XML that can be read safely: elements nested more than 2000 deep (a URDF nests 4 or 5)\n";
+  const ToolRun inspect = kdlSpace("inspect --urdf " + urdf + " --tip hand");
+  EXPECT_EQ(inspect.rc, 3);
+  EXPECT_EQ(inspect.err, "kdl_space: " + urdf + why);
+  expectCleanFailure(inspect, "inspect");
+  std::ifstream in(kCorpus + "/broken_urdf.yaml");
+  std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  scenario.replace(scenario.find("not_a_robot.urdf"), std::string("not_a_robot.urdf").size(), "nested.urdf");
+  const std::string file = write("nested.yaml", scenario);
+  for (const std::string command : {"capture", "simulate"}) {
+    const ToolRun r = kdlSpace(command + " " + file);
+    EXPECT_EQ(r.rc, 3) << command;
+    EXPECT_EQ(r.err, "kdl_space: " + file + ":3: robot.urdf: " + urdf + why) << command;
+    expectCleanFailure(r, command);
+  }
 }
 
 // --- Command lines -------------------------------------------------------------------------------

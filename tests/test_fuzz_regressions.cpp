@@ -60,18 +60,71 @@ TEST(FuzzRegression, NothingPastTheEndOfTheTextIsRead) {
   EXPECT_FALSE(checkUrdfString(dirty, path).errors.empty());
 }
 
-// Known, not fixed yet (found next to the fuzzers' findings, beyond fuzz_urdf's -max_len):
-// loadUrdfString hands any nesting depth to TinyXML, whose recursive descent overflows the stack
-// (SIGSEGV here at 200,000 levels, a 1.4 MB file); checkUrdfString refuses more than 2,000
-// levels before parsing. Enable when the loader applies the same limit.
-TEST(FuzzRegression, DISABLED_DeeplyNestedXmlIsRefusedNotAStackOverflow) {
-  const int levels = 200000;
-  std::string xml = "<?xml version=\"1.0\"?>\n<robot name=\"deep\">";
-  for (int i = 0; i < levels; ++i) xml += "<a>";
-  for (int i = 0; i < levels; ++i) xml += "</a>";
-  xml += "</robot>\n";
-  EXPECT_THROW(loadUrdfString(xml, "deep.urdf"), ModelError);
+// TinyXML (under urdfdom, and under checkUrdfString) descends recursively, once per nesting
+// level: 200,000 levels overflowed the stack (SIGSEGV, a 1.4 MB file). Each document below nests
+// that deep for TinyXML, and the ones after the first hide their depth from a naive count of
+// tags in a way TinyXML reads differently from XML; all must be refused, by both entry points,
+// with the same clear error.
+struct DeepDocument {
+  std::string name;
+  std::string head, level, tail;  ///< head + level x 200,000 + tail
+  std::string why;                ///< the expected reason, after "not XML that can be read safely: "
+};
+
+class FuzzRegressionDeepXml : public ::testing::TestWithParam<DeepDocument> {};
+
+TEST_P(FuzzRegressionDeepXml, IsRefusedNotAStackOverflow) {
+  const DeepDocument& d = GetParam();
+  std::string xml = d.head;
+  for (int i = 0; i < 200000; ++i) xml += d.level;
+  xml += d.tail;
+  const std::string expected = "deep.urdf: not XML that can be read safely: " + d.why;
+  try {
+    loadUrdfString(xml, "deep.urdf");
+    ADD_FAILURE() << "loaded";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), expected);
+  }
+  const UrdfReport report = checkUrdfString(xml, "deep.urdf");
+  ASSERT_EQ(report.errors.size(), 1u);
+  EXPECT_EQ(report.errors[0].kind, "not_xml");
+  EXPECT_EQ("deep.urdf: " + report.errors[0].message, expected);
 }
+
+const std::string kDeep = "elements nested more than 2000 deep (a URDF nests 4 or 5)";
+
+INSTANTIATE_TEST_SUITE_P(
+    Documents, FuzzRegressionDeepXml,
+    ::testing::Values(
+        DeepDocument{"Plain", "<?xml version=\"1.0\"?>\n<robot name=\"deep\">", "<a>", "</robot>\n", kDeep},
+        // Ends of elements in comments: XML's and TinyXML's reading agree, the depth is real.
+        DeepDocument{"ClosingTagsInComments", "<robot name=\"deep\">", "<a><!--</a>-->", "</robot>", kDeep},
+        // A '/>' inside an attribute value does not close the element.
+        DeepDocument{"SlashInAttribute", "<robot name=\"deep\">", "<a x=\"/>\">", "</robot>", kDeep},
+        // TinyXML reads "<?xml" anywhere as a declaration, quoted values and all, and its end
+        // at the first '>' after them: the "</a>" is inside the declaration for TinyXML.
+        DeepDocument{"DeclarationInsideElements", "<robot name=\"deep\">", "<a><?xml version=\"x>\"</a>\"?>",
+                     "</robot>",
+                     "line 1: XML or text declaration not at start of entity (a file of more than 2000 elements "
+                     "is read only when it is well-formed XML)"},
+        // In a UTF-8 document TinyXML takes a lead byte and the next three bytes as one
+        // character: "\xF0</a" is text for TinyXML, an end tag after a bad byte for XML.
+        DeepDocument{"EndTagsEatenByUtf8LeadBytes",
+                     "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<robot name=\"deep\">", "<a>\xF0</a>", "</robot>",
+                     "line 2: not well-formed (invalid token) (a file of more than 2000 elements is read only "
+                     "when it is well-formed XML)"},
+        // TinyXML ends a DOCTYPE at its first '>', inside the internal subset: the entity's
+        // text becomes elements for TinyXML, an unused declaration for XML.
+        DeepDocument{"ElementsInADoctype", "<!DOCTYPE robot [<!ENTITY e \"<a>", "<a>",
+                     "\">]>\n<robot name=\"deep\"/>",
+                     "a DOCTYPE at line 1 (a URDF needs none; TinyXML reads it differently from XML), in a file "
+                     "of more than 2000 elements"},
+        // TinyXML reads "<?xml-..." as a declaration too, ending at the first '>'.
+        DeepDocument{"ElementsInAnInstruction", "<robot name=\"deep\"><?xml-model x=\"a>", "<a>",
+                     "\"?></robot>",
+                     "a processing instruction at line 1 (a URDF needs none; TinyXML reads it differently from "
+                     "XML), in a file of more than 2000 elements"}),
+    [](const ::testing::TestParamInfo<DeepDocument>& info) { return info.param.name; });
 
 INSTANTIATE_TEST_SUITE_P(Inputs, FuzzRegressionUrdf, ::testing::ValuesIn(regressionFiles("urdf")),
                          [](const ::testing::TestParamInfo<std::string>& info) {
