@@ -18,10 +18,19 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   const std::size_t nb = model_->bodies().size();
   R_.resize(nb);
   p_.resize(nb);
-  joints_.resize(nb);
-  for (std::size_t i = 1; i < nb; ++i) {
+  local_.resize(nb);
+  for (std::size_t i = 0; i < nb; ++i) {
     const Body& b = model_->bodies()[i];
-    LocalJoint& j = joints_[i];
+    LocalBody& j = local_[i];
+    j.parent = b.parent;
+    j.joint = b.joint;
+    j.twist_v = b.joint_twist.head<3>();
+    j.twist_w = b.joint_twist.tail<3>();
+    j.mass = b.mass;
+    j.armature = b.joint >= 0 ? model_->armature()[b.joint] : 0.0;
+    j.com = b.com;
+    j.I_com = b.I_com;
+    if (i == 0) continue;
     const KDL::Frame pose0 = b.segment.pose(0.0);
     j.R0 = toEigen(pose0.M);
     j.p0 = toEigen(pose0.p);
@@ -54,58 +63,55 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
 
 KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const State& state) {
   computed_ = false;
-  const std::vector<Body>& bodies = model_->bodies();
   if (state.q.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!state.q.data.allFinite() || !allFinite(state.world_T_base)) return E_NOT_FINITE;
   p_b_ = toEigen(state.world_T_base.p);
+  const std::size_t nb = local_.size();
 
   // Forward kinematics (KDL's segment motion, precomputed as a screw about each joint axis);
   // unit joint twists and body inertias about the base origin.
   R_[0] = toEigen(state.world_T_base.M);
   p_[0] = p_b_;
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
-    if (b.parent >= 0) {
-      const LocalJoint& j = joints_[i];
-      const Matrix3d& R_parent = R_[b.parent];
-      const Vector3d& p_parent = p_[b.parent];
+  // Each result is built in registers and stored once (a store read back in pieces stalls).
+  for (std::size_t i = 0; i < nb; ++i) {
+    const LocalBody& j = local_[i];
+    if (j.parent >= 0) {
+      const Matrix3d& R_parent = R_[j.parent];
+      const Vector3d& p_parent = p_[j.parent];
       if (j.kind == 1) {  // revolute: rotation about the joint's axis line, then pose(0)
-        const double t = j.scale * state.q.data(b.joint), s = std::sin(t), c1 = 1.0 - std::cos(t);
-        const Matrix3d R_local = j.R0 + s * j.K1 + c1 * j.K2;
-        R_[i].noalias() = R_parent * R_local;
-        p_[i] = p_parent;
-        p_[i].noalias() += R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
+        const double t = j.scale * state.q.data(j.joint), s = std::sin(t), c1 = 1.0 - std::cos(t);
+        R_[i].noalias() = R_parent * (j.R0 + s * j.K1 + c1 * j.K2);
+        p_[i] = p_parent + R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
       } else {
         R_[i].noalias() = R_parent * j.R0;
-        p_[i] = p_parent + R_parent * (j.kind == 2 ? Vector3d(j.p0 + j.scale * state.q.data(b.joint) * j.axis) : j.p0);
+        p_[i] = p_parent + R_parent * (j.kind == 2 ? Vector3d(j.p0 + j.scale * state.q.data(j.joint) * j.axis) : j.p0);
       }
-      if (b.joint >= 0) {
+      if (j.joint >= 0) {
         // The joint's unit twist, rotated to world axes and moved from the parent's origin to p_b.
-        S_[i].tail<3>().noalias() = R_parent * b.joint_twist.tail<3>();
-        S_[i].head<3>().noalias() = R_parent * b.joint_twist.head<3>();
-        S_[i].head<3>() += S_[i].tail<3>().cross(p_b_ - p_parent);
+        const Vector3d w = R_parent * j.twist_w;
+        const Vector3d v = R_parent * j.twist_v + w.cross(p_b_ - p_parent);
+        S_[i] << v, w;
       }
     }
     IA_[i].setZero();
-    if (b.mass > 0.0) {  // else a frame-only link
+    if (j.mass > 0.0) {  // else a frame-only link
       const Matrix3d& R = R_[i];
-      const Matrix3d RI = R * b.I_com;
-      IA_[i].addRigidBody(b.mass, R * b.com + p_[i] - p_b_, RI * R.transpose());
+      const Matrix3d RI = R * j.I_com;
+      IA_[i].addRigidBody(j.mass, R * j.com + p_[i] - p_b_, RI * R.transpose());
     }
   }
   // Articulated-body inertias, leaves first.
-  for (std::size_t i = bodies.size(); i-- > 1;) {
-    const Body& b = bodies[i];
-    IA_[b.parent] += IA_[i];
-    if (b.joint >= 0) {
+  for (std::size_t i = nb; i-- > 1;) {
+    const LocalBody& j = local_[i];
+    IA_[j.parent] += IA_[i];
+    if (j.joint >= 0) {
       U_[i] = IA_[i] * S_[i];
-      D_[i] = S_[i].dot(U_[i]) + model_->armature()[b.joint];
+      D_[i] = S_[i].dot(U_[i]) + j.armature;
       if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
-      IA_[b.parent].subtractRank1(U_[i], 1.0 / D_[i]);
+      IA_[j.parent].subtractRank1(U_[i], 1.0 / D_[i]);
     }
   }
-  IA0_llt_.compute(IA_[0].toDense());
-  if (IA0_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  if (!IA_[0].invert(Omega0_)) return E_NOT_POSITIVE_DEFINITE;
   computed_ = true;
   return E_NOERROR;
 }
@@ -132,22 +138,20 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix
   // Omega_0 = (I^A_0)^-1, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T with
   // T_i = 1 - S_i D_i^-1 U_i^T (an impulse's bias force crossing joint i inward is T_i^T times it).
   // Expanded with w = Omega U, c = U^T w: Omega - (S y^T + y S^T), y = w/D - (c/D^2 + 1/D) S / 2.
-  Symmetric6d Omega;
-  for (int c = 0; c < 6; ++c) {  // vector solves: no blocked path
-    const Vector6d col = IA0_llt_.solve(Vector6d::Unit(c));
-    for (int r = c; r < 6; ++r) Omega.a[Symmetric6d::index(r, c)] = col(r);
-  }
+  // Dense here: Eigen vectorises the column updates, which a packed triangle does not allow.
+  Matrix6d O = Omega0_.toDense();
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
     if (bodies[i].joint < 0) continue;
     const double d = 1.0 / D_[i];
-    const Vector6d w = Omega * U_[i];
-    Omega.subtractRank2(S_[i], d * w - (0.5 * d * (d * U_[i].dot(w) + 1.0)) * S_[i]);
+    const Vector6d& S = S_[i];
+    const Vector6d w = O * U_[i];
+    const Vector6d y = d * w - (0.5 * d * (d * U_[i].dot(w) + 1.0)) * S;
+    for (int c = 0; c < 6; ++c) O.col(c) -= S * y(c) + y * S(c);
   }
   // G* = X Omega X^T, X = transfer(r) = [E, -r^; 0, E] (eq. 5, 11), by 3x3 blocks: with
   // Omega = [a, b; b^T, c], G* = [a - r^ b^T + e r^, e; e^T, c], e = b - r^ c.
   const Matrix3d rx = skew(R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_);
-  const Matrix6d O = Omega.toDense();
   const Matrix3d e = O.topRightCorner<3, 3>() - rx * O.bottomRightCorner<3, 3>();
   G.topLeftCorner<3, 3>() = O.topLeftCorner<3, 3>() - rx * O.bottomLeftCorner<3, 3>() + e * rx;
   G.topRightCorner<3, 3>() = e;
@@ -173,7 +177,7 @@ int RecursiveExIITSolver::velocityJump(const Contact& h, const Vector6d& F, Vect
     pa_[i] = p;
     if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) / D_[i]);
   }
-  a_[0] = -IA0_llt_.solve(p);
+  a_[0] = -(Omega0_ * p);
   d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
   for (std::size_t i = 1; i < bodies.size(); ++i) {
     const Body& b = bodies[i];

@@ -435,7 +435,26 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "+=, rank-1 and rank-2 updates";
     for (int r = 0; r < 6; ++r)
       for (int k = 0; k < 6; ++k) EXPECT_EQ(S(r, k), S(k, r));
+
+    // The inverse of a rigid body's inertia (positive definite), and of one made indefinite.
+    Symmetric6d P, P_inv;
+    P.setZero();
+    P.addRigidBody(m, c, I_c);
+    const Matrix6d P_dense = P.toDense();
+    ASSERT_TRUE(P.invert(P_inv));
+    const Eigen::LDLT<Matrix6d> ldlt(P_dense);  // Eigen's pivoting factorisation, not ours
+    const Matrix6d expected = ldlt.solve(Matrix6d::Identity());
+    EXPECT_LT((P_inv.toDense() - expected).norm(), 1e-12 * expected.norm()) << "invert";
+    EXPECT_LT((P_dense * P_inv.toDense() - Matrix6d::Identity()).norm(), 1e-12 * P_dense.norm() * expected.norm());
+    const Vector6d e = Vector6d::Unit(trial % 6);
+    P.subtractRank1(e, 2.0 / expected(trial % 6, trial % 6));  // e^T P^-1 e = 1/(that): crosses zero
+    EXPECT_FALSE(P.invert(P_inv)) << "not positive definite";
   }
+  Symmetric6d nan, out;
+  nan.setZero();
+  nan.addRigidBody(1.0, Vector3d::Zero(), Matrix3d::Identity());
+  nan.a[Symmetric6d::index(4, 2)] = std::nan("");
+  EXPECT_FALSE(nan.invert(out));
 }
 
 TEST(RecursiveRandomTrees, GeneratorCoversTheCases) {

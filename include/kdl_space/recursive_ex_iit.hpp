@@ -52,26 +52,32 @@ class RecursiveExIITSolver {
   std::shared_ptr<const FloatingModel> model_;
   bool computed_ = false;
   Vector3d p_b_ = Vector3d::Zero();                ///< base origin: the common reference point
-  /// A joint's motion, from KDL's segment once: pose(q) = screw(q) * pose(0), the screw about the
+  /// What compute() reads of one body, copied from the model once and packed together.
+  /// Its joint's motion, from KDL's segment: pose(q) = screw(q) * pose(0), the screw about the
   /// joint's axis (revolute: rotation by scale q about the line through `point`; prismatic:
   /// translation by scale q), so that compute() needs no KDL call per body.
   /// Revolute, by Rodrigues' formula Rot(a, t) = E + sin t a^ + (1 - cos t) a^ a^ folded into
   /// pose(0): pose(q) = (R0 + s K1 + (1 - c) K2, p0 + s k1 + (1 - c) k2), t = scale q.
-  struct LocalJoint {
+  struct LocalBody {
+    int parent = -1, joint = -1;  ///< as Body
     int kind = 0;  ///< 0 fixed, 1 revolute, 2 prismatic
     Vector3d axis = Vector3d::UnitZ();  ///< parent frame
     double scale = 1.0;
     Matrix3d R0 = Matrix3d::Identity(), K1 = Matrix3d::Zero(), K2 = Matrix3d::Zero();  ///< parent frame
     Vector3d p0 = Vector3d::Zero(), k1 = Vector3d::Zero(), k2 = Vector3d::Zero();
+    Vector3d twist_v = Vector3d::Zero(), twist_w = Vector3d::Zero();  ///< Body::joint_twist
+    double mass = 0.0, armature = 0.0;
+    Vector3d com = Vector3d::Zero();
+    Matrix3d I_com = Matrix3d::Zero();
   };
-  std::vector<LocalJoint> joints_;      ///< per body
+  std::vector<LocalBody> local_;        ///< per body
   std::vector<Matrix3d> R_;             ///< per body: world rotation
   std::vector<Vector3d> p_;             ///< per body: world position of the frame origin
   std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
   std::vector<Symmetric6d> IA_;                    ///< per body: articulated inertia at p_b
   std::vector<Vector6d> U_;                        ///< per body: I^A S
   std::vector<double> D_;                          ///< per body: S^T I^A S + armature
-  Eigen::LLT<Matrix6d> IA0_llt_;
+  Symmetric6d Omega0_;                             ///< (I^A_0)^-1
   std::vector<int> path_;                          ///< scratch: contact path
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse)

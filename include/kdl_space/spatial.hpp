@@ -54,25 +54,20 @@ struct Symmetric6d {
 
   static constexpr int index(int r, int c) { return r >= c ? r * (r + 1) / 2 + c : c * (c + 1) / 2 + r; }
   double operator()(int r, int c) const { return a[index(r, c)]; }
-  void setZero() {
-    for (double& x : a) x = 0.0;
-  }
+  void setZero() { Eigen::Map<Eigen::Matrix<double, 21, 1>>(a).setZero(); }  // vector stores, not rep stos
   Symmetric6d& operator+=(const Symmetric6d& o) {
     for (int k = 0; k < 21; ++k) a[k] += o.a[k];
     return *this;
   }
-  /// this * x (each stored number used twice off the diagonal)
+  /// this * x (each stored number used twice off the diagonal): six independent dot products
   Vector6d operator*(const Vector6d& x) const {
-    Vector6d y = Vector6d::Zero();
+    Vector6d y;
 #pragma GCC unroll 6
     for (int r = 0; r < 6; ++r) {
-      const int row = r * (r + 1) / 2;
+      double s = 0.0;
 #pragma GCC unroll 6
-      for (int c = 0; c < r; ++c) {
-        y(r) += a[row + c] * x(c);
-        y(c) += a[row + c] * x(r);
-      }
-      y(r) += a[row + r] * x(r);
+      for (int c = 0; c < 6; ++c) s += a[index(r, c)] * x(c);
+      y(r) = s;
     }
     return y;
   }
@@ -110,6 +105,44 @@ struct Symmetric6d {
     a[18] += I_c(2, 0) - mx * c.z();
     a[19] += I_c(2, 1) - my * c.z();
     a[20] += I_c(2, 2) + mx * c.x() + my * c.y();
+  }
+  /// \brief The inverse, from the root-free Cholesky factors A = L D L^T (L unit lower
+  /// triangular; no pivoting, as for any symmetric positive definite matrix):
+  /// A^-1 = X^T D^-1 X with X = L^-1. \return false, `inverse` unspecified, when a pivot is not
+  /// positive: the matrix is not positive definite (or holds NaN).
+  bool invert(Symmetric6d& inverse) const {
+    double L[6][6], LD[6][6], d_inv[6];  // LD(i, k) = L(i, k) d_k
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      double d = a[index(j, j)];
+      for (int k = 0; k < j; ++k) d -= L[j][k] * LD[j][k];
+      if (!(d > 0.0)) return false;
+      d_inv[j] = 1.0 / d;
+      for (int i = j + 1; i < 6; ++i) {
+        double s = a[index(i, j)];
+        for (int k = 0; k < j; ++k) s -= L[i][k] * LD[j][k];
+        LD[i][j] = s;
+        L[i][j] = s * d_inv[j];
+      }
+    }
+    double X[6][6];  // X = L^-1, unit lower triangular: X(i, c) = -sum_{c <= k < i} L(i, k) X(k, c)
+#pragma GCC unroll 6
+    for (int c = 0; c < 6; ++c) {
+      X[c][c] = 1.0;
+      for (int i = c + 1; i < 6; ++i) {
+        double s = -L[i][c];
+        for (int k = c + 1; k < i; ++k) s -= L[i][k] * X[k][c];
+        X[i][c] = s;
+      }
+    }
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r)  // (X^T D^-1 X)(r, c) = sum_{k >= r} X(k, r) X(k, c) / d_k, c <= r
+      for (int c = 0; c <= r; ++c) {
+        double s = 0.0;
+        for (int k = r; k < 6; ++k) s += X[k][r] * d_inv[k] * X[k][c];
+        inverse.a[index(r, c)] = s;
+      }
+    return true;
   }
   Matrix6d toDense() const {
     Matrix6d M;
