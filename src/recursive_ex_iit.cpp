@@ -103,13 +103,14 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const State& state) {
   // Articulated-body inertias, leaves first.
   for (std::size_t i = nb; i-- > 1;) {
     const LocalBody& j = local_[i];
-    IA_[j.parent] += IA_[i];
-    if (j.joint >= 0) {
-      U_[i] = IA_[i] * S_[i];
-      D_[i] = S_[i].dot(U_[i]) + j.armature;
-      if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
-      IA_[j.parent].subtractRank1(U_[i], 1.0 / D_[i]);
+    if (j.joint < 0) {
+      IA_[j.parent] += IA_[i];
+      continue;
     }
+    U_[i] = IA_[i] * S_[i];
+    D_[i] = S_[i].dot(U_[i]) + j.armature;
+    if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
+    IA_[j.parent].addMinusRank1(IA_[i], U_[i], 1.0 / D_[i]);
   }
   if (!IA_[0].invert(Omega0_)) return E_NOT_POSITIVE_DEFINITE;
   computed_ = true;
@@ -145,7 +146,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix
     if (bodies[i].joint < 0) continue;
     const double d = 1.0 / D_[i];
     const Vector6d& S = S_[i];
-    const Vector6d w = O * U_[i];
+    const Vector6d w = O.leftCols<3>() * U_[i].head<3>() + O.rightCols<3>() * U_[i].tail<3>();  // two chains
     const Vector6d y = d * w - (0.5 * d * (d * U_[i].dot(w) + 1.0)) * S;
     for (int c = 0; c < 6; ++c) O.col(c) -= S * y(c) + y * S(c);
   }

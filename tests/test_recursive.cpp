@@ -428,11 +428,12 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     EXPECT_LT((S * x - D * x).norm(), 1e-14 * D.norm() * x.norm()) << "product";
     S += S;
     D += D;
-    S.subtractRank1(u, alpha);
-    D -= alpha * u * u.transpose();
-    S.subtractRank2(u, v);
-    D -= u * v.transpose() + v * u.transpose();
-    EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "+=, rank-1 and rank-2 updates";
+    Symmetric6d other;  // another rigid body
+    other.setZero();
+    other.addRigidBody(m, v.head<3>(), I_c);
+    D += other.toDense() - alpha * u * u.transpose();
+    S.addMinusRank1(other, u, alpha);
+    EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "+= and the rank-1 update";
     for (int r = 0; r < 6; ++r)
       for (int k = 0; k < 6; ++k) EXPECT_EQ(S(r, k), S(k, r));
 
@@ -447,7 +448,9 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     EXPECT_LT((P_inv.toDense() - expected).norm(), 1e-12 * expected.norm()) << "invert";
     EXPECT_LT((P_dense * P_inv.toDense() - Matrix6d::Identity()).norm(), 1e-12 * P_dense.norm() * expected.norm());
     const Vector6d e = Vector6d::Unit(trial % 6);
-    P.subtractRank1(e, 2.0 / expected(trial % 6, trial % 6));  // e^T P^-1 e = 1/(that): crosses zero
+    Symmetric6d zero;
+    zero.setZero();
+    P.addMinusRank1(zero, e, 2.0 / expected(trial % 6, trial % 6));  // e^T P^-1 e = 1/(that): crosses zero
     EXPECT_FALSE(P.invert(P_inv)) << "not positive definite";
   }
   Symmetric6d nan, out;

@@ -20,9 +20,10 @@ namespace kdl_space {
 ///
 /// `compute(state)`: forward kinematics and one backward pass of articulated-body inertias
 /// I^A_i = I_i + sum over children (I^A_c - U_c D_c^-1 U_c^T), U = I^A S, D = S^T U (+ armature),
-/// all in world axes about the base frame's origin (packed symmetric, Symmetric6d).
+/// all in world axes about the base frame's origin (packed symmetric, Symmetric6d), and
+/// Omega_0 = (I^A_0)^-1 by a root-free Cholesky factorisation.
 /// `G_star(h)`: the inverse inertia a wrench on body i meets, outward along the path from the
-/// base to h's body: Omega_0 = (I^A_0)^-1, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T,
+/// base to h's body: from Omega_0, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T,
 /// T_i = 1 - S_i D_i^-1 U_i^T (sums of positive terms: no cancellation), then
 /// G* = R_h Omega R_h^T (eq. 5, 11) = J_full M_full^-1 J_full^T without any n x n matrix.
 /// `velocityJump`: the impulse's bias forces from h's body to the base, the base's jump

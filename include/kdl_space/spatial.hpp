@@ -59,35 +59,27 @@ struct Symmetric6d {
     for (int k = 0; k < 21; ++k) a[k] += o.a[k];
     return *this;
   }
-  /// this * x (each stored number used twice off the diagonal): six independent dot products
+  /// this * x (each stored number used twice off the diagonal): six independent dot products,
+  /// each as three pairs summed (a shorter chain of dependent operations than six in a row)
   Vector6d operator*(const Vector6d& x) const {
     Vector6d y;
 #pragma GCC unroll 6
     for (int r = 0; r < 6; ++r) {
-      double s = 0.0;
-#pragma GCC unroll 6
-      for (int c = 0; c < 6; ++c) s += a[index(r, c)] * x(c);
-      y(r) = s;
+      const double s01 = a[index(r, 0)] * x(0) + a[index(r, 1)] * x(1);
+      const double s23 = a[index(r, 2)] * x(2) + a[index(r, 3)] * x(3);
+      const double s45 = a[index(r, 4)] * x(4) + a[index(r, 5)] * x(5);
+      y(r) = s01 + (s23 + s45);
     }
     return y;
   }
-  /// this -= alpha u u^T
-  void subtractRank1(const Vector6d& u, double alpha) {
+  /// this += B - alpha u u^T, in one pass (an articulated body's contribution to its parent)
+  void addMinusRank1(const Symmetric6d& B, const Vector6d& u, double alpha) {
 #pragma GCC unroll 6
     for (int r = 0; r < 6; ++r) {
       const double ur = alpha * u(r);
       const int row = r * (r + 1) / 2;
 #pragma GCC unroll 6
-      for (int c = 0; c <= r; ++c) a[row + c] -= ur * u(c);
-    }
-  }
-  /// this -= u v^T + v u^T
-  void subtractRank2(const Vector6d& u, const Vector6d& v) {
-#pragma GCC unroll 6
-    for (int r = 0; r < 6; ++r) {
-      const int row = r * (r + 1) / 2;
-#pragma GCC unroll 6
-      for (int c = 0; c <= r; ++c) a[row + c] -= u(r) * v(c) + v(r) * u(c);
+      for (int c = 0; c <= r; ++c) a[row + c] += B.a[row + c] - ur * u(c);
     }
   }
   /// Adds the spatial inertia of a rigid body about the reference point, world axes: mass m,
