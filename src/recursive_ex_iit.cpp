@@ -126,14 +126,13 @@ KDL::Frame RecursiveExIITSolver::bodyPose(int i) const {
 
 int RecursiveExIITSolver::walkPath(const Contact& h) {
   int count = 0;
-  for (int b = h.body; b >= 0; b = model_->bodies()[b].parent) path_[count++] = b;
+  for (int b = h.body; b >= 0; b = local_[b].parent) path_[count++] = b;
   return count;
 }
 
 KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) {
   if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
-  const std::vector<Body>& bodies = model_->bodies();
+  if (h.body < 0 || h.body >= static_cast<int>(local_.size())) return E_BAD_CONTACT;
   const int count = walkPath(h);
   // Outward along the path, the inverse inertia a wrench at body i meets (about p_b):
   // Omega_0 = (I^A_0)^-1, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T with
@@ -143,7 +142,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix
   Matrix6d O = Omega0_.toDense();
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
-    if (bodies[i].joint < 0) continue;
+    if (local_[i].joint < 0) continue;
     const double d = 1.0 / D_[i];
     const Vector6d& S = S_[i];
     const Vector6d w = O.leftCols<3>() * U_[i].head<3>() + O.rightCols<3>() * U_[i].tail<3>();  // two chains
@@ -165,10 +164,9 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G_star(const Contact& h, Matrix
 int RecursiveExIITSolver::velocityJump(const Contact& h, const Vector6d& F, Vector6d& d_base_twist,
                                        KDL::JntArray& dqdot) {
   if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
+  if (h.body < 0 || h.body >= static_cast<int>(local_.size())) return E_BAD_CONTACT;
   if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!F.allFinite()) return E_NOT_FINITE;
-  const std::vector<Body>& bodies = model_->bodies();
   const Vector3d r = R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_;
   const int count = walkPath(h);
   for (auto& p : pa_) p.setZero();
@@ -176,12 +174,12 @@ int RecursiveExIITSolver::velocityJump(const Contact& h, const Vector6d& F, Vect
   for (int k = 0; k < count - 1; ++k) {
     const int i = path_[k];
     pa_[i] = p;
-    if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) / D_[i]);
+    if (local_[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) / D_[i]);
   }
   a_[0] = -(Omega0_ * p);
   d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
-  for (std::size_t i = 1; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
+  for (std::size_t i = 1; i < local_.size(); ++i) {
+    const LocalBody& b = local_[i];
     a_[i] = a_[b.parent];
     if (b.joint >= 0) {
       const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) / D_[i];

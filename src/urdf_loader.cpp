@@ -31,8 +31,6 @@ class CapturedLog : public console_bridge::OutputHandler {
 /// after some errors (an unparsable number in <inertial> leaves the link massless): any logged
 /// error refuses the file.
 urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& source) {
-  if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty())
-    throw ModelError(source + ": not XML that can be read safely: " + problem);
   static std::mutex console_mutex;  // console_bridge's handler is process-wide
   std::lock_guard<std::mutex> lock(console_mutex);
   CapturedLog log;
@@ -86,6 +84,9 @@ std::string typeName(const urdf::Joint& j) {
 }  // namespace
 
 FloatingModel loadUrdfString(const std::string& xml, const std::string& source) {
+  // Before TinyXML's recursive descent sees the text (parse, twice below).
+  if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty())
+    throw ModelError(source + ": not XML that can be read safely: " + problem);
   const urdf::ModelInterfaceSharedPtr model = parse(xml, source);
   std::vector<Diagnostic> diagnostics;
   auto fail = [&](const std::string& what) -> void { throw ModelError(source + ": " + what); };
