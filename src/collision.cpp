@@ -5,107 +5,113 @@
 #include <cmath>
 #include <string>
 
+#include "model_rules.hpp"
+
 namespace kdl_space {
 
 namespace {
-bool finite(const KDL::Vector& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
-
 [[noreturn]] void refuse(const std::string& what) { throw ModelError("FloatingSide: " + what); }
 [[noreturn]] void refuse(const std::string& what, int rc) { refuse(what + ": " + strError(rc)); }
+
+std::shared_ptr<const FloatingModel> checkedModel(std::shared_ptr<const FloatingModel> model) {
+  if (!model) refuse("null model");
+  return model;
+}
 }  // namespace
 
-FloatingSide::FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
-                           Response response, ExIITMethod method)
-    : solver_(solver), h_(h), response_(response), before_(before), after_(before), dqdot_(solver.model().nj()),
+FloatingSide::FloatingSide(const FloatingSystem& s, ExIITMethod method)
+    : FloatingSide(s.model, s.state, s.contact, s.velocity, s.response, method) {}
+
+FloatingSide::~FloatingSide() = default;
+
+FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
+                           const FloatingVelocity& before, Response response, ExIITMethod method)
+    : model_(checkedModel(std::move(model))),
+      kin_(*model_),
+      momentum_(model_),
+      h_(h),
+      response_(response),
+      before_(before),
+      after_(before),
+      dqdot_(model_->nj()),
       trial_(before) {
-  const unsigned int n = solver.model().nj();
+  const unsigned int n = model_->nj();
   if (before.qdot.rows() != n)
     refuse(std::to_string(before.qdot.rows()) + " joint rates given for the model's " + std::to_string(n) + " joints");
-  if (!before.qdot.data.allFinite() || !finite(before.base_twist.vel) || !finite(before.base_twist.rot))
+  if (!before.qdot.data.allFinite() || !allFinite(before.base_twist))
     refuse("the base twist or a joint rate is NaN or infinite");
   if (response_ != Response::FreeFloating && response_ != Response::Grounded && response_ != Response::JointsLocked)
     refuse("the response is not one of FreeFloating, Grounded, JointsLocked");
-  Vector3d p_h;
-  if (const int rc = solver_.contactPoint(h_, p_h)) refuse("contact point", rc);
-  r_g_ = solver_.r_g();
-  if (response_ == Response::FreeFloating && method == ExIITMethod::Recursive) {
-    recursive_ = std::make_unique<RecursiveExIITSolver>(solver_.sharedModel());
-    int rc = recursive_->compute(solver_.state());
-    if (rc == E_NOERROR) rc = recursive_->G_star(h_, G_);
-    if (rc == E_NOERROR && !G_.allFinite()) rc = E_NOT_FINITE;
-    if (rc) refuse("G* at the contact point", rc);
-  } else if (const int rc = solver_.G(h_, response_, G_)) {
-    refuse(response_ == Response::Grounded ? "grounded G at the contact point" : "G at the contact point", rc);
-  }
+  if (method != ExIITMethod::Recursive && method != ExIITMethod::Dense)
+    refuse("the method is not one of Recursive, Dense");
+  if (h_.body < 0 || h_.body >= static_cast<int>(model_->bodies().size())) refuse("contact point", E_BAD_CONTACT);
+  if (!allFinite(h_.offset)) refuse("contact point", E_NOT_FINITE);
+  if (const int rc = forwardKinematics(*model_, state, kin_)) refuse("the state", rc);
   if (response_ == Response::Grounded) {
     // The grounded base does not move, whatever twist was given.
     before_.base_twist = after_.base_twist = trial_.base_twist = KDL::Twist::Zero();
   }
-  int rc = solver_.momentum(before_.base_twist, before_.qdot, PL_before_);
-  if (rc == E_NOERROR) rc = solver_.kineticEnergy(before_.base_twist, before_.qdot, T_before_);
-  if (rc == E_NOERROR) rc = contactAndCentroidTwists(before_, PL_before_, t_before_, v_g_before_);
+  int rc = momentum_.compute(kin_, before_);
   if (rc) refuse("the state before the impact", rc);
-  PL_after_ = PL_before_;
-  T_after_ = T_before_;
+  const char* what = response_ == Response::Grounded ? "grounded G at the contact point"
+                     : response_ == Response::FreeFloating ? "G* at the contact point"
+                                                           : "G at the contact point";
+  if (response_ == Response::JointsLocked) {
+    rc = momentum_.G_locked(h_, G_);  // eq. 20
+  } else if (method == ExIITMethod::Recursive) {
+    recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
+    rc = recursive_->compute(kin_);
+    if (rc == E_NOERROR) rc = recursive_->G(h_, response_, G_);
+  } else {
+    dense_ = std::make_unique<FreeFloatingSolver>(model_);
+    rc = dense_->compute(kin_);
+    if (rc == E_NOERROR) rc = dense_->G(h_, response_, G_);
+  }
+  if (rc) refuse(what, rc);
+  h_before_ = h_after_ = momentum_.momentum();
+  T_before_ = T_after_ = momentum_.kineticEnergy();
+  v_g_before_ = v_g_after_ = momentum_.centroidTwist();
+  if ((rc = momentum_.contactTwist(h_, t_before_))) refuse("the state before the impact", rc);
   t_after_ = t_before_;
-  v_g_after_ = v_g_before_;
-}
-
-int FloatingSide::contactAndCentroidTwists(const FloatingVelocity& v, const Vector6d& PL_g, Vector6d& t_h,
-                                           Vector6d& v_g) const {
-  KDL::Twist t;
-  if (const int rc = solver_.handTwist(h_, v.qdot, PL_g, t)) return rc;  // eq. 4
-  // (v_g; w_g) = M_a^-1 (P_g; L_g), M_a = diag(w E, I_g) (eq. 12)
-  const Eigen::LLT<Matrix3d> I_g_llt(solver_.I_g());
-  if (I_g_llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  Vector6d c;
-  c.head<3>() = PL_g.head<3>() / solver_.w();
-  c.tail<3>() = I_g_llt.solve(Vector3d(PL_g.tail<3>()));
-  if (!c.allFinite()) return E_NOT_FINITE;
-  t_h = toEigen(t);
-  v_g = c;
-  return E_NOERROR;
 }
 
 int FloatingSide::applyImpulse(const Vector6d& F) {
   if (!F.allFinite()) return E_NOT_FINITE;
-  // Everything after the impulse goes to trial_ and locals first: the state after changes only
-  // when all of it is good.
-  Vector6d PL, t_h, v_g;
-  double T = 0.0;
-  if (recursive_) {
-    Vector6d d_base;
-    if (const int rc = recursive_->velocityJump(h_, F, d_base, dqdot_)) return rc;
-    trial_.qdot.data = before_.qdot.data + dqdot_.data;
-    trial_.base_twist = before_.base_twist + toTwist(d_base);
-    if (const int rc = solver_.momentum(trial_.base_twist, trial_.qdot, PL)) return rc;
+  // Everything after the impulse goes to trial_ first: the state after changes only when all of
+  // it is good.
+  trial_.qdot.data = before_.qdot.data;
+  if (response_ == Response::JointsLocked) {
+    // One rigid body: the momentum changes by the impulse (eq. 21), the joints stay still.
+    Vector6d h = h_before_;
+    h.head<3>() += F.head<3>();
+    h.tail<3>() += F.tail<3>() + kin_.point(h_).cross(Vector3d(F.head<3>()));  // moment about the origin
+    if (const int rc = momentum_.baseTwist(kin_, h, trial_.qdot, trial_.base_twist)) return rc;
   } else {
-    Vector6d dPL;
-    if (const int rc = solver_.velocityJump(h_, response_, F, dPL, dqdot_)) return rc;
-    trial_.qdot.data = before_.qdot.data + dqdot_.data;
-    if (response_ != Response::Grounded) {
-      PL = PL_before_ + dPL;
-      if (const int rc = solver_.baseTwist(PL, trial_.qdot, trial_.base_twist)) return rc;
-    } else {
+    const int rc = recursive_ ? recursive_->velocityJump(h_, response_, F, d_base_, dqdot_)
+                              : dense_->velocityJump(h_, response_, F, d_base_, dqdot_);
+    if (rc) return rc;
+    trial_.qdot.data += dqdot_.data;
+    if (response_ == Response::Grounded) {
       trial_.base_twist = before_.base_twist;  // zero: the ground holds the base
-      if (const int rc = solver_.momentum(trial_.base_twist, trial_.qdot, PL)) return rc;
+    } else if (recursive_) {
+      trial_.base_twist = before_.base_twist + toTwist(d_base_);
+    } else {
+      // The dense route gives the jump of (P_g; L_g) (eq. 8): the base twist from the momentum.
+      Vector6d PL_g;
+      if (const int rc = dense_->momentum(before_.base_twist, before_.qdot, PL_g)) return rc;
+      if (const int rc = dense_->baseTwist(PL_g + d_base_, trial_.qdot, trial_.base_twist)) return rc;
     }
   }
-  if (const int rc = solver_.kineticEnergy(trial_.base_twist, trial_.qdot, T)) return rc;
-  if (const int rc = contactAndCentroidTwists(trial_, PL, t_h, v_g)) return rc;
+  Vector6d t_h;
+  if (const int rc = momentum_.compute(kin_, trial_)) return rc;
+  if (const int rc = momentum_.contactTwist(h_, t_h)) return rc;
   after_.base_twist = trial_.base_twist;
   after_.qdot.data = trial_.qdot.data;
-  PL_after_ = PL;
-  T_after_ = T;
+  h_after_ = momentum_.momentum();
+  T_after_ = momentum_.kineticEnergy();
   t_after_ = t_h;
-  v_g_after_ = v_g;
+  v_g_after_ = momentum_.centroidTwist();
   return E_NOERROR;
-}
-
-Vector6d FloatingSide::aboutOrigin(const Vector6d& PL_g) const {
-  Vector6d m = PL_g;
-  m.tail<3>() += r_g_.cross(PL_g.head<3>());  // L_O = L_g + r_g x P
-  return m;
 }
 
 RigidBodySide::RigidBodySide(const RigidBody& body, const Vector3d& contact_point)
@@ -113,9 +119,8 @@ RigidBodySide::RigidBodySide(const RigidBody& body, const Vector3d& contact_poin
   if (!(body.mass > 0.0) || !std::isfinite(body.mass)) throw ModelError("target: mass must be a finite value > 0");
   if (!body.I_com.allFinite() || !body.com.allFinite() || !body.twist.allFinite() || !contact_point.allFinite())
     throw ModelError("target: inertia, CoM, twist and contact point must be finite");
-  const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(0.5 * (body.I_com + body.I_com.transpose()),
-                                                    Eigen::EigenvaluesOnly);
-  if (!(eig.eigenvalues()(0) > 0.0) || (body.I_com - body.I_com.transpose()).norm() > 1e-12 * body.I_com.norm())
+  const rules::InertiaVerdict verdict = rules::judgeInertia(body.I_com);
+  if (!verdict.symmetric || verdict.kind == rules::InertiaVerdict::NotPositiveDefinite)
     throw ModelError("target: inertia must be symmetric positive definite");
   if (const int rc = rigidBodyG(body.mass, body.I_com, r_bc_, G_))
     throw ModelError(std::string("target: inverse inertia at the contact point: ") + strError(rc));

@@ -3,17 +3,13 @@
 #include <cmath>
 
 namespace kdl_space {
-namespace {
-bool finite(const KDL::Vector& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
-bool finite(const KDL::Twist& t) { return finite(t.vel) && finite(t.rot); }
-}  // namespace
-
 FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
     : model_(std::move(model)) {
   if (!model_) throw ModelError("FreeFloatingSolver: null model");
   const std::size_t nb = model_->bodies().size();
   const unsigned int n = model_->nj();
   world_T_body_.resize(nb);
+  own_ = Kinematics(*model_);
   state_ = State(*model_);
   I_c_.resize(nb);
   I_body_.resize(nb);
@@ -35,48 +31,31 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
 int FreeFloatingSolver::compute(const State& state) {
   computed_ = false;
   H_ok_ = false;
+  if (const int rc = forwardKinematics(*model_, state, own_)) return rc;
+  return compute(own_);
+}
+
+int FreeFloatingSolver::compute(const Kinematics& kin) {
+  computed_ = false;
+  H_ok_ = false;
   const std::vector<Body>& bodies = model_->bodies();
   const unsigned int n = model_->nj();
-  if (state.q.rows() != n) return E_SIZE_MISMATCH;
-  if (!state.q.data.allFinite() || !allFinite(state.world_T_base)) return E_NOT_FINITE;
-  world_T_base_ = state.world_T_base;
+  if (kin.model != model_.get() || kin.R.size() != bodies.size()) return E_SIZE_MISMATCH;
+  if (!kin.valid) return E_NOT_COMPUTED;
+  world_T_base_ = kin.state.world_T_base;
   H_.data.setZero();
-
-  // Forward kinematics (parents first); unit joint twists at each moved body's origin.
-  Vector3d first_moment = Vector3d::Zero();
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
-    if (b.parent < 0) {
-      world_T_body_[i] = world_T_base_;
-    } else {
-      const double q = b.joint >= 0 ? state.q(b.joint) : 0.0;
-      const KDL::Frame& world_T_parent = world_T_body_[b.parent];
-      world_T_body_[i] = world_T_parent * b.segment.pose(q);
-      // The joint's unit twist in world axes, at the parent's origin (moved to r_g below).
-      if (b.joint >= 0) {
-        const Matrix3d R = toEigen(world_T_parent.M);
-        S_[b.joint] << R * b.joint_twist.head<3>(), R * b.joint_twist.tail<3>();
-      }
-    }
-    first_moment += b.mass * toEigen(world_T_body_[i] * toKDL(b.com));
-  }
-  r_g_ = first_moment / w();
+  for (std::size_t i = 0; i < bodies.size(); ++i) world_T_body_[i] = kin.pose(static_cast<int>(i));
+  r_g_ = kin.r_g;
 
   // Spatial inertia of every body about r_g (world axes), then composites (children first).
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
-    const Matrix3d R = toEigen(world_T_body_[i].M);
-    const Vector3d r_gi = toEigen(world_T_body_[i] * toKDL(b.com)) - r_g_;
-    I_body_[i] = spatialInertia(b.mass, r_gi, R * b.I_com * R.transpose());
+    I_body_[i] = spatialInertia(bodies[i].mass, kin.com[i] - r_g_, kin.I_com[i]);
     I_c_[i] = I_body_[i];
   }
   for (std::size_t i = bodies.size(); i-- > 1;) I_c_[bodies[i].parent] += I_c_[i];
 
   // Joint twists moved to r_g; A_m and H by the composite-rigid-body pass.
-  for (unsigned int j = 0; j < n; ++j) {
-    const int b = model_->jointBody()[j];
-    S_[j] = shiftTwist(S_[j], r_g_ - toEigen(world_T_body_[model_->bodies()[b].parent].p));
-  }
+  for (unsigned int j = 0; j < n; ++j) S_[j] = shiftTwist(kin.S[model_->jointBody()[j]], r_g_ - kin.p_b);
   for (unsigned int j = 0; j < n; ++j) {
     const int b = model_->jointBody()[j];
     const Vector6d F = I_c_[b] * S_[j];  // momentum about r_g of the subtree moved by joint j
@@ -105,8 +84,8 @@ int FreeFloatingSolver::compute(const State& state) {
   H_ok_ = H_llt_.info() == Eigen::Success;
   H_star_llt_.compute(H_star_.data);
   if (H_star_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  state_.world_T_base = state.world_T_base;
-  state_.q.data = state.q.data;
+  state_.world_T_base = kin.state.world_T_base;
+  state_.q.data = kin.state.q.data;
   computed_ = true;
   return E_NOERROR;
 }
@@ -123,7 +102,7 @@ int FreeFloatingSolver::momentum(const KDL::Twist& base_twist, const KDL::JntArr
                                  Vector6d& PL_g) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
-  if (!finite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
+  if (!allFinite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
   Vector6d PL;
   PL.noalias() = M_a_ * y + A_m_ * qdot.data;  // eq. 2
@@ -149,7 +128,7 @@ int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::J
                                       double& T) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
-  if (!finite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
+  if (!allFinite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
   double qHq = 0.0;  // q^T H q without a temporary
   for (Eigen::Index j = 0; j < H_.data.cols(); ++j) qHq += qdot(j) * H_.data.col(j).dot(qdot.data);
@@ -162,7 +141,7 @@ int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::J
 int FreeFloatingSolver::ready(const Contact& h) const {
   if (!computed_) return E_NOT_COMPUTED;
   if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
-  if (!finite(h.offset)) return E_NOT_FINITE;
+  if (!allFinite(h.offset)) return E_NOT_FINITE;
   return E_NOERROR;
 }
 

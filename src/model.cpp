@@ -4,6 +4,7 @@
 
 #include "kdl_space/errors.hpp"
 #include "kdl_space/spatial.hpp"
+#include "detail/joint_motion.hpp"
 #include "model_rules.hpp"
 
 namespace kdl_space {
@@ -134,6 +135,7 @@ void FloatingModel::validate() {
 
   total_mass_ = 0.0;
   for (const Body& b : bodies_) total_mass_ += b.mass;
+  motions_ = std::make_shared<const detail::MotionTable>(bodies_);
 }
 
 int FloatingModel::jointIndex(const std::string& name) const {

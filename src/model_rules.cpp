@@ -28,6 +28,20 @@ Finding warning(std::string kind, ElementType type, std::string element, std::st
   return {Severity::Warning, std::move(kind), type, std::move(element), std::move(message)};
 }
 
+InertiaVerdict judgeInertia(const Eigen::Matrix3d& I) {
+  InertiaVerdict v;
+  if (!I.allFinite()) {
+    v.kind = InertiaVerdict::NotFinite;
+    return v;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (I + I.transpose()), Eigen::EigenvaluesOnly);
+  v.moments = eig.eigenvalues();  // ascending
+  v.symmetric = (I - I.transpose()).norm() <= 1e-12 * I.norm();
+  if (!(v.moments(0) > 0.0)) v.kind = InertiaVerdict::NotPositiveDefinite;
+  else if (v.moments(0) + v.moments(1) < v.moments(2) * (1.0 - 1e-9)) v.kind = InertiaVerdict::TriangleInequality;
+  return v;
+}
+
 void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I_com, Findings& out) {
   if (!std::isfinite(mass) || !I_com.allFinite()) {
     out.push_back(error("not_finite", ElementType::Link, link, "inertial values hold NaN or infinite numbers"));
@@ -46,16 +60,15 @@ void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I
                           "<inertial> if it only carries a frame"));
     return;
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (I_com + I_com.transpose()),
-                                                           Eigen::EigenvaluesOnly);
-  const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+  InertiaVerdict v = judgeInertia(I_com);
+  const Eigen::Vector3d& l = v.moments;
   const std::string moments = number(l(0)) + ", " + number(l(1)) + ", " + number(l(2)) + " kg m^2";
-  if (!(l(0) > 0.0)) {
+  if (v.kind == InertiaVerdict::NotPositiveDefinite) {
     out.push_back(error("inertia_not_positive_definite", ElementType::Link, link,
                         "inertia is not positive definite (principal moments " + moments +
                             "): a body with mass has three positive principal moments; check the "
                             "signs, the products of inertia and the units"));
-  } else if (l(0) + l(1) < l(2) * (1.0 - 1e-9)) {
+  } else if (v.kind == InertiaVerdict::TriangleInequality) {
     out.push_back(error("triangle_inequality", ElementType::Link, link,
                         "principal moments " + moments +
                             " break the triangle inequality I1 + I2 >= I3: no rigid body has this "

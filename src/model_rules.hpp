@@ -16,6 +16,17 @@ using Findings = std::vector<Finding>;
 Finding error(std::string kind, ElementType type, std::string element, std::string message);
 Finding warning(std::string kind, ElementType type, std::string element, std::string message);
 
+/// \brief What an inertia about a CoM is: its principal moments (ascending) and the first rule
+/// it breaks. The one test of links, rigid targets and payloads; each caller words the verdict.
+struct InertiaVerdict {
+  enum Kind { Ok, NotFinite, NotPositiveDefinite, TriangleInequality } kind = Ok;  ///< of the symmetric part
+  bool symmetric = true;
+  Eigen::Vector3d moments = Eigen::Vector3d::Zero();  ///< principal moments of the symmetric part, ascending
+};
+/// Symmetric means |I - I^T| <= 1e-12 |I| (Frobenius); the triangle inequality is checked with a
+/// relative slack of 1e-9.
+InertiaVerdict judgeInertia(const Eigen::Matrix3d& I);
+
 /// \brief Inertial values of one link: mass [kg] and inertia about the CoM [kg m^2], any axes
 /// (only its principal moments matter). Errors: `not_finite`, `non_positive_mass` (negative, or
 /// zero with a rotational inertia), `inertia_not_positive_definite`, `triangle_inequality`.

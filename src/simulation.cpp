@@ -244,9 +244,12 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   const double t0 = s.t;
   // On an error, s is left at the last accepted step if its state can be evaluated (else at the
   // last output), so that the caller sees how far the run got.
+  // After the first accepted step, a mass matrix that fails its factorisation (positive definite
+  // at every configuration of a valid model) means the state has left the range where round-off
+  // is small: the motion blew up.
   const auto failed = [&](int rc) {
     publish(x, t, s);
-    return rc;
+    return rc == E_NOT_POSITIVE_DEFINITE && stats_.accepted_steps > 0 ? static_cast<int>(E_NOT_FINITE) : rc;
   };
   while (t < t_end) {
     if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return failed(E_MAX_STEPS);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "detail/symmetric6d.hpp"
+
 namespace kdl_space {
 
 Matrix3d skew(const Vector3d& r) {
@@ -21,7 +23,7 @@ Matrix6d transfer(const Vector3d& r) {
 }
 
 Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c) {
-  Symmetric6d M;  // one formula for the packed and the dense form
+  detail::Symmetric6d M;  // one formula for the packed and the dense form
   M.setZero();
   M.addRigidBody(m, c, I_c);
   return M.toDense();
@@ -54,6 +56,9 @@ bool allFinite(const KDL::Frame& f) {
   }
   return true;
 }
+
+bool allFinite(const KDL::Vector& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+bool allFinite(const KDL::Twist& t) { return allFinite(t.vel) && allFinite(t.rot); }
 
 Matrix3d toEigen(const KDL::Rotation& R) {
   Matrix3d M;

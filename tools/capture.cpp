@@ -22,7 +22,7 @@ std::unique_ptr<FreeFloatingSolver> computed(const std::string& file, const std:
 std::unique_ptr<FloatingSide> side(FreeFloatingSolver& solver, const std::string& file, const ScenarioSystem& s,
                                    const std::string& who) {
   try {
-    return std::make_unique<FloatingSide>(solver, s.contact, s.velocity, s.response);
+    return std::make_unique<FloatingSide>(solver.sharedModel(), s.state, s.contact, s.velocity, s.response);
   } catch (const ModelError& e) {
     throw InputError(file + ": " + who + ": " + e.what());
   }

@@ -1,5 +1,5 @@
 // The whole of both systems before and after an impact: the impulse from impact.hpp applied to
-// a free-floating robot (FreeFloatingSolver) and to what it hits (a rigid body or another
+// a free-floating robot (FloatingSide) and to what it hits (a rigid body or another
 // free-floating robot), with momentum and energy accounting.
 #pragma once
 
@@ -7,16 +7,13 @@
 
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/impact.hpp"
+#include "kdl_space/kinematics.hpp"
+#include "kdl_space/momentum.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
+#include "kdl_space/response.hpp"
+#include "kdl_space/state.hpp"
 
 namespace kdl_space {
-
-/// Velocity of a free-floating system: base twist (linear velocity of the base frame's origin,
-/// angular velocity; world frame) and joint rates (model order).
-struct FloatingVelocity {
-  KDL::Twist base_twist = KDL::Twist::Zero();
-  KDL::JntArray qdot;
-};
 
 /// A free rigid body (the target): everything in the world frame.
 struct RigidBody {
@@ -55,29 +52,54 @@ enum class ExIITMethod {
   Dense,      ///< the paper's J* H*^-1 J*^T + R_h M_a^-1 R_h^T with a factorised H* (eq. 11)
 };
 
+/// A free-floating system at one instant, touching at one contact point: what a FloatingSide is
+/// built from (and one side of a CaptureProblem).
+struct FloatingSystem {
+  std::shared_ptr<const FloatingModel> model;
+  State state;                 ///< base pose and joint positions
+  FloatingVelocity velocity;   ///< base twist (of the base origin) and joint rates
+  Contact contact;             ///< where it touches
+  Response response = Response::FreeFloating;  ///< free, grounded or joints locked
+};
+
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
-/// The solver must have computed the state; the side keeps a reference to it (and uses it in
-/// applyImpulse), so the solver must stay at that state while the side is used (applyImpulse
-/// returns E_NOT_COMPUTED if a later compute() of the solver failed).
+///
+/// The side owns what it answers from: the model (shared), its state and velocity, and its own
+/// solvers and kinematics, computed once in the constructor; nothing a caller does later can
+/// make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
+/// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
+/// energy and twists by MomentumSolver; no n x n matrix is built. ExIITMethod::Dense uses the
+/// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
 class FloatingSide : public ImpactSide {
  public:
-  /// \throws ModelError (a set-up call) if the solver's compute() has not succeeded, the contact
-  /// is no body of the model or its offset is not finite, qdot has the wrong size, the velocity
-  /// is not finite, `response` is no enumerator, or the response is unavailable (grounded with a
-  /// singular H). The message starts with "FloatingSide: ".
-  /// `method` applies to the free-floating response (grounded and locked use their closed forms).
-  FloatingSide(FreeFloatingSolver& solver, const Contact& h, const FloatingVelocity& before,
-               Response response = Response::FreeFloating, ExIITMethod method = ExIITMethod::Recursive);
+  /// \throws ModelError (a set-up call) if the model is null, the state or velocity has the
+  /// wrong size or is not finite, the contact is no body of the model or its offset is not
+  /// finite, `response` or `method` is no enumerator, or the response is unavailable (grounded
+  /// with a singular H). The message starts with "FloatingSide: ".
+  FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
+               const FloatingVelocity& before, Response response = Response::FreeFloating,
+               ExIITMethod method = ExIITMethod::Recursive);
+  explicit FloatingSide(const FloatingSystem& system, ExIITMethod method = ExIITMethod::Recursive);
+  ~FloatingSide() override;
 
   const Matrix6d& G() const override { return G_; }
   const Vector6d& contactTwistBefore() const override { return t_before_; }
   Vector6d contactTwistAfter() const override { return t_after_; }
-  Vector6d momentumBefore() const override { return aboutOrigin(PL_before_); }
-  Vector6d momentumAfter() const override { return aboutOrigin(PL_after_); }
+  Vector6d momentumBefore() const override { return h_before_; }
+  Vector6d momentumAfter() const override { return h_after_; }
   double energyBefore() const override { return T_before_; }
   double energyAfter() const override { return T_after_; }
   int applyImpulse(const Vector6d& F) override;
 
+  const FloatingModel& model() const { return *model_; }
+  const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
+  const State& state() const { return kin_.state; }
+  /// The side's kinematics (world poses of every body at its state).
+  const Kinematics& kinematics() const { return kin_; }
+  const Contact& contact() const { return h_; }
+  Response response() const { return response_; }
+  /// World position of the contact point.
+  Vector3d contactPoint() const { return kin_.point(h_); }
   const FloatingVelocity& before() const { return before_; }
   /// The base twist and joint rates after the last applyImpulse (before it: equal to before()).
   const FloatingVelocity& after() const { return after_; }
@@ -86,18 +108,18 @@ class FloatingSide : public ImpactSide {
   const Vector6d& centroidTwistAfter() const { return v_g_after_; }
 
  private:
-  Vector6d aboutOrigin(const Vector6d& PL_g) const;
-  /// Contact twist (eq. 4) and locked CoM twist of a velocity; 0 or an Error code.
-  int contactAndCentroidTwists(const FloatingVelocity& v, const Vector6d& PL_g, Vector6d& t_h, Vector6d& v_g) const;
-  FreeFloatingSolver& solver_;
-  std::unique_ptr<RecursiveExIITSolver> recursive_;  ///< set for the recursive free-floating response
+  std::shared_ptr<const FloatingModel> model_;
+  Kinematics kin_;
+  MomentumSolver momentum_;
+  std::unique_ptr<RecursiveExIITSolver> recursive_;  ///< ExIITMethod::Recursive, free or grounded
+  std::unique_ptr<FreeFloatingSolver> dense_;        ///< ExIITMethod::Dense, free or grounded
   Contact h_;
   Response response_;
   Matrix6d G_;
-  Vector3d r_g_;  ///< system CoM at the side's state
   FloatingVelocity before_, after_;
-  Vector6d PL_before_, PL_after_, t_before_, t_after_, v_g_before_, v_g_after_;
+  Vector6d h_before_, h_after_, t_before_, t_after_, v_g_before_, v_g_after_;
   double T_before_ = 0.0, T_after_ = 0.0;
+  Vector6d d_base_ = Vector6d::Zero();  ///< workspace
   KDL::JntArray dqdot_;      ///< workspace
   FloatingVelocity trial_;   ///< workspace: the state after, until it is known to be good
 };

@@ -48,4 +48,12 @@ class ModelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Thrown by the scenario loader and the capture set-up when an input (a file, a field, a
+/// value) cannot be used: the message names the file, the field (e.g. "target.mass") and what
+/// is wrong.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace kdl_space

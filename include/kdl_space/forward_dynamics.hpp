@@ -8,7 +8,6 @@
 #include <memory>
 #include <vector>
 
-#include "kdl_space/collision.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 
 namespace kdl_space {

@@ -9,28 +9,23 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
+#include "kdl_space/response.hpp"
 #include "kdl_space/spatial.hpp"
 #include "kdl_space/state.hpp"
 
 namespace kdl_space {
-
-/// How the robot answers an impulse at a contact point: the paper's three cases, as options of
-/// one solver rather than separate code paths.
-enum class Response {
-  FreeFloating,  ///< base free: G* (eq. 11), the general case
-  Grounded,      ///< base held still: G = J H^-1 J^T (eq. 22/23)
-  JointsLocked,  ///< joints braked: one rigid body, R_h M_a^-1 R_h^T (eq. 20/21)
-};
 
 /// \brief Computes, for one state of a FloatingModel, the centroid terms (w, r_g, I_g, M_a,
 /// A_m), the fixed-base H and the generalized inertia H* (eq. 7), and at any contact point the
 /// fixed-base J, the generalized Jacobian J* (eq. 4), the Ex-IIT G* (eq. 11), the grounded
 /// G = J H^-1 J^T (eq. 22) and the locked R_h M_a^-1 R_h^T (eq. 20).
 ///
-/// Usage: `compute(state)` once per state (forward kinematics and a composite-rigid-body pass
-/// over the KDL tree, factorisation of H* and H), then any number of contact queries, which
-/// read the result of the last successful `compute`. Every vector and matrix is in the world
+/// Usage: `compute(kin)` once per state (a composite-rigid-body pass over the kinematics of
+/// forwardKinematics, factorisation of H* and H; `compute(state)` runs forwardKinematics into the
+/// solver's own Kinematics first), then any number of contact queries, which read the result of
+/// the last successful `compute` (the solver keeps what they need: no reference to `kin`). Every vector and matrix is in the world
 /// frame; twists are (v; w), wrenches (f; n). Compute calls never throw: they return 0 or an
 /// Error code (errors.hpp) and leave their outputs untouched on an error. Every query returns
 /// E_NOT_COMPUTED before a successful compute(); a contact query returns E_BAD_CONTACT for a
@@ -48,11 +43,14 @@ class FreeFloatingSolver {
   const FloatingModel& model() const { return *model_; }
   const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
 
-  /// \brief Forward kinematics, centroid terms, H, A_m, H*; factorises H* and H.
-  /// \return E_NOERROR, E_SIZE_MISMATCH (q), E_NOT_FINITE (q or the base pose, or a base pose so
-  /// far away that the centroid terms overflow), or E_NOT_POSITIVE_DEFINITE if H* is not. On any
-  /// error the previous result is discarded: every query returns E_NOT_COMPUTED until the next
-  /// successful compute().
+  /// \brief Centroid terms, H, A_m, H* at the state of `kin`; factorises H* and H.
+  /// \return E_NOERROR, E_SIZE_MISMATCH (kin of another model), E_NOT_COMPUTED (kin not valid),
+  /// E_NOT_FINITE (a state so far away that the centroid terms overflow), or
+  /// E_NOT_POSITIVE_DEFINITE if H* is not. On any error the previous result is discarded: every
+  /// query returns E_NOT_COMPUTED until the next successful compute().
+  int compute(const Kinematics& kin);
+  /// The same from a state: forwardKinematics into the solver's own Kinematics, then compute.
+  /// \return also E_SIZE_MISMATCH (q) and E_NOT_FINITE (q or the base pose).
   int compute(const State& state);
 
   // --- Results of the last compute() (world frame) ------------------------------------------
@@ -141,6 +139,7 @@ class FreeFloatingSolver {
   void M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const;
 
   std::shared_ptr<const FloatingModel> model_;
+  Kinematics own_;  ///< for compute(State) only
   bool computed_ = false;
   bool H_ok_ = false;
   KDL::Frame world_T_base_;

@@ -7,10 +7,14 @@
 #include <kdl/chain.hpp>
 #include <kdl/rigidbodyinertia.hpp>
 #include <kdl/tree.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace kdl_space {
+namespace detail {
+struct MotionTable;  // src/detail/joint_motion.hpp
+}
 
 /// A problem that does not stop the computation (a massless link, a root inertia kdl_parser
 /// would have dropped, a dropped floating joint). The library never prints: callers read these.
@@ -73,6 +77,8 @@ class FloatingModel {
   const KDL::Tree& tree() const { return tree_; }
   /// Total mass w [kg].
   double totalMass() const { return total_mass_; }
+  /// Each body's joint motion, precomputed for forward kinematics (library internal).
+  const detail::MotionTable& motions() const { return *motions_; }
 
   /// Index of the joint named `name`, or -1.
   int jointIndex(const std::string& name) const;
@@ -101,6 +107,7 @@ class FloatingModel {
   std::vector<double> armature_;
   std::vector<Diagnostic> diagnostics_;
   double total_mass_ = 0.0;
+  std::shared_ptr<const detail::MotionTable> motions_;  ///< immutable: shared by copies
 };
 
 }  // namespace kdl_space

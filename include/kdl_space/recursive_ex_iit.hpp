@@ -8,19 +8,24 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/spatial.hpp"
 #include "kdl_space/state.hpp"
 
 namespace kdl_space {
+namespace detail {
+struct Symmetric6d;  // src/detail/symmetric6d.hpp: a packed symmetric 6x6
+}
 
 /// \brief G* at one contact point and the velocity jump of the whole robot from an impulse there,
 /// in O(n) per state (plus O(depth of the contact) per contact), allocation-free after
 /// construction.
 ///
-/// `compute(state)`: forward kinematics and one backward pass of articulated-body inertias
+/// `compute(kin)`: one backward pass of articulated-body inertias
 /// I^A_i = I_i + sum over children (I^A_c - U_c D_c^-1 U_c^T), U = I^A S, D = S^T U (+ armature),
-/// all in world axes about the base frame's origin (packed symmetric, Symmetric6d), and
+/// all in world axes about the base frame's origin (packed symmetric 6x6), and
 /// Omega_0 = (I^A_0)^-1 by a root-free Cholesky factorisation.
 /// `G_star(h)`: the inverse inertia a wrench on body i meets, outward along the path from the
 /// base to h's body: from Omega_0, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T,
@@ -32,55 +37,58 @@ namespace kdl_space {
 class RecursiveExIITSolver {
  public:
   explicit RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model);
+  ~RecursiveExIITSolver();
+  RecursiveExIITSolver(const RecursiveExIITSolver&);
+  RecursiveExIITSolver& operator=(const RecursiveExIITSolver&);
   const FloatingModel& model() const { return *model_; }
 
-  /// Forward kinematics and articulated-body inertias. \return 0, E_SIZE_MISMATCH, E_NOT_FINITE
-  /// or E_NOT_POSITIVE_DEFINITE.
+  /// \brief Articulated-body inertias at the state of `kin` (forwardKinematics of this model).
+  /// Keeps what its queries need; no reference to `kin`.
+  /// \return 0, E_SIZE_MISMATCH (kin of another model), E_NOT_COMPUTED (kin not valid) or
+  /// E_NOT_POSITIVE_DEFINITE.
+  int compute(const Kinematics& kin);
+  /// The same from a state: forwardKinematics into the solver's own Kinematics, then compute.
+  /// \return also E_NOT_FINITE for a non-finite state.
   int compute(const State& state);
   /// Ex-IIT G* at h (world frame, twist per impulse), eq. 11.
+  /// \return 0, E_NOT_COMPUTED, E_BAD_CONTACT (no such body), E_NOT_FINITE (offset, result).
   int G_star(const Contact& h, Matrix6d& G);
+  /// \brief G at h for a response: FreeFloating is G* (eq. 11); Grounded is G = J H^-1 J^T
+  /// (eq. 22) by the same recursion from a base of infinite inertia (Omega_0 = 0; singular where J
+  /// is). JointsLocked is not this solver's (it needs no recursion: see MomentumSolver).
+  /// \return as G_star, and E_BAD_ARGUMENT for JointsLocked or a value that is no enumerator.
+  int G(const Contact& h, Response response, Matrix6d& G);
   /// \brief Velocity jump from an impulse wrench F on the robot at h (world frame): the change of
   /// the base twist (linear velocity of the base origin; angular velocity) and of the joint
-  /// rates, M_full^-1 J_full^T F by one articulated-body pass.
+  /// rates, M_full^-1 J_full^T F by one articulated-body pass (eq. 18). Grounded: the base does
+  /// not move (eq. 23). \return 0, E_NOT_COMPUTED, E_BAD_CONTACT, E_SIZE_MISMATCH (dqdot),
+  /// E_NOT_FINITE (F, offset, result), E_BAD_ARGUMENT (JointsLocked, no enumerator).
   int velocityJump(const Contact& h, const Vector6d& F, Vector6d& d_base_twist, KDL::JntArray& dqdot);
-  /// World pose of body i after compute().
+  int velocityJump(const Contact& h, Response response, const Vector6d& F, Vector6d& d_base_twist,
+                   KDL::JntArray& dqdot);
+  /// World pose of body i at the state of the last compute().
   KDL::Frame bodyPose(int i) const;
 
  private:
+  /// 0, or the code of a contact query that cannot be answered.
+  int ready(const Contact& h) const;
   /// Marks the bodies from h.body to the base in path_ (root last); returns the count.
   int walkPath(const Contact& h);
 
   std::shared_ptr<const FloatingModel> model_;
+  Kinematics own_;                                 ///< for compute(State) only
   bool computed_ = false;
   Vector3d p_b_ = Vector3d::Zero();                ///< base origin: the common reference point
-  /// What compute() reads of one body, copied from the model once and packed together.
-  /// Its joint's motion, from KDL's segment: pose(q) = screw(q) * pose(0), the screw about the
-  /// joint's axis (revolute: rotation by scale q about the line through `point`; prismatic:
-  /// translation by scale q), so that compute() needs no KDL call per body.
-  /// Revolute, by Rodrigues' formula Rot(a, t) = E + sin t a^ + (1 - cos t) a^ a^ folded into
-  /// pose(0): pose(q) = (R0 + s K1 + (1 - c) K2, p0 + s k1 + (1 - c) k2), t = scale q.
-  struct LocalBody {
-    int parent = -1, joint = -1;  ///< as Body
-    int kind = 0;  ///< 0 fixed, 1 revolute, 2 prismatic
-    Vector3d axis = Vector3d::UnitZ();  ///< parent frame
-    double scale = 1.0;
-    Matrix3d R0 = Matrix3d::Identity(), K1 = Matrix3d::Zero(), K2 = Matrix3d::Zero();  ///< parent frame
-    Vector3d p0 = Vector3d::Zero(), k1 = Vector3d::Zero(), k2 = Vector3d::Zero();
-    Vector3d twist_v = Vector3d::Zero(), twist_w = Vector3d::Zero();  ///< Body::joint_twist
-    double mass = 0.0, armature = 0.0;
-    Vector3d com = Vector3d::Zero();
-    Matrix3d I_com = Matrix3d::Zero();
-  };
-  std::vector<LocalBody> local_;        ///< per body
-  std::vector<Matrix3d> R_;             ///< per body: world rotation
-  std::vector<Vector3d> p_;             ///< per body: world position of the frame origin
+  std::vector<Matrix3d> R_;                        ///< per body: world rotation (copied from kin)
+  std::vector<Vector3d> p_;                        ///< per body: world position of the frame origin
   std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
-  std::vector<Symmetric6d> IA_;                    ///< per body: articulated inertia at p_b
+  std::vector<detail::Symmetric6d> IA_;            ///< per body: articulated inertia at p_b
   std::vector<Vector6d> U_;                        ///< per body: I^A S
   std::vector<double> D_;                          ///< per body: S^T I^A S + armature
-  Symmetric6d Omega0_;                             ///< (I^A_0)^-1
+  Matrix6d Omega0_ = Matrix6d::Zero();            ///< (I^A_0)^-1
   std::vector<int> path_;                          ///< scratch: contact path
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
+  Eigen::VectorXd dq_;                             ///< scratch: joint-rate jumps (n)
   std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse)
 };
 

@@ -1,4 +1,5 @@
-// The configuration of a free-floating system: base pose in the world and joint positions.
+// The state of a free-floating system: its configuration (base pose in the world, joint
+// positions) and its velocity (base twist, joint rates).
 #pragma once
 
 #include <kdl/frames.hpp>
@@ -18,6 +19,18 @@ struct State {
   State() = default;
   /// Identity base pose, all joints at 0.
   explicit State(const FloatingModel& model) : q(model.nj()) {}
+};
+
+/// Velocity of a free-floating system: base twist (linear velocity of the base frame's origin,
+/// angular velocity; world frame) and joint rates (model order).
+struct FloatingVelocity {
+  KDL::Twist base_twist = KDL::Twist::Zero();
+  KDL::JntArray qdot;
+
+  FloatingVelocity() = default;
+  /// Base at rest, all joint rates 0.
+  explicit FloatingVelocity(const FloatingModel& model) : qdot(model.nj()) {}
+  FloatingVelocity(const KDL::Twist& base_twist_, const KDL::JntArray& qdot_) : base_twist(base_twist_), qdot(qdot_) {}
 };
 
 /// Base pose in URDF convention: position, then roll-pitch-yaw about fixed axes

@@ -7,6 +7,7 @@
 #include <memory>
 #include <set>
 
+#include "kdl_space/collision.hpp"
 #include "kdl_space/simulation.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"
@@ -521,7 +522,7 @@ TEST_F(SideCodes, ApplyImpulseRefusesNonFiniteAndOverflowingImpulses) {
     for (ExIITMethod method : {ExIITMethod::Recursive, ExIITMethod::Dense}) {
       SCOPED_TRACE("response " + std::to_string(static_cast<int>(response)) + ", method " +
                    std::to_string(static_cast<int>(method)));
-      FloatingSide robot(solver, tip, velocity, response, method);
+      FloatingSide robot(solver.sharedModel(), solver.state(), tip, velocity, response, method);
       ASSERT_EQ(robot.applyImpulse(Vector6d::Constant(0.1)), E_NOERROR);
       const AfterState good(robot);
       Vector6d F = Vector6d::Zero();
@@ -542,16 +543,25 @@ TEST_F(SideCodes, ApplyImpulseRefusesNonFiniteAndOverflowingImpulses) {
   EXPECT_EQ(target.twistAfter(), good);
 }
 
-TEST_F(SideCodes, ASideWhoseSolverLostItsStateRefuses) {
+TEST_F(SideCodes, ASideCannotGoStaleBehindItsCaller) {
+  // The side owns its state and solvers: a caller's solver computing another state (or failing
+  // to) changes nothing of the side's G*, velocity jump, momentum or energy.
   for (ExIITMethod method : {ExIITMethod::Recursive, ExIITMethod::Dense}) {
     ASSERT_EQ(solver.compute(state), E_NOERROR);
-    FloatingSide robot(solver, tip, velocity, Response::FreeFloating, method);
-    const AfterState before(robot);
+    FloatingSide robot(solver.sharedModel(), solver.state(), tip, velocity, Response::FreeFloating, method);
+    FloatingSide reference(model, state, tip, velocity, Response::FreeFloating, method);
+    State other = state;
+    other.q(0) += 0.7;
+    ASSERT_EQ(solver.compute(other), E_NOERROR);
     State bad = state;
     bad.q(0) = kNaN;
     ASSERT_EQ(solver.compute(bad), E_NOT_FINITE);
-    EXPECT_NO_THROW(EXPECT_EQ(robot.applyImpulse(Vector6d::Ones()), E_NOT_COMPUTED));
-    EXPECT_TRUE(AfterState(robot) == before);
+    EXPECT_EQ(robot.G(), reference.G());
+    ASSERT_EQ(robot.applyImpulse(Vector6d::Ones()), E_NOERROR);
+    ASSERT_EQ(reference.applyImpulse(Vector6d::Ones()), E_NOERROR);
+    EXPECT_TRUE(AfterState(robot) == AfterState(reference));
+    EXPECT_EQ(robot.momentumAfter(), reference.momentumAfter());
+    EXPECT_EQ(robot.energyAfter(), reference.energyAfter());
   }
 }
 
@@ -570,19 +580,23 @@ void expectModelError(Build build, const std::string& prefix, const std::string&
 
 TEST_F(SideCodes, SideConstructorsThrowModelErrorNamingTheProblem) {
   FloatingVelocity short_rates{KDL::Twist::Zero(), KDL::JntArray(2)};
-  expectModelError([&] { FloatingSide(solver, tip, short_rates); }, "FloatingSide: ",
+  expectModelError([&] { FloatingSide(solver.sharedModel(), solver.state(), tip, short_rates); }, "FloatingSide: ",
                    "2 joint rates given for the model's 7 joints");
   FloatingVelocity nan_twist = velocity;
   nan_twist.base_twist.vel.y(kNaN);
-  expectModelError([&] { FloatingSide(solver, tip, nan_twist); }, "FloatingSide: ", "NaN or infinite");
-  expectModelError([&] { FloatingSide(solver, Contact{99, KDL::Vector::Zero()}, velocity); }, "FloatingSide: ",
+  expectModelError([&] { FloatingSide(solver.sharedModel(), solver.state(), tip, nan_twist); }, "FloatingSide: ", "NaN or infinite");
+  expectModelError([&] { FloatingSide(solver.sharedModel(), solver.state(), Contact{99, KDL::Vector::Zero()}, velocity); }, "FloatingSide: ",
                    strError(E_BAD_CONTACT));
-  expectModelError([&] { FloatingSide(solver, Contact{tip.body, KDL::Vector(0, kNaN, 0)}, velocity); },
+  expectModelError([&] { FloatingSide(solver.sharedModel(), solver.state(), Contact{tip.body, KDL::Vector(0, kNaN, 0)}, velocity); },
                    "FloatingSide: ", strError(E_NOT_FINITE));
-  expectModelError([&] { FloatingSide(solver, tip, velocity, static_cast<Response>(3)); }, "FloatingSide: ",
+  expectModelError([&] { FloatingSide(solver.sharedModel(), solver.state(), tip, velocity, static_cast<Response>(3)); }, "FloatingSide: ",
                    "not one of FreeFloating, Grounded, JointsLocked");
-  FreeFloatingSolver fresh(model);
-  expectModelError([&] { FloatingSide(fresh, tip, velocity); }, "FloatingSide: ", strError(E_NOT_COMPUTED));
+  State nan_state = solver.state();
+  nan_state.q(2) = kNaN;
+  expectModelError([&] { FloatingSide(model, nan_state, tip, velocity); }, "FloatingSide: the state", strError(E_NOT_FINITE));
+  expectModelError([&] { FloatingSide(nullptr, solver.state(), tip, velocity); }, "FloatingSide: ", "null model");
+  expectModelError([&] { FloatingSide(model, solver.state(), tip, velocity, Response::FreeFloating, static_cast<ExIITMethod>(5)); },
+                   "FloatingSide: ", "not one of Recursive, Dense");
 
   RigidBody light = box;
   light.mass = 0.0;
@@ -616,7 +630,7 @@ class RefusingSide : public ImpactSide {
 };
 
 TEST_F(SideCodes, CollideReportsWhichPartRefusedAndKeepsNothing) {
-  FloatingSide robot(solver, tip, velocity);
+  FloatingSide robot(solver.sharedModel(), solver.state(), tip, velocity);
   RigidBodySide target(box, p_h);
   const AfterState robot_before(robot);
   const Vector6d target_before = target.twistAfter();

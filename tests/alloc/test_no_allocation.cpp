@@ -19,7 +19,7 @@
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
 #include "kdl_space/urdf_loader.hpp"
-#include "../benchmarks/generated_chain.hpp"
+#include "generated_chain.hpp"
 #include "test_util.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -172,9 +172,9 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   const RigidBody box{50.0, Matrix3d::Identity() * 2.0, Vector3d(1.0, 0.5, 0.2), Vector6d::Constant(0.01)};
   Vector3d p_h;
   solver.contactPoint(h, p_h);
-  FloatingSide robot(solver, h, v);
-  FloatingSide robot_dense(solver, h, v, Response::FreeFloating, ExIITMethod::Dense);
-  FloatingSide robot_grounded(solver, h, v, Response::Grounded);
+  FloatingSide robot(solver.sharedModel(), solver.state(), h, v);
+  FloatingSide robot_dense(solver.sharedModel(), solver.state(), h, v, Response::FreeFloating, ExIITMethod::Dense);
+  FloatingSide robot_grounded(solver.sharedModel(), solver.state(), h, v, Response::Grounded);
   RigidBodySide target(box, p_h);
   const Matrix6d G_B = target.G();
 

@@ -13,6 +13,7 @@
 #include <memory>
 #include <random>
 
+#include "kdl_space/collision.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"

@@ -535,7 +535,7 @@ TEST(Capture, CapturedTargetStaysAttached) {
   target.com = p_h + Vector3d(0.2, -0.4, 0.4);
   target.twist << 0.3, -0.1, 0.2, 0.05, -0.08, 0.1;
 
-  FloatingSide robot(solver, hand, s.velocity);
+  FloatingSide robot(solver.sharedModel(), solver.state(), hand, s.velocity);
   RigidBodySide body(target, p_h);
   collideOk(robot, body, ImpactLaw{ImpactKind::Capture});
   const Vector6d h_pre = robot.momentumBefore() + body.momentumBefore();

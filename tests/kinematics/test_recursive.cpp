@@ -39,6 +39,8 @@
 
 #include <kdl/rigidbodyinertia.hpp>
 
+#include "detail/symmetric6d.hpp"
+#include "kdl_space/collision.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/urdf_loader.hpp"
@@ -413,7 +415,7 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     for (int k = 0; k < 6; ++k) u(k) = U(rng), v(k) = U(rng), x(k) = U(rng);
     const double alpha = U(rng);
 
-    Symmetric6d S;
+    detail::Symmetric6d S;
     S.setZero();
     S.addRigidBody(m, c, I_c);
     // Independently: KDL's rigid-body inertia about the reference point, [m E, -m c^; m c^, I_o].
@@ -428,7 +430,7 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     EXPECT_LT((S * x - D * x).norm(), 1e-14 * D.norm() * x.norm()) << "product";
     S += S;
     D += D;
-    Symmetric6d other;  // another rigid body
+    detail::Symmetric6d other;  // another rigid body
     other.setZero();
     other.addRigidBody(m, v.head<3>(), I_c);
     D += other.toDense() - alpha * u * u.transpose();
@@ -438,7 +440,7 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
       for (int k = 0; k < 6; ++k) EXPECT_EQ(S(r, k), S(k, r));
 
     // The inverse of a rigid body's inertia (positive definite), and of one made indefinite.
-    Symmetric6d P, P_inv;
+    detail::Symmetric6d P, P_inv;
     P.setZero();
     P.addRigidBody(m, c, I_c);
     const Matrix6d P_dense = P.toDense();
@@ -448,15 +450,15 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     EXPECT_LT((P_inv.toDense() - expected).norm(), 1e-12 * expected.norm()) << "invert";
     EXPECT_LT((P_dense * P_inv.toDense() - Matrix6d::Identity()).norm(), 1e-12 * P_dense.norm() * expected.norm());
     const Vector6d e = Vector6d::Unit(trial % 6);
-    Symmetric6d zero;
+    detail::Symmetric6d zero;
     zero.setZero();
     P.addMinusRank1(zero, e, 2.0 / expected(trial % 6, trial % 6));  // e^T P^-1 e = 1/(that): crosses zero
     EXPECT_FALSE(P.invert(P_inv)) << "not positive definite";
   }
-  Symmetric6d nan, out;
+  detail::Symmetric6d nan, out;
   nan.setZero();
   nan.addRigidBody(1.0, Vector3d::Zero(), Matrix3d::Identity());
-  nan.a[Symmetric6d::index(4, 2)] = std::nan("");
+  nan.a[detail::Symmetric6d::index(4, 2)] = std::nan("");
   EXPECT_FALSE(nan.invert(out));
 }
 

@@ -46,7 +46,7 @@ class CollisionReference : public ::testing::TestWithParam<std::string> {};
 TEST_P(CollisionReference, Capture) {
   Scene s(GetParam());
   const nlohmann::json& e = s.c.json.at("capture");
-  FloatingSide robot(s.solver, s.c.contact, {s.c.base_twist, s.c.qdot});
+  FloatingSide robot(s.solver.sharedModel(), s.solver.state(), s.c.contact, {s.c.base_twist, s.c.qdot});
   RigidBodySide body(s.target, s.p_h);
   EXPECT_TRUE(near(robot.contactTwistBefore(), ReferenceCase::mat(e.at("contact_twist_before")), kRel, kAbs, "contact_twist_before"));
   const Impulse impulse = collideOk(robot, body, ImpactLaw{ImpactKind::Capture});
@@ -61,7 +61,7 @@ TEST_P(CollisionReference, Capture) {
 TEST_P(CollisionReference, PointImpact) {
   Scene s(GetParam());
   const nlohmann::json& e = s.c.json.at("point_impact");
-  FloatingSide robot(s.solver, s.c.contact, {s.c.base_twist, s.c.qdot});
+  FloatingSide robot(s.solver.sharedModel(), s.solver.state(), s.c.contact, {s.c.base_twist, s.c.qdot});
   RigidBodySide body(s.target, s.p_h);
   ImpactLaw law{ImpactKind::PointImpact, ReferenceCase::mat(e.at("normal")), e.at("restitution").get<double>()};
   const Impulse impulse = collideOk(robot, body, law);

@@ -35,6 +35,7 @@
 #include <memory>
 #include <random>
 
+#include "kdl_space/collision.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"

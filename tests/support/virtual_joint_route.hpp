@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "kdl_space/collision.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/state.hpp"
 

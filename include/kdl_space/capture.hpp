@@ -1,0 +1,84 @@
+// The capture as one library call: a capture problem (the robot at one instant, what it meets,
+// the impact law) -> a capture result (the impulse and everything before and after, the
+// numbers `kdl_space capture --json` prints), and the model that moves on after a rigid capture.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <variant>
+
+#include "kdl_space/collision.hpp"
+
+namespace kdl_space {
+
+/// \brief A rigid target in the terms of a scenario file: its inertia about the CoM in its own
+/// frame, the pose of that frame in the world, the CoM in that frame, the twist at the CoM in the
+/// world frame. RigidBody is the same body with everything in the world frame (toWorld()).
+struct RigidTarget {
+  double mass = 0.0;                             ///< [kg]
+  Matrix3d inertia = Matrix3d::Identity();       ///< about the CoM, target-frame axes [kg m^2]
+  KDL::Frame pose = KDL::Frame::Identity();      ///< target frame in the world
+  Vector3d com = Vector3d::Zero();               ///< CoM in the target frame [m]
+  Vector6d twist = Vector6d::Zero();             ///< (v of the CoM; w), world frame
+
+  /// The same body in world terms (inertia rotated to world axes, CoM in the world).
+  RigidBody toWorld() const;
+};
+
+/// What the robot meets: a rigid body, or another free-floating system (whose contact point must
+/// coincide with the robot's within `CaptureProblem::touch_tolerance`).
+using CaptureTarget = std::variant<RigidTarget, FloatingSystem>;
+
+/// A capture (or any impact) to solve.
+struct CaptureProblem {
+  FloatingSystem robot;
+  CaptureTarget target;
+  ImpactLaw law;
+  /// Whether the law's normal is meaningful (point impacts; optional for captures): the virtual
+  /// mass along it is reported.
+  bool has_normal = false;
+  /// How the free-floating G* and velocity jumps are computed (the O(n) recursion by default: no
+  /// n x n matrix is built).
+  ExIITMethod method = ExIITMethod::Recursive;
+  double touch_tolerance = 1e-3;  ///< [m], robot-to-robot contact
+};
+
+/// One free-floating side of a solved impact.
+struct FloatingSideResult {
+  FloatingVelocity before, after;               ///< base twist and joint rates
+  Vector6d contact_twist_before = Vector6d::Zero(), contact_twist_after = Vector6d::Zero();
+  /// Locked twist at the system's CoM: (v_g; w_g) = M_a^-1 (P_g; L_g).
+  Vector6d centroid_twist_before = Vector6d::Zero(), centroid_twist_after = Vector6d::Zero();
+};
+
+/// Everything about a solved impact (world frame; momentum angular part about the world origin).
+struct CaptureResult {
+  Impulse impulse;                              ///< on the robot at the contact point
+  Vector3d contact_point = Vector3d::Zero();    ///< the robot's contact point in the world
+  FloatingSideResult robot;
+  /// The target's twist at its CoM (a free-floating target: its locked twist at its CoM).
+  Vector6d target_twist_before = Vector6d::Zero(), target_twist_after = Vector6d::Zero();
+  std::optional<FloatingSideResult> floating_target;  ///< set for a free-floating target
+  Matrix6d G_robot = Matrix6d::Zero();          ///< the robot's G for its response (G*, G, locked G)
+  Matrix6d G_target = Matrix6d::Zero();         ///< the target's (G_B, or its G*)
+  Vector6d momentum_before = Vector6d::Zero(), momentum_after = Vector6d::Zero();  ///< both sides
+  double energy_before = 0.0, energy_after = 0.0;  ///< both sides [J]
+  double energyLost() const { return energy_before - energy_after; }
+  /// 1 / (n^T G_vv n) of the robot along the law's normal; empty without a normal, or where the
+  /// robot cannot move its contact point along it (infinite).
+  std::optional<double> virtual_mass;
+  /// World pose of the robot's contact body at the impact (where a captured target is attached).
+  KDL::Frame contact_body_pose = KDL::Frame::Identity();
+};
+
+/// \brief Solves the capture problem: both sides at their states, the impulse from the law,
+/// everything after. A set-up call: \throws InputError with a message that starts with the part
+/// concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
+CaptureResult solveCapture(const CaptureProblem& problem);
+
+/// \brief The robot's model after a rigid capture of a rigid target: the target merged into the
+/// robot's contact link (its inertia in that link's frame at the impact). \throws InputError
+/// ("target: ...") if it cannot be attached.
+std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
+
+}  // namespace kdl_space

@@ -1,0 +1,19 @@
+// Small text helpers of the library's messages, written once.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace kdl_space::detail {
+
+/// 'name', as every message quotes a link, joint or file.
+inline std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+/// "a, b, c" of names, for messages that list what a model has ("none" for an empty list).
+inline std::string listNames(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list.empty() ? "none" : list;
+}
+
+}  // namespace kdl_space::detail

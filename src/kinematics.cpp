@@ -1,0 +1,76 @@
+#include "kdl_space/kinematics.hpp"
+
+#include <cmath>
+
+#include "detail/joint_motion.hpp"
+#include "detail/multiversion.hpp"
+
+namespace kdl_space {
+
+Kinematics::Kinematics(const FloatingModel& m)
+    : model(&m),
+      state(m),
+      R(m.bodies().size(), Matrix3d::Identity()),
+      p(m.bodies().size(), Vector3d::Zero()),
+      S(m.bodies().size(), Vector6d::Zero()),
+      com(m.bodies().size(), Vector3d::Zero()),
+      I_com(m.bodies().size(), Matrix3d::Zero()) {}
+
+KDL::Frame Kinematics::pose(int i) const {
+  KDL::Rotation M;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) M(r, c) = R[i](r, c);
+  return KDL::Frame(M, toKDL(p[i]));
+}
+
+KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const State& state, Kinematics& kin) {
+  kin.valid = false;
+  const std::vector<detail::JointMotion>& bodies = model.motions().bodies;
+  const std::size_t nb = bodies.size();
+  if (kin.model != &model || kin.R.size() != nb || kin.state.q.rows() != model.nj()) return E_SIZE_MISMATCH;
+  if (state.q.rows() != model.nj()) return E_SIZE_MISMATCH;
+  if (!state.q.data.allFinite() || !allFinite(state.world_T_base)) return E_NOT_FINITE;
+  const Vector3d p_b = toEigen(state.world_T_base.p);
+  kin.R[0] = toEigen(state.world_T_base.M);
+  kin.p[0] = p_b;
+  Vector3d first_moment = Vector3d::Zero();
+  // Parents first. Each result is built in registers and stored once (a store read back in
+  // pieces stalls).
+  for (std::size_t i = 0; i < nb; ++i) {
+    const detail::JointMotion& j = bodies[i];
+    if (j.parent >= 0) {
+      const Matrix3d& R_parent = kin.R[j.parent];
+      const Vector3d& p_parent = kin.p[j.parent];
+      if (j.kind == detail::JointMotion::Revolute) {  // rotation about the joint's axis line, then pose(0)
+        const double t = j.scale * state.q.data(j.joint), s = std::sin(t), c1 = 1.0 - std::cos(t);
+        kin.R[i].noalias() = R_parent * (j.R0 + s * j.K1 + c1 * j.K2);
+        kin.p[i] = p_parent + R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
+      } else {
+        kin.R[i].noalias() = R_parent * j.R0;
+        kin.p[i] = p_parent + R_parent * (j.kind == detail::JointMotion::Prismatic
+                                              ? Vector3d(j.p0 + j.scale * state.q.data(j.joint) * j.axis)
+                                              : j.p0);
+      }
+      if (j.joint >= 0) {
+        // The joint's unit twist, rotated to world axes and moved from the parent's origin to p_b.
+        const Vector3d w = R_parent * j.twist_w;
+        const Vector3d v = R_parent * j.twist_v + w.cross(p_b - p_parent);
+        kin.S[i] << v, w;
+      }
+    }
+    const Matrix3d& R = kin.R[i];
+    kin.com[i] = R * j.com + kin.p[i];
+    kin.I_com[i].noalias() = R * j.I_com * R.transpose();
+    first_moment += j.mass * kin.com[i];
+  }
+  kin.p_b = p_b;
+  kin.r_g = first_moment / model.totalMass();
+  // Finite inputs of absurd magnitude (a base 1e300 m away) overflow: refuse.
+  if (!kin.r_g.allFinite() || !kin.p.back().allFinite()) return E_NOT_FINITE;
+  kin.state.world_T_base = state.world_T_base;
+  kin.state.q.data = state.q.data;
+  kin.valid = true;
+  return E_NOERROR;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,122 @@
+#include "kdl_space/momentum.hpp"
+
+#include <Eigen/Cholesky>
+
+namespace kdl_space {
+
+MomentumSolver::MomentumSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
+  if (!model_) throw ModelError("MomentumSolver: null model");
+  const std::size_t nb = model_->bodies().size();
+  V_.assign(nb, Vector6d::Zero());
+  R_.assign(nb, Matrix3d::Identity());
+  p_.assign(nb, Vector3d::Zero());
+}
+
+void MomentumSolver::sweep(const Kinematics& kin, const Vector6d& V_b, const Eigen::VectorXd& qdot, Vector6d& h_b,
+                           double& twoT) {
+  const std::vector<Body>& bodies = model_->bodies();
+  h_b.setZero();
+  twoT = 0.0;
+  I_tot_.setZero();
+  Vector3d first_moment = Vector3d::Zero();
+  Matrix3d I_b = Matrix3d::Zero();  // rotational inertia about p_b
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    if (b.parent < 0) V_[i] = V_b;
+    else V_[i] = b.joint >= 0 ? Vector6d(V_[b.parent] + kin.S[i] * qdot(b.joint)) : V_[b.parent];
+    if (!(b.mass > 0.0)) continue;  // a frame-only link
+    const Vector3d r = kin.com[i] - kin.p_b;
+    const Vector3d w = V_[i].tail<3>();
+    const Vector3d v_c = V_[i].head<3>() + w.cross(r);  // CoM velocity
+    const Vector3d P = b.mass * v_c;
+    const Vector3d Iw = kin.I_com[i] * w;
+    h_b.head<3>() += P;
+    h_b.tail<3>() += Iw + r.cross(P);  // about p_b
+    twoT += b.mass * v_c.squaredNorm() + w.dot(Iw);
+    first_moment += b.mass * r;
+    I_b += kin.I_com[i] + b.mass * (r.squaredNorm() * Matrix3d::Identity() - r * r.transpose());
+  }
+  // sum_i I_i about p_b (spatialInertia's blocks): [[w E, -skew(c)], [skew(c), I_b]], c = first moment
+  I_tot_.topLeftCorner<3, 3>() = model_->totalMass() * Matrix3d::Identity();
+  I_tot_.topRightCorner<3, 3>() = -skew(first_moment);
+  I_tot_.bottomLeftCorner<3, 3>() = skew(first_moment);
+  I_tot_.bottomRightCorner<3, 3>() = I_b;
+}
+
+int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
+  computed_ = false;
+  const std::size_t nb = model_->bodies().size();
+  if (kin.model != model_.get() || kin.R.size() != nb || v.qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!kin.valid) return E_NOT_COMPUTED;
+  if (!allFinite(v.base_twist) || !v.qdot.data.allFinite()) return E_NOT_FINITE;
+  Vector6d h_b;
+  double twoT = 0.0;
+  sweep(kin, toEigen(v.base_twist), v.qdot.data, h_b, twoT);
+  p_b_ = kin.p_b;
+  r_g_ = kin.r_g;
+  for (std::size_t i = 0; i < nb; ++i) {
+    R_[i] = kin.R[i];
+    p_[i] = kin.p[i];
+  }
+  // I_g = I_b - w skew(r)^T skew(r) with r = r_g - p_b (parallel axes, eq. 3)
+  const Vector3d r = r_g_ - p_b_;
+  I_g_ = I_tot_.bottomRightCorner<3, 3>() -
+         model_->totalMass() * (r.squaredNorm() * Matrix3d::Identity() - r * r.transpose());
+  PL_g_ = shiftMomentum(h_b, r);   // L_g = L_b - (r_g - p_b) x P
+  h_O_ = shiftMomentum(h_b, -p_b_);  // L_O = L_b + p_b x P
+  T_ = 0.5 * twoT;
+  const Eigen::LLT<Matrix3d> I_g_llt(I_g_);
+  if (I_g_llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  v_g_ << PL_g_.head<3>() / model_->totalMass(), I_g_llt.solve(Vector3d(PL_g_.tail<3>()));  // eq. 12
+  if (!h_O_.allFinite() || !v_g_.allFinite() || !std::isfinite(T_) || !I_g_.allFinite()) return E_NOT_FINITE;
+  computed_ = true;
+  return E_NOERROR;
+}
+
+int MomentumSolver::contactTwist(const Contact& h, Vector6d& t_h) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (h.body < 0 || h.body >= static_cast<int>(V_.size())) return E_BAD_CONTACT;
+  if (!allFinite(h.offset)) return E_NOT_FINITE;
+  const Vector6d t = shiftTwist(V_[h.body], R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_);
+  if (!t.allFinite()) return E_NOT_FINITE;
+  t_h = t;
+  return E_NOERROR;
+}
+
+int MomentumSolver::G_locked(const Contact& h, Matrix6d& G) const {
+  if (!computed_) return E_NOT_COMPUTED;
+  if (h.body < 0 || h.body >= static_cast<int>(V_.size())) return E_BAD_CONTACT;
+  if (!allFinite(h.offset)) return E_NOT_FINITE;
+  const Matrix6d R = transfer(R_[h.body] * toEigen(h.offset) + p_[h.body] - r_g_);  // R_h, eq. 5
+  Matrix6d X = R.transpose();
+  X.topRows<3>() /= model_->totalMass();
+  const Eigen::LLT<Matrix3d> I_g_llt(I_g_);
+  for (int c = 0; c < 6; ++c) X.col(c).tail<3>() = I_g_llt.solve(Vector3d(X.col(c).tail<3>()));
+  Matrix6d result;
+  result.noalias() = R * X;  // eq. 20
+  symmetrize(result);
+  if (!result.allFinite()) return E_NOT_FINITE;
+  G = result;
+  return E_NOERROR;
+}
+
+int MomentumSolver::baseTwist(const Kinematics& kin, const Vector6d& h_O, const KDL::JntArray& qdot,
+                              KDL::Twist& base_twist) {
+  if (kin.model != model_.get() || kin.R.size() != V_.size() || qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!kin.valid) return E_NOT_COMPUTED;
+  if (!h_O.allFinite() || !qdot.data.allFinite()) return E_NOT_FINITE;
+  // Momentum of the joint motion with the base still, and the locked inertia, about p_b; then
+  // I_tot V_b = h_b - h_q (eq. 2 about p_b).
+  Vector6d h_q;
+  double twoT = 0.0;
+  sweep(kin, Vector6d::Zero(), qdot.data, h_q, twoT);
+  computed_ = false;  // V_ now holds another velocity's twists
+  const Eigen::LLT<Matrix6d> llt(I_tot_);
+  if (llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  const Vector6d V_b = llt.solve(shiftMomentum(h_O, kin.p_b) - h_q);
+  if (!V_b.allFinite()) return E_NOT_FINITE;
+  base_twist = toTwist(V_b);
+  return E_NOERROR;
+}
+
+}  // namespace kdl_space
