@@ -15,6 +15,7 @@
 #include <new>
 
 #include "kdl_space/collision.hpp"
+#include "kdl_space/momentum.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
@@ -175,6 +176,9 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   FloatingSide robot(solver.sharedModel(), solver.state(), h, v);
   FloatingSide robot_dense(solver.sharedModel(), solver.state(), h, v, Response::FreeFloating, ExIITMethod::Dense);
   FloatingSide robot_grounded(solver.sharedModel(), solver.state(), h, v, Response::Grounded);
+  FloatingSide robot_locked(solver.sharedModel(), solver.state(), h, v, Response::JointsLocked);
+  Kinematics kin(*model);
+  MomentumSolver momentum(model);
   RigidBodySide target(box, p_h);
   const Matrix6d G_B = target.G();
 
@@ -188,7 +192,14 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   for (const State* s : {&state, &other}) {
     NO_ALLOCATION(EXPECT_EQ(solver.compute(*s), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(recursive.compute(*s), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(forwardKinematics(*model, *s, kin), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(solver.compute(kin), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(recursive.compute(kin), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(momentum.compute(kin, v), E_NOERROR));
   }
+  NO_ALLOCATION(EXPECT_EQ(momentum.contactTwist(h, PL), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(momentum.G_locked(h, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(momentum.baseTwist(kin, momentum.momentum(), qdot, t), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(solver.momentum(base_twist, qdot, PL), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(solver.baseTwist(PL, qdot, t), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(solver.kineticEnergy(base_twist, qdot, T), E_NOERROR));
@@ -207,6 +218,8 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   }
   NO_ALLOCATION(EXPECT_EQ(recursive.G_star(h, G), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, F, d_base, dqdot), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(recursive.G(h, Response::Grounded, G), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, Response::Grounded, F, d_base, dqdot), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(state, v, tau, no_wrenches, a), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(other, v, tau, wrenches, a), E_NOERROR));
   NO_ALLOCATION(G = rigidBodyG(20.0, Matrix3d::Identity(), Vector3d(0.1, 0.2, 0.3)));
@@ -218,7 +231,7 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
     Impulse impulse;
     NO_ALLOCATION(impulse = solveImpact(robot.G(), G_B, robot.contactTwistBefore(), target.contactTwistBefore(), law));
     EXPECT_TRUE(impulse.F.allFinite());
-    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded})
+    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded, &robot_locked})
       NO_ALLOCATION(EXPECT_EQ(side->applyImpulse(impulse.F), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(target.applyImpulse(-impulse.F), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(collide(robot, target, law, impulse), E_NOERROR));

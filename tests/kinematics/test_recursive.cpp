@@ -663,30 +663,5 @@ TEST_F(RecursiveErrors, NotFiniteImpulse) {
   EXPECT_TRUE(near(dq.data, dq_dense.data, kRel, kJumpFloor * dq_dense.data.norm(), "dqdot after errors"));
 }
 
-// The O(n) solver's own forward kinematics (each joint's motion precomputed as a screw about its
-// axis) against KDL's Segment::pose, which the dense solver uses: every body, random states,
-// revolute and prismatic joints (arm6_public has one), chain and tree.
-TEST(RecursiveKinematics, BodyPosesEqualKdlSegmentPoses) {
-  std::mt19937 rng(808);
-  for (const std::string& file : {urdfDir() + "/space_arm7.urdf", urdfDir() + "/dual_arm.urdf",
-                                  dataDir() + "/reference/models/arm6_public.urdf"}) {
-    const auto model = std::make_shared<const FloatingModel>(loadUrdfFile(file));
-    FreeFloatingSolver dense(model);
-    RecursiveExIITSolver recursive(model);
-    for (int trial = 0; trial < 10; ++trial) {
-      const State state = randomState(*model, rng);
-      ASSERT_EQ(dense.compute(state), E_NOERROR);
-      ASSERT_EQ(recursive.compute(state), E_NOERROR);
-      for (int i = 0; i < static_cast<int>(model->bodies().size()); ++i) {
-        const KDL::Frame a = recursive.bodyPose(i), b = dense.bodyPose(i);
-        for (int r = 0; r < 3; ++r) {
-          EXPECT_NEAR(a.p(r), b.p(r), 1e-12 * (1.0 + b.p.Norm())) << file << " body " << i;
-          for (int c = 0; c < 3; ++c) EXPECT_NEAR(a.M(r, c), b.M(r, c), 1e-13) << file << " body " << i;
-        }
-      }
-    }
-  }
-}
-
 }  // namespace
 }  // namespace kdl_space::test
