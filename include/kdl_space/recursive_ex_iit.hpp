@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
-#include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
+#include "kdl_space/response.hpp"
 #include "kdl_space/spatial.hpp"
 #include "kdl_space/state.hpp"
 
