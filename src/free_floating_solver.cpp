@@ -138,12 +138,7 @@ int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::J
   return E_NOERROR;
 }
 
-int FreeFloatingSolver::ready(const Contact& h) const {
-  if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(model_->bodies().size())) return E_BAD_CONTACT;
-  if (!allFinite(h.offset)) return E_NOT_FINITE;
-  return E_NOERROR;
-}
+int FreeFloatingSolver::ready(const Contact& h) const { return contactCode(computed_, h, model_->bodies().size()); }
 
 int FreeFloatingSolver::contactPoint(const Contact& h, Vector3d& p_h) const {
   if (const int rc = ready(h)) return rc;

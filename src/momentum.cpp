@@ -74,9 +74,7 @@ int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
 }
 
 int MomentumSolver::contactTwist(const Contact& h, Vector6d& t_h) const {
-  if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(V_.size())) return E_BAD_CONTACT;
-  if (!allFinite(h.offset)) return E_NOT_FINITE;
+  if (const int rc = contactCode(computed_, h, V_.size())) return rc;
   const Vector6d t = shiftTwist(V_[h.body], R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_);
   if (!t.allFinite()) return E_NOT_FINITE;
   t_h = t;
@@ -84,9 +82,7 @@ int MomentumSolver::contactTwist(const Contact& h, Vector6d& t_h) const {
 }
 
 int MomentumSolver::G_locked(const Contact& h, Matrix6d& G) const {
-  if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(V_.size())) return E_BAD_CONTACT;
-  if (!allFinite(h.offset)) return E_NOT_FINITE;
+  if (const int rc = contactCode(computed_, h, V_.size())) return rc;
   const Matrix6d R = transfer(R_[h.body] * toEigen(h.offset) + p_[h.body] - r_g_);  // R_h, eq. 5
   Matrix6d X = R.transpose();
   X.topRows<3>() /= model_->totalMass();

@@ -76,12 +76,7 @@ KDL::Frame RecursiveExIITSolver::bodyPose(int i) const {
   return KDL::Frame(M, toKDL(p_[i]));
 }
 
-int RecursiveExIITSolver::ready(const Contact& h) const {
-  if (!computed_) return E_NOT_COMPUTED;
-  if (h.body < 0 || h.body >= static_cast<int>(R_.size())) return E_BAD_CONTACT;
-  if (!allFinite(h.offset)) return E_NOT_FINITE;
-  return E_NOERROR;
-}
+int RecursiveExIITSolver::ready(const Contact& h) const { return contactCode(computed_, h, R_.size()); }
 
 int RecursiveExIITSolver::walkPath(const Contact& h) {
   const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;

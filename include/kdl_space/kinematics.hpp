@@ -37,6 +37,16 @@ struct Kinematics {
   Vector3d point(const Contact& h) const { return R[h.body] * toEigen(h.offset) + p[h.body]; }
 };
 
+/// \brief The code of a contact query that cannot be answered: E_NOT_COMPUTED (nothing
+/// computed), E_BAD_CONTACT (h.body outside [0, bodies)), E_NOT_FINITE (a non-finite offset); 0
+/// when it can. Every solver's contact queries start with it.
+inline int contactCode(bool computed, const Contact& h, std::size_t bodies) {
+  if (!computed) return E_NOT_COMPUTED;
+  if (h.body < 0 || static_cast<std::size_t>(h.body) >= bodies) return E_BAD_CONTACT;
+  if (!allFinite(h.offset)) return E_NOT_FINITE;
+  return E_NOERROR;
+}
+
 /// \brief Forward kinematics of `model` at `state` into `kin` (sized for that model).
 /// \return 0; E_SIZE_MISMATCH (state.q, or `kin` sized for another model); E_NOT_FINITE (the
 /// state, or a result that overflows). On an error `kin.valid` is false.
