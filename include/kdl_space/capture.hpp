@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "kdl_space/collision.hpp"
+#include "kdl_space/export.hpp"
 
 namespace kdl_space {
 
@@ -22,7 +23,7 @@ struct RigidTarget {
   Vector6d twist = Vector6d::Zero();             ///< (v of the CoM; w), world frame
 
   /// The same body in world terms (inertia rotated to world axes, CoM in the world).
-  RigidBody toWorld() const;
+  KDL_SPACE_EXPORT RigidBody toWorld() const;
 };
 
 /// What the robot meets: a rigid body, or another free-floating system (whose contact point must
@@ -74,11 +75,11 @@ struct CaptureResult {
 /// \brief Solves the capture problem: both sides at their states, the impulse from the law,
 /// everything after. A set-up call: \throws InputError with a message that starts with the part
 /// concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
-CaptureResult solveCapture(const CaptureProblem& problem);
+KDL_SPACE_EXPORT CaptureResult solveCapture(const CaptureProblem& problem);
 
 /// \brief The robot's model after a rigid capture of a rigid target: the target merged into the
 /// robot's contact link (its inertia in that link's frame at the impact). \throws InputError
 /// ("target: ...") if it cannot be attached.
-std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
+KDL_SPACE_EXPORT std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
 
 }  // namespace kdl_space

@@ -5,6 +5,7 @@
 
 #include <memory>
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/impact.hpp"
 #include "kdl_space/kinematics.hpp"
@@ -25,7 +26,7 @@ struct RigidBody {
 
 /// One side of an impact: its inverse inertia and contact twist before, and its state after an
 /// impulse. Implemented for a free-floating robot and for a rigid body.
-class ImpactSide {
+class KDL_SPACE_EXPORT ImpactSide {
  public:
   virtual ~ImpactSide() = default;
   /// Inverse inertia at the contact point (G*, G, or G_B), twist per impulse.
@@ -70,7 +71,7 @@ struct FloatingSystem {
 /// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
 /// energy and twists by MomentumSolver; no n x n matrix is built. ExIITMethod::Dense uses the
 /// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
-class FloatingSide : public ImpactSide {
+class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
  public:
   /// \throws ModelError (a set-up call) if the model is null, the state or velocity has the
   /// wrong size or is not finite, the contact is no body of the model or its offset is not
@@ -125,7 +126,7 @@ class FloatingSide : public ImpactSide {
 };
 
 /// \brief A rigid body as an impact side, touched at a world point.
-class RigidBodySide : public ImpactSide {
+class KDL_SPACE_EXPORT RigidBodySide : public ImpactSide {
  public:
   /// \throws ModelError (a set-up call) if the mass is not a finite value > 0, the inertia is not
   /// symmetric positive definite, or an input is not finite. The message starts with "target: ".
@@ -168,6 +169,6 @@ enum class ImpactFault {
 /// \param fault if not null, set to the part that refused (ImpactFault::None on success)
 /// \return 0, or the code of the part that refused. On an error neither side keeps the impulse:
 /// if B refuses it, A is reset to its state before (as by A.applyImpulse of a zero impulse).
-int collide(ImpactSide& A, ImpactSide& B, const ImpactLaw& law, Impulse& impulse, ImpactFault* fault = nullptr);
+KDL_SPACE_EXPORT int collide(ImpactSide& A, ImpactSide& B, const ImpactLaw& law, Impulse& impulse, ImpactFault* fault = nullptr);
 
 }  // namespace kdl_space

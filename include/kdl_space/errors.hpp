@@ -22,6 +22,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "kdl_space/export.hpp"
+
 namespace kdl_space {
 
 /// Return codes of compute calls. 0 and KDL's codes (e.g. KDL::SolverI::E_SIZE_MISMATCH = -4)
@@ -39,11 +41,11 @@ enum Error : int {
 };
 
 /// Human-readable text of a return code.
-const char* strError(int code);
+KDL_SPACE_EXPORT const char* strError(int code);
 
 /// Thrown by constructors, loaders and set-up calls when a model or an input cannot be used. The
 /// message names the file, the link or joint, and what is wrong.
-class ModelError : public std::runtime_error {
+class KDL_SPACE_EXPORT ModelError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
@@ -51,7 +53,7 @@ class ModelError : public std::runtime_error {
 /// Thrown by the scenario loader and the capture set-up when an input (a file, a field, a
 /// value) cannot be used: the message names the file, the field (e.g. "target.mass") and what
 /// is wrong.
-class InputError : public std::runtime_error {
+class KDL_SPACE_EXPORT InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/export.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/response.hpp"
@@ -36,7 +37,7 @@ namespace kdl_space {
 ///
 /// The accessors that take an index (bodyPose, S, bodyInertia) are not checked: the index must
 /// lie in [0, bodies().size()) or [0, nj()).
-class FreeFloatingSolver {
+class KDL_SPACE_EXPORT FreeFloatingSolver {
  public:
   explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model);
 

@@ -10,6 +10,7 @@
 // B. A approaches B when u_n = n^T (v_A - v_B) > 0.
 #pragma once
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/spatial.hpp"
 
 namespace kdl_space {
@@ -54,26 +55,26 @@ struct Impulse {
 /// frictional impact the friction is negative; E_NOT_POSITIVE_DEFINITE if the law's block of
 /// G_A + G_B cannot be factorised (capture: the 6x6 sum; translational capture and friction: its
 /// translational 3x3 block; point impact: n^T G_vv n <= 0). `impulse` is untouched on an error.
-int solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
+KDL_SPACE_EXPORT int solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
                 const ImpactLaw& law, Impulse& impulse);
 /// The same, unchecked (see the top of this header).
-Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
+KDL_SPACE_EXPORT Impulse solveImpact(const Matrix6d& G_A, const Matrix6d& G_B, const Vector6d& t_A, const Vector6d& t_B,
                     const ImpactLaw& law);
 
 /// \brief Virtual mass of a side along a direction n: 1 / (n^T G_vv n) with n made unit (the
 /// seed's ref. 3). \return 0, E_NOT_FINITE (G or n), E_BAD_ARGUMENT (n of zero length), or
 /// E_NOT_POSITIVE_DEFINITE when n^T G_vv n <= 0 (the side cannot be moved along n: a grounded arm
 /// at a singular configuration has an infinite virtual mass there). `m` untouched on an error.
-int virtualMass(const Matrix6d& G, const Vector3d& n, double& m);
+KDL_SPACE_EXPORT int virtualMass(const Matrix6d& G, const Vector3d& n, double& m);
 /// The same for a unit n, unchecked: +inf where n^T G_vv n = 0.
-double virtualMass(const Matrix6d& G, const Vector3d& n);
+KDL_SPACE_EXPORT double virtualMass(const Matrix6d& G, const Vector3d& n);
 
 /// \brief Inverse inertia of a rigid body B at a point c: G_B = R_b M_b^-1 R_b^T (eq. 15-17),
 /// mass m, inertia I_com about the CoM (world axes), r_bc = p_c - p_b.
 /// \return 0, E_NOT_FINITE (an input, or the result overflows), E_BAD_ARGUMENT (m <= 0) or
 /// E_NOT_POSITIVE_DEFINITE (I_com). `G_B` untouched on an error.
-int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B);
+KDL_SPACE_EXPORT int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B);
 /// The same, unchecked (m > 0 and I_com symmetric positive definite are the caller's).
-Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
+KDL_SPACE_EXPORT Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
 
 }  // namespace kdl_space

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/export.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/spatial.hpp"
 #include "kdl_space/state.hpp"
@@ -15,7 +16,7 @@ namespace kdl_space {
 /// \brief Kinematics of one state of a FloatingModel (plain data, world frame; per body in
 /// model().bodies() order). Sized for its model by the constructor; filled by forwardKinematics,
 /// which allocates nothing. Solvers read it `const` and keep no reference to it.
-struct Kinematics {
+struct KDL_SPACE_EXPORT Kinematics {
   const FloatingModel* model = nullptr;  ///< the model it was sized for (identity only)
   bool valid = false;                    ///< set by a successful forwardKinematics
   State state;                           ///< the state it holds
@@ -50,6 +51,6 @@ inline int contactCode(bool computed, const Contact& h, std::size_t bodies) {
 /// \brief Forward kinematics of `model` at `state` into `kin` (sized for that model).
 /// \return 0; E_SIZE_MISMATCH (state.q, or `kin` sized for another model); E_NOT_FINITE (the
 /// state, or a result that overflows). On an error `kin.valid` is false.
-int forwardKinematics(const FloatingModel& model, const State& state, Kinematics& kin);
+KDL_SPACE_EXPORT int forwardKinematics(const FloatingModel& model, const State& state, Kinematics& kin);
 
 }  // namespace kdl_space

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/export.hpp"
+
 namespace kdl_space {
 namespace detail {
 struct MotionTable;  // src/detail/joint_motion.hpp
@@ -48,7 +50,7 @@ struct Contact {
 ///
 /// Immutable once built; solvers share it through `std::shared_ptr<const FloatingModel>`.
 /// Joint order is the KDL tree's joint numbering (q_nr), fixed here once.
-class FloatingModel {
+class KDL_SPACE_EXPORT FloatingModel {
  public:
   /// \brief Builds the model from a KDL tree whose root segment is the base, plus the base
   /// body's inertia (in the base frame, as KDL segments hold theirs).

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/export.hpp"
 #include "kdl_space/kinematics.hpp"
 
 namespace kdl_space {
@@ -17,7 +18,7 @@ namespace kdl_space {
 /// as FreeFloatingSolver's dense momentum / kineticEnergy / handTwist / baseTwist (the tests'
 /// second route). Workspaces are sized in the constructor; compute calls allocate nothing and
 /// never throw. The solver keeps what its queries need (no reference to the Kinematics).
-class MomentumSolver {
+class KDL_SPACE_EXPORT MomentumSolver {
  public:
   explicit MomentumSolver(std::shared_ptr<const FloatingModel> model);
   const FloatingModel& model() const { return *model_; }

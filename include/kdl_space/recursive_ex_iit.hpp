@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/export.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/response.hpp"
@@ -34,7 +35,7 @@ struct Symmetric6d;  // src/detail/symmetric6d.hpp: a packed symmetric 6x6
 /// `velocityJump`: the impulse's bias forces from h's body to the base, the base's jump
 /// -(I^A_0)^-1 p^A_0, and the joints' jumps outward.
 /// Compute calls return 0 or an Error code and never throw.
-class RecursiveExIITSolver {
+class KDL_SPACE_EXPORT RecursiveExIITSolver {
  public:
   explicit RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model);
   ~RecursiveExIITSolver();

@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <kdl/frames.hpp>
 
+#include "kdl_space/export.hpp"
+
 namespace kdl_space {
 
 using Vector3d = Eigen::Vector3d;
@@ -17,12 +19,12 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 /// \brief Cross-product matrix: skew(r) x = r x x (the paper's r-hat, eq. 1).
-Matrix3d skew(const Vector3d& r);
+KDL_SPACE_EXPORT Matrix3d skew(const Vector3d& r);
 
 /// \brief Rigid transfer of a twist from point a to point a + r (eq. 5):
 /// `[[E, -skew(r)], [0, E]]`. With r = r_gh it is the paper's R_h; its transpose maps a wrench
 /// at a + r to the same wrench at a (eq. 8).
-Matrix6d transfer(const Vector3d& r);
+KDL_SPACE_EXPORT Matrix6d transfer(const Vector3d& r);
 
 /// \brief The same rigid twist with its reference point moved by r (from the old point to the
 /// new one): v' = v + w x r. (transfer(r) t, without the 6x6 product.)
@@ -40,9 +42,9 @@ void symmetrize(Eigen::MatrixBase<Derived>& A) {
 }
 
 /// True when every number of the frame (vector, twist) is finite.
-bool allFinite(const KDL::Frame& f);
-bool allFinite(const KDL::Vector& v);
-bool allFinite(const KDL::Twist& t);
+KDL_SPACE_EXPORT bool allFinite(const KDL::Frame& f);
+KDL_SPACE_EXPORT bool allFinite(const KDL::Vector& v);
+KDL_SPACE_EXPORT bool allFinite(const KDL::Twist& t);
 
 /// \brief Momentum (P; L) with its angular part about point a moved to point b = a + r:
 /// L_b = L_a - r x P (e.g. about the world origin from about r_g: r = -r_g, L_O = L_g + r_g x P).
@@ -55,10 +57,10 @@ inline Vector6d shiftMomentum(const Vector6d& PL, const Vector3d& r) {
 /// \brief Spatial inertia (6x6, (v; w) order) of a rigid body about a reference point, world
 /// axes: mass m, CoM at c relative to the reference point, inertia I_c about the CoM.
 /// Maps a twist at the reference point to the momentum (P; L about the reference point).
-Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c);
+KDL_SPACE_EXPORT Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c);
 
 /// \brief Centroid inertia M_a = diag(w E, I_g) (eq. 12).
-Matrix6d centroidInertia(double w, const Matrix3d& I_g);
+KDL_SPACE_EXPORT Matrix6d centroidInertia(double w, const Matrix3d& I_g);
 
 /// \brief Rank and conditioning of a symmetric positive semi-definite 6x6 matrix (e.g. the
 /// grounded G, which is singular where J is).
@@ -68,7 +70,7 @@ struct SpectralFigures {
   double max_eigenvalue = 0.0;
   double condition = 0.0;        ///< max/min eigenvalue; +inf when singular
 };
-SpectralFigures spectralFigures(const Matrix6d& G, double tolerance = 1e-12);
+KDL_SPACE_EXPORT SpectralFigures spectralFigures(const Matrix6d& G, double tolerance = 1e-12);
 
 /// Conversions between KDL and Eigen, same component order.
 inline Vector3d toEigen(const KDL::Vector& v) { return Vector3d(v.x(), v.y(), v.z()); }
@@ -82,7 +84,7 @@ inline Vector6d toEigen(const KDL::Wrench& w) {
   r << w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(), w.torque.z();
   return r;
 }
-Matrix3d toEigen(const KDL::Rotation& R);
+KDL_SPACE_EXPORT Matrix3d toEigen(const KDL::Rotation& R);
 inline KDL::Vector toKDL(const Vector3d& v) { return KDL::Vector(v.x(), v.y(), v.z()); }
 inline KDL::Twist toTwist(const Vector6d& t) {
   return KDL::Twist(KDL::Vector(t(0), t(1), t(2)), KDL::Vector(t(3), t(4), t(5)));

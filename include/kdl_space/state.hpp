@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/model.hpp"
 
 namespace kdl_space {
@@ -41,6 +42,6 @@ inline KDL::Frame basePose(const KDL::Vector& position, double roll, double pitc
 
 /// \brief A joint-indexed vector (positions or rates) from values by joint name; joints not
 /// named are 0. \throws ModelError naming an unknown joint.
-KDL::JntArray jointsByName(const FloatingModel& model, const std::map<std::string, double>& values);
+KDL_SPACE_EXPORT KDL::JntArray jointsByName(const FloatingModel& model, const std::map<std::string, double>& values);
 
 }  // namespace kdl_space
