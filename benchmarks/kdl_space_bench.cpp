@@ -1,13 +1,20 @@
-// kdl_space_bench: times our G*, J*, H*, the full post-impact state of a capture and forward
-// dynamics side by side with the naive KDL route (six virtual base joints + ChainDynParam +
-// ChainJntToJacSolver + an Eigen factorisation) and, when built with DART, DART's J M^-1 J^T on
-// the same URDF with a free root joint. Prints the ratios; --markdown FILE writes the table.
+// kdl_space_bench: times our G*, J*, H*, the full post-impact state of a capture, forward
+// dynamics and a simulation side by side with the naive KDL route (six virtual base joints +
+// ChainDynParam + ChainJntToJacSolver + an Eigen factorisation), with the library's previous
+// dense forward dynamics (the composite-rigid-body route of tests/support, compiled in) and,
+// when built with DART, with DART's J M^-1 J^T and computeForwardDynamics on the same URDF with a
+// free root joint. Before timing, the forward dynamics of every route are checked equal to 1e-9
+// (and the two simulations to each other); the benchmark aborts if they are not. Prints the
+// ratios; --markdown FILE writes the tables.
 //
 //   kdl_space_bench [--model FILE.urdf --tip LINK [--offset X Y Z]] [--sizes 7,14,...]
-//                   [--markdown FILE] [Google Benchmark flags, e.g. --benchmark_repetitions=5]
+//                   [--simulate 7,100] [--markdown FILE]
+//                   [Google Benchmark flags, e.g. --benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -17,15 +24,18 @@
 #include <random>
 #include <sstream>
 
+#include "crb_forward_dynamics.hpp"
 #include "generated_chain.hpp"
 #include "kdl_space/collision.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
+#include "kdl_space/simulation.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 #ifdef KDL_SPACE_WITH_DART
 #include <dart/dynamics/BodyNode.hpp>
 #include <dart/dynamics/DegreeOfFreedom.hpp>
+#include <dart/dynamics/FreeJoint.hpp>
 #include <dart/dynamics/Skeleton.hpp>
 #include <dart/utils/urdf/DartLoader.hpp>
 #endif
@@ -42,11 +52,22 @@ struct Case {
   State state;      ///< the configuration timed
   State other;      ///< a second one: calls alternate so that no library can reuse a cached result
   Contact contact;
+  FloatingVelocity velocity;  ///< forward dynamics and simulation: base twist and joint rates
+  KDL::JntArray tau;          ///< forward dynamics: joint torques
+  bool simulate = false;      ///< whether the 10 s simulation is timed on this case
   const State& at(std::size_t i) const { return i & 1 ? other : state; }
 };
 
 Case makeCase(const std::string& name, const std::string& urdf, const std::string& tip, const KDL::Vector& offset) {
-  Case c{name, urdf, tip, offset, std::make_shared<const FloatingModel>(loadUrdfString(urdf, name)), {}, {}, {}};
+  Case c{name, urdf, tip, offset, std::make_shared<const FloatingModel>(loadUrdfString(urdf, name)), {}, {}, {}, {}, {}};
+  const unsigned int n = c.model->nj();
+  c.velocity = FloatingVelocity(KDL::Twist(KDL::Vector(0.01, -0.005, 0.002), KDL::Vector(0.003, 0.02, -0.01)),
+                                KDL::JntArray(n));
+  c.tau = KDL::JntArray(n);
+  for (unsigned int j = 0; j < n; ++j) {
+    c.velocity.qdot(j) = 0.1 - 0.02 * (j % 7);
+    c.tau(j) = 0.5 * std::sin(1.0 + j);
+  }
   c.state = State(*c.model);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> angle(-1.0, 1.0);
@@ -105,6 +126,168 @@ struct NaiveKdl {
 std::vector<Case>& cases() {
   static std::vector<Case> all;
   return all;
+}
+
+#ifdef KDL_SPACE_WITH_DART
+/// DART's skeleton of a case's URDF (a free root joint, massless links given zero inertia as our
+/// loader does), with the case's two states, velocity and torques as DART coordinates. DART's
+/// free joint takes the base's twist in base axes, angular part first.
+struct DartRoute {
+  dart::dynamics::SkeletonPtr skel;
+  std::vector<std::size_t> dof;  ///< per model joint: its DART degree of freedom
+  Eigen::VectorXd q[2], dq[2], forces;
+
+  explicit DartRoute(const Case& c) {
+    dart::utils::DartLoader::Options options;
+    options.mDefaultRootJointType = dart::utils::DartLoader::RootJointType::FLOATING;
+    options.mDefaultInertia = dart::dynamics::Inertia(0.0, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
+    dart::utils::DartLoader loader(options);
+    skel = loader.parseSkeletonString(c.urdf, "");
+    if (!skel) return;
+    skel->setGravity(Eigen::Vector3d::Zero());
+    const unsigned int n = c.model->nj();
+    forces = Eigen::VectorXd::Zero(skel->getNumDofs());
+    for (unsigned int j = 0; j < n; ++j) {
+      const auto* d = skel->getDof(c.model->jointNames()[j]);
+      if (!d) throw ModelError("DART has no joint " + c.model->jointNames()[j]);
+      dof.push_back(d->getIndexInSkeleton());
+      forces(dof.back()) = c.tau(j);
+    }
+    for (std::size_t k = 0; k < 2; ++k) {
+      const State& s = c.at(k);
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.linear() = toEigen(s.world_T_base.M);
+      T.translation() = toEigen(s.world_T_base.p);
+      q[k] = dq[k] = Eigen::VectorXd::Zero(skel->getNumDofs());
+      q[k].head<6>() = dart::dynamics::FreeJoint::convertToPositions(T);
+      dq[k].head<3>() = T.linear().transpose() * toEigen(c.velocity.base_twist.rot);
+      dq[k].segment<3>(3) = T.linear().transpose() * toEigen(c.velocity.base_twist.vel);
+      for (unsigned int j = 0; j < n; ++j) {
+        q[k](dof[j]) = s.q(j);
+        dq[k](dof[j]) = c.velocity.qdot(j);
+      }
+    }
+  }
+  void forwardDynamics(std::size_t k) {
+    skel->setPositions(q[k]);
+    skel->setVelocities(dq[k]);
+    skel->setForces(forces);
+    skel->computeForwardDynamics();
+  }
+  /// DART's accelerations of the last forwardDynamics(k) in our terms: the base origin's
+  /// classical acceleration R (v_b' + w_b x v_b) and R w_b' (world), and the joints'.
+  void acceleration(const Case& c, std::size_t k, FloatingAcceleration& a) const {
+    const Eigen::VectorXd& ddq = skel->getAccelerations();
+    const Matrix3d R = toEigen(c.at(k).world_T_base.M);
+    const Vector3d w_b = dq[k].head<3>(), v_b = dq[k].segment<3>(3);
+    a.base.head<3>() = R * (ddq.segment<3>(3) + w_b.cross(v_b));
+    a.base.tail<3>() = R * ddq.head<3>();
+    for (std::size_t j = 0; j < dof.size(); ++j) a.qddot(j) = ddq(dof[j]);
+  }
+};
+#endif
+
+/// max over the elements of |x - y| / max(|y|, 1e-3 max|y|): relative per element, the elements
+/// below a thousandth of the largest compared to that thousandth.
+double mismatch(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+  const double scale = 1e-3 * y.cwiseAbs().maxCoeff();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) worst = std::max(worst, std::abs(x(i) - y(i)) / std::max(std::abs(y(i)), scale));
+  return worst;
+}
+/// (base; qddot)
+Eigen::VectorXd flat(const FloatingAcceleration& a) {
+  Eigen::VectorXd x(6 + a.qddot.rows());
+  x << a.base, a.qddot.data;
+  return x;
+}
+/// (base position; base twist; q; qdot)
+Eigen::VectorXd flat(const SimulationState& s) {
+  Eigen::VectorXd x(12 + 2 * s.state.q.rows());
+  x << toEigen(s.state.world_T_base.p), toEigen(s.velocity.base_twist), s.state.q.data, s.velocity.qdot.data;
+  return x;
+}
+
+/// A 10 s simulation of a case (dopri5, rtol 1e-10, free joints), as `kdl_space simulate` after
+/// a capture: the start state, and the end state of each route from the set-up run.
+struct SimulationCase {
+  SimulationState start, ours_end, dense_end;
+  SimulationStats ours_stats, dense_stats;
+  static constexpr double kDuration = 10.0;
+};
+
+SimulationState startOf(const Case& c) {
+  SimulationState s;
+  s.state = c.state;
+  s.velocity = c.velocity;
+  return s;
+}
+
+/// s = from, without allocating (same sizes).
+void reset(SimulationState& s, const SimulationState& from) {
+  s.t = from.t;
+  s.state.world_T_base = from.state.world_T_base;
+  s.state.q.data = from.state.q.data;
+  s.velocity.base_twist = from.velocity.base_twist;
+  s.velocity.qdot.data = from.velocity.qdot.data;
+}
+
+std::map<std::string, SimulationCase>& simulations() {
+  static std::map<std::string, SimulationCase> all;
+  return all;
+}
+
+/// The set-up check: every forward dynamics route equal to 1e-9 at both states of every case,
+/// and the two simulations equal to each other; false (with the figures on stderr) if not.
+bool checkRoutes() {
+  bool ok = true;
+  for (const Case& c : cases()) {
+    const unsigned int n = c.model->nj();
+    ForwardDynamicsSolver aba(c.model);
+    test::CrbForwardDynamics crb(c.model);
+    const std::vector<KDL::Wrench> none;
+    for (std::size_t k = 0; k < 2; ++k) {
+      FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(n)}, b = a;
+      if (aba.CartToJnt(c.at(k), c.velocity, c.tau, none, a) || crb.CartToJnt(c.at(k), c.velocity, c.tau, none, b)) {
+        std::cerr << "kdl_space_bench: " << c.name << ": forward dynamics failed\n";
+        return false;
+      }
+      const double e = mismatch(flat(a), flat(b));
+      std::cerr << "check " << c.name << " state " << k << ": ABA vs composite-rigid-body route " << e;
+      ok = ok && e <= 1e-9;
+#ifdef KDL_SPACE_WITH_DART
+      DartRoute dart(c);
+      if (!dart.skel) {
+        std::cerr << "\nkdl_space_bench: DART could not load " << c.name << "\n";
+        return false;
+      }
+      dart.forwardDynamics(k);
+      FloatingAcceleration d = a;
+      dart.acceleration(c, k, d);
+      const double e_dart = mismatch(flat(a), flat(d));
+      std::cerr << ", vs DART " << e_dart;
+      ok = ok && e_dart <= 1e-9;
+#endif
+      std::cerr << "\n";
+    }
+    if (!c.simulate) continue;
+    SimulationCase& sim = simulations()[c.name];
+    sim.start = sim.ours_end = sim.dense_end = startOf(c);
+    Simulator ours(c.model);
+    test::CrbSimulator dense(c.model);
+    const double T = SimulationCase::kDuration;
+    if (ours.run(sim.ours_end, T, T, {}) || dense.run(sim.dense_end, T)) {
+      std::cerr << "kdl_space_bench: " << c.name << ": a simulation failed\n";
+      return false;
+    }
+    sim.ours_stats = ours.stats();
+    sim.dense_stats = dense.stats();
+    const double e = mismatch(flat(sim.ours_end), flat(sim.dense_end));
+    std::cerr << "check " << c.name << " simulation of " << T << " s: " << sim.ours_stats.accepted_steps << " and "
+              << sim.dense_stats.accepted_steps << " steps, end states differ by " << e << "\n";
+    ok = ok && e <= 1e-6 && sim.ours_stats.accepted_steps == sim.dense_stats.accepted_steps;
+  }
+  return ok;
 }
 
 void registerCase(const Case& c) {
@@ -170,19 +353,82 @@ void registerCase(const Case& c) {
       benchmark::DoNotOptimize(imp.F.data());
     }
   });
+  benchmark::RegisterBenchmark((n + "/ours_capture_end_to_end").c_str(), [cp](benchmark::State& st) {
+    // The library's capture path from a state, as a user calls it: the robot side (its
+    // kinematics, momentum, energy and G* by the O(n) recursion), the target's side, the
+    // capture impulse and the whole state after, of both (collide).
+    const ImpactLaw capture{};
+    std::size_t i = 0;
+    for (auto _ : st) {
+      FloatingSide robot(cp->model, cp->at(i++), cp->contact, cp->velocity);
+      const RigidBody box{50.0, Matrix3d::Identity() * 2.0, robot.contactPoint() + Vector3d(0.2, 0.1, -0.1),
+                          (Vector6d() << -0.02, 0.01, 0.0, 0.0, 0.01, 0.02).finished()};
+      RigidBodySide target(box, robot.contactPoint());
+      Impulse impulse;
+      collide(robot, target, capture, impulse);
+      benchmark::DoNotOptimize(robot.after().qdot.data.data());
+      benchmark::DoNotOptimize(target.twistAfter().data());
+    }
+  });
+  // Forward dynamics: base and joint accelerations from state, velocity and torques, forward
+  // kinematics included, by three routes (checked equal in checkRoutes()).
   benchmark::RegisterBenchmark((n + "/ours_forward_dynamics").c_str(), [cp](benchmark::State& st) {
     ForwardDynamicsSolver fd(cp->model);
-    FloatingVelocity v{KDL::Twist(KDL::Vector(0.01, 0, 0), KDL::Vector(0, 0.02, 0)), KDL::JntArray(cp->model->nj())};
-    v.qdot.data.setConstant(0.1);
-    KDL::JntArray tau(cp->model->nj());
     FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
     const std::vector<KDL::Wrench> none;
     std::size_t i = 0;
     for (auto _ : st) {
-      fd.CartToJnt(cp->at(i++), v, tau, none, a);
+      fd.CartToJnt(cp->at(i++), cp->velocity, cp->tau, none, a);
       benchmark::DoNotOptimize(a.qddot.data.data());
     }
   });
+  benchmark::RegisterBenchmark((n + "/crb_forward_dynamics").c_str(), [cp](benchmark::State& st) {
+    test::CrbForwardDynamics fd(cp->model);
+    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
+    const std::vector<KDL::Wrench> none;
+    std::size_t i = 0;
+    for (auto _ : st) {
+      fd.CartToJnt(cp->at(i++), cp->velocity, cp->tau, none, a);
+      benchmark::DoNotOptimize(a.qddot.data.data());
+    }
+  });
+#ifdef KDL_SPACE_WITH_DART
+  benchmark::RegisterBenchmark((n + "/DART_forward_dynamics").c_str(), [cp](benchmark::State& st) {
+    DartRoute dart(*cp);
+    if (!dart.skel) {
+      st.SkipWithError("DART could not load the URDF");
+      return;
+    }
+    std::size_t i = 0;
+    for (auto _ : st) {
+      dart.forwardDynamics(i++ & 1);
+      benchmark::DoNotOptimize(dart.skel->getAccelerations().data());
+    }
+  });
+#endif
+  if (c.simulate) {
+    // `kdl_space simulate` of 10 s from the case's state (free joints, dopri5, rtol 1e-10): the
+    // Simulator, and its loop on the previous dense route. One call = the whole run.
+    const SimulationCase* sc = &simulations().at(n);
+    benchmark::RegisterBenchmark((n + "/ours_simulate_10s").c_str(), [cp, sc](benchmark::State& st) {
+      Simulator sim(cp->model);
+      SimulationState s = sc->start;
+      for (auto _ : st) {
+        reset(s, sc->start);
+        sim.run(s, SimulationCase::kDuration, SimulationCase::kDuration, {});
+        benchmark::DoNotOptimize(s.state.q.data.data());
+      }
+    })->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark((n + "/crb_simulate_10s").c_str(), [cp, sc](benchmark::State& st) {
+      test::CrbSimulator sim(cp->model);
+      SimulationState s = sc->start;
+      for (auto _ : st) {
+        reset(s, sc->start);
+        sim.run(s, SimulationCase::kDuration);
+        benchmark::DoNotOptimize(s.state.q.data.data());
+      }
+    })->Unit(benchmark::kMillisecond);
+  }
   benchmark::RegisterBenchmark((n + "/naive_KDL_G_star").c_str(), [cp](benchmark::State& st) {
     NaiveKdl naive(*cp);
     Matrix6d G;
@@ -264,7 +510,13 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   std::string model, tip, markdown;
   KDL::Vector offset = KDL::Vector::Zero();
-  std::vector<int> sizes{7, 14, 28, 50, 100};
+  std::vector<int> sizes{7, 14, 28, 50, 100}, simulate{7, 100};
+  const auto list = [](const std::string& text) {
+    std::vector<int> out;
+    std::stringstream s(text);
+    for (std::string n; std::getline(s, n, ',');) out.push_back(std::stoi(n));
+    return out;
+  };
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto need = [&](int k) {
@@ -282,9 +534,10 @@ int main(int argc, char** argv) {
       i += 3;
     } else if (a == "--sizes") {
       need(1);
-      sizes.clear();
-      std::stringstream s(argv[++i]);
-      for (std::string n; std::getline(s, n, ',');) sizes.push_back(std::stoi(n));
+      sizes = list(argv[++i]);
+    } else if (a == "--simulate") {
+      need(1);
+      simulate = list(argv[++i]);
     } else {
       std::cerr << "kdl_space_bench: unknown argument " << a << "\n";
       return 2;
@@ -306,34 +559,96 @@ int main(int argc, char** argv) {
       cases().push_back(makeCase(model, text.str(), tip, offset));
     } else {
       cases().reserve(sizes.size());
-      for (int n : sizes) cases().push_back(makeCase("N=" + std::to_string(n), bench::generatedChainUrdf(n), "tip", offset));
+      for (int n : sizes) {
+        cases().push_back(makeCase("N=" + std::to_string(n), bench::generatedChainUrdf(n), "tip", offset));
+        cases().back().simulate = std::find(simulate.begin(), simulate.end(), n) != simulate.end();
+      }
     }
   } catch (const ModelError& e) {
     std::cerr << "kdl_space_bench: " << e.what() << "\n";
     return 3;
+  }
+  if (!checkRoutes()) {
+    std::cerr << "kdl_space_bench: the routes disagree (tolerance 1e-9, simulations 1e-6): not timing them\n";
+    return 4;
   }
   for (const Case& c : cases()) registerCase(c);
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
 
   // Side-by-side table: median time per call and the ratio to our G*.
-  const std::vector<std::string> methods{"ours_G_star", "ours_J_star", "ours_H_star", "ours_capture_state",
-                                         "ours_capture_solve", "ours_forward_dynamics", "naive_KDL_G_star", "DART_G_star"};
+  const std::vector<std::string> methods{"ours_G_star",          "ours_J_star",           "ours_H_star",
+                                         "ours_capture_state",   "ours_capture_end_to_end", "ours_capture_solve",
+                                         "ours_forward_dynamics", "crb_forward_dynamics",  "naive_KDL_G_star",
+                                         "DART_G_star",          "DART_forward_dynamics"};
+  const auto time = [&](const std::string& c, const std::string& m) {
+    const auto it = reporter.ns.find(c + "/" + m);
+    return it == reporter.ns.end() ? -1.0 : it->second;
+  };
+  const auto cell = [&](double ns) { return ns < 0.0 ? std::string("–") : fmt(ns); };
+  const auto ratio = [](double a, double b) {
+    std::ostringstream r;
+    if (a < 0.0 || b < 0.0) return std::string("–");
+    r << std::setprecision(3) << a / b << "×";
+    return r.str();
+  };
   std::ostringstream table;
   table << "| model | method | CPU time per call | ratio to our G* |\n|---|---|---|---|\n";
-  for (const Case& c : cases()) {
-    const auto ours = reporter.ns.find(c.name + "/ours_G_star");
+  for (const Case& c : cases())
     for (const std::string& m : methods) {
-      const auto it = reporter.ns.find(c.name + "/" + m);
-      if (it == reporter.ns.end() || ours == reporter.ns.end()) continue;
-      table << "| " << c.name << " (" << c.model->nj() << " joints) | " << m << " | " << fmt(it->second) << " | "
-            << std::setprecision(3) << it->second / ours->second << "× |\n";
+      const double t = time(c.name, m), ours = time(c.name, "ours_G_star");
+      if (t < 0.0 || ours < 0.0) continue;
+      table << "| " << c.name << " (" << c.model->nj() << " joints) | " << m << " | " << fmt(t) << " | "
+            << ratio(t, ours) << " |\n";
     }
+  const auto growth = [&](const std::string& m) {
+    const double t50 = time("N=50", m), t100 = time("N=100", m);
+    std::ostringstream g;
+    if (t50 > 0.0 && t100 > 0.0) g << std::setprecision(3) << t100 / t50;
+    return g.str();
+  };
+  if (!growth("ours_G_star").empty()) table << "\nGrowth of our G*: t(100) / t(50) = " << growth("ours_G_star") << "\n";
+
+  // Forward dynamics, the three routes side by side.
+  table << "\n### Forward dynamics (state, velocities and torques to base and joint accelerations)\n\n"
+        << "| model | ours (articulated body, O(n)) | previous dense route (CRB) | DART | dense / ours | DART / ours |\n"
+        << "|---|---|---|---|---|---|\n";
+  for (const Case& c : cases()) {
+    const double ours = time(c.name, "ours_forward_dynamics"), crb = time(c.name, "crb_forward_dynamics"),
+                 dart = time(c.name, "DART_forward_dynamics");
+    if (ours < 0.0) continue;
+    table << "| " << c.name << " (" << c.model->nj() << " joints) | " << cell(ours) << " | " << cell(crb) << " | "
+          << cell(dart) << " | " << ratio(crb, ours) << " | " << ratio(dart, ours) << " |\n";
   }
-  if (sizes.size() > 1 && model.empty()) {
-    const auto t50 = reporter.ns.find("N=50/ours_G_star"), t100 = reporter.ns.find("N=100/ours_G_star");
-    if (t50 != reporter.ns.end() && t100 != reporter.ns.end())
-      table << "\nGrowth of our G*: t(100) / t(50) = " << std::setprecision(3) << t100->second / t50->second << "\n";
+  if (!growth("ours_forward_dynamics").empty())
+    table << "\nGrowth t(100) / t(50): ours " << growth("ours_forward_dynamics") << ", previous dense route "
+          << growth("crb_forward_dynamics") << (growth("DART_forward_dynamics").empty() ? "" : ", DART ")
+          << growth("DART_forward_dynamics") << "\n";
+
+  // The capture path end to end.
+  table << "\n### Capture end to end (state to G*, impulse and the whole state after; FloatingSide + "
+           "RigidBodySide + collide)\n\n| model | CPU time per call |\n|---|---|\n";
+  for (const Case& c : cases())
+    if (time(c.name, "ours_capture_end_to_end") > 0.0)
+      table << "| " << c.name << " (" << c.model->nj() << " joints) | " << fmt(time(c.name, "ours_capture_end_to_end"))
+            << " |\n";
+
+  // The simulations.
+  if (!simulations().empty()) {
+    table << "\n### Simulation: " << SimulationCase::kDuration
+          << " s, dopri5, rtol 1e-10, free joints (as `kdl_space simulate`)\n\n"
+          << "| model | ours (Simulator) | the same loop on the dense route | dense / ours | steps accepted (rejected) |"
+             " end states differ by |\n|---|---|---|---|---|---|\n";
+    for (const Case& c : cases()) {
+      const auto it = simulations().find(c.name);
+      if (it == simulations().end()) continue;
+      const double ours = time(c.name, "ours_simulate_10s"), dense = time(c.name, "crb_simulate_10s");
+      std::ostringstream diff;
+      diff << std::setprecision(2) << mismatch(flat(it->second.ours_end), flat(it->second.dense_end));
+      table << "| " << c.name << " (" << c.model->nj() << " joints) | " << cell(ours) << " | " << cell(dense) << " | "
+            << ratio(dense, ours) << " | " << it->second.ours_stats.accepted_steps << " ("
+            << it->second.ours_stats.rejected_steps << ") | " << diff.str() << " |\n";
+    }
   }
   std::cout << "\n" << table.str();
   if (!markdown.empty()) {

@@ -1,120 +1,184 @@
 #include "kdl_space/forward_dynamics.hpp"
 
+#include "detail/joint_motion.hpp"
+#include "detail/multiversion.hpp"
+#include "detail/symmetric6d.hpp"
+
 namespace kdl_space {
+
+// Featherstone, Rigid Body Dynamics Algorithms (2008): the articulated-body algorithm (ch. 7, sec.
+// 7.3, Table 7.1) with a floating base (ch. 9), in the fixed-frame form (world axes,
+// every quantity about one point p_b; twists (v; w), wrenches (f; n)). The velocity-product
+// accelerations are accumulated outward (a_i, the acceleration of zero joint accelerations and a
+// still base) and enter the bias forces p_i = I_i a_i + V_i x* I_i V_i - f_ext; the unknowns are
+// then A_i - a_i, whose recursion has no velocity term (so the inward pass needs no I^A c).
+struct ForwardDynamicsSolver::BodyData {
+  detail::Symmetric6d IA;          ///< articulated inertia I^A
+  Vector6d V = Vector6d::Zero();   ///< twist
+  Vector6d a = Vector6d::Zero();   ///< outward: bias acceleration a_i; last pass: A_i - a_i
+  Vector6d pA = Vector6d::Zero();  ///< articulated bias force p^A
+  Vector6d U = Vector6d::Zero();   ///< I^A S
+  double D_inv = 0.0;              ///< 1 / (S^T I^A S + armature)
+  double u = 0.0;                  ///< tau - S^T p^A
+};
+
 namespace {
 
-/// Spatial cross products in (linear; angular) order.
-Vector6d crossMotion(const Vector6d& V, const Vector6d& U) {
+/// Spatial cross product of motions, V x U, (linear; angular) order.
+inline Vector6d crossMotion(const Vector6d& V, const Vector6d& U) {
   Vector6d r;
-  r.head<3>() = V.tail<3>().cross(U.head<3>()) + V.head<3>().cross(U.tail<3>());
-  r.tail<3>() = V.tail<3>().cross(U.tail<3>());
+  const Vector3d w = V.tail<3>();
+  r.head<3>() = w.cross(U.head<3>()) + V.head<3>().cross(U.tail<3>());
+  r.tail<3>() = w.cross(U.tail<3>());
   return r;
 }
-Vector6d crossForce(const Vector6d& V, const Vector6d& F) {
+
+/// I x of a rigid body of mass m, CoM at c relative to the reference point, inertia I_c about
+/// the CoM (world axes), without forming I: (m (x_v + x_w x c); I_c x_w + c x m (x_v + x_w x c)).
+inline Vector6d rigidTimes(double m, const Vector3d& c, const Matrix3d& I_c, const Vector6d& x) {
+  const Vector3d P = m * (x.head<3>() + x.tail<3>().cross(c));
   Vector6d r;
-  r.head<3>() = V.tail<3>().cross(F.head<3>());
-  r.tail<3>() = V.tail<3>().cross(F.tail<3>()) + V.head<3>().cross(F.head<3>());
+  r.head<3>() = P;
+  r.tail<3>() = I_c * x.tail<3>() + c.cross(P);
   return r;
 }
 
 }  // namespace
 
-ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model)
-    : kinematics_(std::move(model)) {
-  const std::size_t nb = this->model().bodies().size();
-  const unsigned int n = this->model().nj();
-  locked_.assign(n, false);
-  V_.resize(nb);
-  A_.resize(nb);
-  F_.resize(nb);
-  c_.setZero(6 + n);
-  rhs_.setZero(6 + n);
-  M_.setZero(6 + n, 6 + n);
-  M_llt_.compute(Eigen::MatrixXd::Identity(6 + n, 6 + n));  // sized; see FreeFloatingSolver's constructor
+ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
+  if (!model_) throw ModelError("ForwardDynamicsSolver: null model");
+  const std::size_t nb = model_->bodies().size();
+  locked_.assign(model_->nj(), false);
+  moving_.resize(nb);
+  for (std::size_t i = 0; i < nb; ++i) moving_[i] = model_->bodies()[i].joint >= 0;
+  own_ = Kinematics(*model_);
+  data_.resize(nb);
+  qddot_.setZero(model_->nj());
 }
 
+ForwardDynamicsSolver::~ForwardDynamicsSolver() = default;
+ForwardDynamicsSolver::ForwardDynamicsSolver(const ForwardDynamicsSolver&) = default;
+ForwardDynamicsSolver& ForwardDynamicsSolver::operator=(const ForwardDynamicsSolver&) = default;
+
 int ForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
-  if (locked.size() != model().nj()) return E_SIZE_MISMATCH;
+  if (locked.size() != model_->nj()) return E_SIZE_MISMATCH;
   locked_ = locked;
+  const std::vector<Body>& bodies = model_->bodies();
+  for (std::size_t i = 0; i < bodies.size(); ++i) moving_[i] = bodies[i].joint >= 0 && !locked_[bodies[i].joint];
   return E_NOERROR;
 }
 
-int ForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity& velocity,
-                                     const KDL::JntArray& tau, const std::vector<KDL::Wrench>& f_ext,
-                                     FloatingAcceleration& acceleration) {
-  const FloatingModel& m = model();
-  const std::vector<Body>& bodies = m.bodies();
-  const unsigned int n = m.nj();
-  if (velocity.qdot.rows() != n || tau.rows() != n || acceleration.qddot.rows() != n ||
-      (!f_ext.empty() && f_ext.size() != bodies.size()))
-    return E_SIZE_MISMATCH;
-  if (!velocity.qdot.data.allFinite() || !tau.data.allFinite() || !toEigen(velocity.base_twist).allFinite())
-    return E_NOT_FINITE;
-  for (const KDL::Wrench& f : f_ext)
-    if (!toEigen(f).allFinite()) return E_NOT_FINITE;
-  if (const int rc = kinematics_.compute(state)) return rc;
-  const FreeFloatingSolver& k = kinematics_;
-  const Vector3d& P = k.r_g();  // the fixed point of this instant
-  const Vector3d p_b = toEigen(state.world_T_base.p);
+int ForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+                                     const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {
+  if (const int rc = forwardKinematics(*model_, state, own_)) return rc;
+  return CartToJnt(own_, velocity, tau, f_ext, acceleration);
+}
 
-  // Newton-Euler with zero accelerations: velocity products, gravity, external wrenches.
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
-    if (b.parent < 0) {
-      V_[i] = shiftTwist(toEigen(velocity.base_twist), P - p_b);
-      A_[i] << -gravity_, Vector3d::Zero();  // gravity as an acceleration of the frame
+KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity,
+                                                            const KDL::JntArray& tau,
+                                                            const std::vector<KDL::Wrench>& f_ext,
+                                                            FloatingAcceleration& acceleration) {
+  const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
+  const std::size_t nb = bodies.size();
+  const unsigned int n = model_->nj();
+  if (kin.model != model_.get() || kin.R.size() != nb || velocity.qdot.rows() != n || tau.rows() != n ||
+      acceleration.qddot.rows() != n || (!f_ext.empty() && f_ext.size() != nb))
+    return E_SIZE_MISMATCH;
+  if (!kin.valid) return E_NOT_COMPUTED;
+  if (!velocity.qdot.data.allFinite() || !tau.data.allFinite() || !allFinite(velocity.base_twist)) return E_NOT_FINITE;
+  for (const KDL::Wrench& f : f_ext)
+    if (!allFinite(f.force) || !allFinite(f.torque)) return E_NOT_FINITE;
+  const Vector3d& p_b = kin.p_b;  // the reference point of every spatial quantity
+  const std::vector<double>& armature = model_->armature();
+  const double* qdot = velocity.qdot.data.data();
+
+  // 1. Outward: twists, bias accelerations, rigid-body inertias and bias forces (Table 7.1's
+  // first loop; the base's twist is given, its bias acceleration is zero).
+  for (std::size_t i = 0; i < nb; ++i) {
+    const detail::JointMotion& j = bodies[i];
+    BodyData& b = data_[i];
+    if (j.parent < 0) {
+      b.V = toEigen(velocity.base_twist);
+      b.a.setZero();
     } else {
-      V_[i] = V_[b.parent];
-      A_[i] = A_[b.parent];
-      if (b.joint >= 0) {
-        const Vector6d Sqd = k.S(b.joint) * velocity.qdot(b.joint);
-        V_[i] += Sqd;
-        A_[i] += crossMotion(V_[i], Sqd);
+      const BodyData& parent = data_[j.parent];
+      if (j.joint >= 0) {
+        const Vector6d Sqd = kin.S[i] * qdot[j.joint];
+        b.V = parent.V + Sqd;
+        b.a = parent.a + crossMotion(parent.V, Sqd);  // c_i = V_parent x S qdot (= V_i x S qdot)
+      } else {
+        b.V = parent.V;
+        b.a = parent.a;
       }
     }
-    const Matrix6d& I = k.bodyInertia(static_cast<int>(i));
-    F_[i] = I * A_[i] + crossForce(V_[i], I * V_[i]);
+    b.IA.setZero();
+    b.pA.setZero();
+    if (j.mass > 0.0) {  // else a frame: no inertia
+      const Vector3d c = kin.com[i] - p_b;
+      const Matrix3d& I_c = kin.I_com[i];
+      b.IA.addRigidBody(j.mass, c, I_c);
+      const Vector6d h = rigidTimes(j.mass, c, I_c, b.V);  // momentum I V
+      const Vector3d w = b.V.tail<3>();
+      b.pA = rigidTimes(j.mass, c, I_c, b.a);
+      b.pA.head<3>() += w.cross(h.head<3>());  // V x* I V
+      b.pA.tail<3>() += w.cross(h.tail<3>()) + b.V.head<3>().cross(h.head<3>());
+    }
     if (!f_ext.empty()) {
       const Vector3d f = toEigen(f_ext[i].force);
-      const Vector3d o = toEigen(k.bodyPose(static_cast<int>(i)).p);
-      F_[i].head<3>() -= f;
-      F_[i].tail<3>() -= toEigen(f_ext[i].torque) + (o - P).cross(f);  // moment moved to P
+      b.pA.head<3>() -= f;
+      b.pA.tail<3>() -= toEigen(f_ext[i].torque) + (kin.p[i] - p_b).cross(f);  // moment moved to p_b
     }
   }
-  for (std::size_t i = bodies.size(); i-- > 1;) {
-    F_[bodies[i].parent] += F_[i];
-    if (bodies[i].joint >= 0) c_(6 + bodies[i].joint) = k.S(bodies[i].joint).dot(F_[i]);
-  }
-  c_.head<6>() = F_[0];
 
-  // [[M_a, A_m], [A_m^T, H]] at the CoM; locked joints held (row and column replaced).
-  M_.topLeftCorner<6, 6>() = k.M_a();
-  M_.topRightCorner(6, n) = k.A_m();
-  M_.bottomLeftCorner(n, 6) = k.A_m().transpose();
-  M_.bottomRightCorner(n, n) = k.H().data;
-  rhs_.head<6>() = -c_.head<6>();
-  rhs_.tail(n) = tau.data - c_.tail(n);
-  for (unsigned int j = 0; j < n; ++j) {
-    if (!locked_[j]) continue;
-    M_.row(6 + j).setZero();
-    M_.col(6 + j).setZero();
-    M_(6 + j, 6 + j) = 1.0;
-    rhs_(6 + j) = 0.0;
+  // 2. Inward: articulated inertias and bias forces (Table 7.1's second loop, c = 0 here). A
+  // fixed or locked joint passes its body's on whole.
+  for (std::size_t i = nb; i-- > 1;) {
+    const detail::JointMotion& j = bodies[i];
+    BodyData& b = data_[i];
+    BodyData& parent = data_[j.parent];
+    if (!moving_[i]) {
+      parent.IA += b.IA;
+      parent.pA += b.pA;
+      continue;
+    }
+    const Vector6d& S = kin.S[i];
+    b.U = b.IA * S;
+    const double D = S.dot(b.U) + armature[j.joint];
+    if (!(D > 0.0)) return E_NOT_POSITIVE_DEFINITE;
+    b.D_inv = 1.0 / D;
+    b.u = tau(j.joint) - S.dot(b.pA);
+    parent.IA.addMinusRank1(b.IA, b.U, b.D_inv);
+    parent.pA += b.pA + b.U * (b.u * b.D_inv);
   }
-  M_llt_.compute(M_);
-  if (M_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  M_llt_.solveInPlace(rhs_);
-  if (!rhs_.allFinite()) return E_NOT_FINITE;
 
-  // Base: spatial acceleration at P -> acceleration of the base origin.
-  const Vector6d a_g = rhs_.head<6>();
+  // 3. Outward: the base's acceleration I^A_0 A_0 = -p^A_0 (the floating base, ch. 9), then the
+  // joints'.
+  Vector6d A0;
+  if (!data_[0].IA.solve(-data_[0].pA, A0)) return E_NOT_POSITIVE_DEFINITE;
+  data_[0].a = A0;
+  for (std::size_t i = 1; i < nb; ++i) {
+    const detail::JointMotion& j = bodies[i];
+    BodyData& b = data_[i];
+    const Vector6d& a_parent = data_[j.parent].a;
+    if (moving_[i]) {
+      const double qdd = (b.u - b.U.dot(a_parent)) * b.D_inv;
+      qddot_(j.joint) = qdd;
+      b.a = a_parent + kin.S[i] * qdd;
+    } else {
+      if (j.joint >= 0) qddot_(j.joint) = 0.0;  // brakes on
+      b.a = a_parent;
+    }
+  }
+
+  // Gravity: the frame's acceleration -g undone; the base origin's classical acceleration.
+  A0.head<3>() += gravity_;
   const Vector3d w = toEigen(velocity.base_twist.rot), v_b = toEigen(velocity.base_twist.vel);
   Vector6d base;
-  base.head<3>() = a_g.head<3>() + a_g.tail<3>().cross(p_b - P) + w.cross(v_b);
-  base.tail<3>() = a_g.tail<3>();
-  if (!base.allFinite()) return E_NOT_FINITE;
+  base.head<3>() = A0.head<3>() + w.cross(v_b);
+  base.tail<3>() = A0.tail<3>();
+  if (!base.allFinite() || !qddot_.allFinite()) return E_NOT_FINITE;
   acceleration.base = base;
-  acceleration.qddot.data = rhs_.tail(n);
+  acceleration.qddot.data = qddot_;
   return E_NOERROR;
 }
 

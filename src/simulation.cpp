@@ -1,5 +1,6 @@
 #include "kdl_space/simulation.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -24,7 +25,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
-    : dynamics_(std::move(model)), options_(options) {
+    : model_(model ? std::move(model) : throw ModelError("simulation: null model")),
+      kin_(*model_),
+      momentum_(model_),
+      dynamics_(model_),
+      options_(options) {
   const unsigned int n = this->model().nj();
   controls_.assign(n, JointControl{});
   scratch_.state = State(this->model());
@@ -64,17 +69,10 @@ void Simulator::setJointControl(unsigned int joint, const JointControl& control)
 }
 
 int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
-  FreeFloatingSolver& k = dynamics_.kinematics();
-  if (const int rc = k.compute(s.state)) return rc;
-  Vector6d PL_g;
-  double energy = 0.0;
-  if (const int rc = k.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
-  if (const int rc = k.kineticEnergy(s.velocity.base_twist, s.velocity.qdot, energy)) return rc;
-  Vector6d momentum = PL_g;
-  momentum.tail<3>() += k.r_g().cross(PL_g.head<3>());  // L_O = L_g + r_g x P
-  if (!momentum.allFinite()) return E_NOT_FINITE;
-  h_O = momentum;
-  T = energy;
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+  if (const int rc = momentum_.compute(kin_, s.velocity)) return rc;
+  h_O = momentum_.momentum();
+  T = momentum_.kineticEnergy();
   return E_NOERROR;
 }
 
@@ -86,30 +84,37 @@ int Simulator::engageBrakes(SimulationState& s) {
   for (unsigned int j = 0; j < n; ++j)
     if (controls_[j].mode == JointControl::Mode::Locked && s.velocity.qdot(j) != 0.0) locked.push_back(j);
   if (locked.empty()) return E_NOERROR;
-  FreeFloatingSolver& k = dynamics_.kinematics();
-  if (const int rc = k.compute(s.state)) return rc;
-  // Generalized velocity nu = (twist at r_g; qdot), mass matrix [[M_a, A_m], [A_m^T, H]]:
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+  // Generalized velocity nu = (base twist at p_b; qdot), mass matrix M in those coordinates:
   // nu+ = nu - M^-1 G^T (G M^-1 G^T)^-1 G nu, G selecting the locked rates. The base rows of
-  // M nu (the momentum) are unchanged: the brake impulse is internal.
-  Eigen::MatrixXd M(6 + n, 6 + n);
-  M << k.M_a(), k.A_m(), k.A_m().transpose(), k.H().data;
-  Eigen::VectorXd nu(6 + n);
-  const Vector3d p_b = toEigen(s.state.world_T_base.p);
-  Vector6d y = toEigen(s.velocity.base_twist);
-  y.head<3>() += y.tail<3>().cross(k.r_g() - p_b);
-  nu << y, s.velocity.qdot.data;
-  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(6 + n, locked.size());
-  for (std::size_t i = 0; i < locked.size(); ++i) Gt(6 + locked[i], i) = 1.0;
-  const Eigen::LLT<Eigen::MatrixXd> M_llt(M);
-  if (M_llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  const Eigen::MatrixXd X = M_llt.solve(Gt);
-  const Eigen::VectorXd lambda = (Gt.transpose() * X).llt().solve(Gt.transpose() * nu);
-  nu -= X * lambda;
+  // M nu (the momentum) are unchanged: the brake impulse is internal. The columns of
+  // M^-1 G^T are the accelerations from rest of a unit torque on each locked joint, by the
+  // articulated-body algorithm of the system without brakes or gravity (at rest the base's
+  // classical acceleration is its spatial one at p_b).
+  ForwardDynamicsSolver unbraked(model_);
+  const FloatingVelocity rest(*model_);
+  KDL::JntArray unit(n);
+  FloatingAcceleration acc{Vector6d::Zero(), KDL::JntArray(n)};
+  const std::size_t k = locked.size();
+  Eigen::MatrixXd X(6 + n, k), GX(k, k);
+  for (std::size_t i = 0; i < k; ++i) {
+    unit(locked[i]) = 1.0;
+    if (const int rc = unbraked.CartToJnt(kin_, rest, unit, {}, acc)) return rc;
+    unit(locked[i]) = 0.0;
+    X.col(i) << acc.base, acc.qddot.data;
+  }
+  Eigen::VectorXd nu(6 + n), G_nu(k);
+  nu << toEigen(s.velocity.base_twist), s.velocity.qdot.data;
+  for (std::size_t i = 0; i < k; ++i) {
+    G_nu(i) = nu(6 + locked[i]);
+    for (std::size_t c = 0; c < k; ++c) GX(i, c) = X(6 + locked[i], c);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> GX_llt(GX);
+  if (GX_llt.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  nu -= X * GX_llt.solve(G_nu);
   for (unsigned int j : locked) nu(6 + j) = 0.0;  // exactly
   if (!nu.allFinite()) return E_NOT_FINITE;
-  y = nu.head<6>();
-  y.head<3>() += y.tail<3>().cross(p_b - k.r_g());
-  s.velocity.base_twist = toTwist(y);
+  s.velocity.base_twist = toTwist(nu.head<6>());
   s.velocity.qdot.data = nu.tail(n);
   return E_NOERROR;
 }
@@ -134,11 +139,8 @@ int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
                                     KDL::Vector(x(0), x(1), x(2)));
   s.state.q.data = x.segment(7, n);
   s.velocity.qdot.data = x.tail(n);
-  FreeFloatingSolver& k = dynamics_.kinematics();
-  if (const int rc = k.compute(s.state)) return rc;
-  Vector6d PL_g = x.segment<6>(7 + n);
-  PL_g.tail<3>() -= k.r_g().cross(PL_g.head<3>());  // L_g = L_O - r_g x P
-  return k.baseTwist(PL_g, s.velocity.qdot, s.velocity.base_twist);  // eq. 2
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;  // the one pass of this stage
+  return momentum_.baseTwist(kin_, x.segment<6>(7 + n), s.velocity.qdot, s.velocity.base_twist);  // eq. 2
 }
 
 int Simulator::derivative(double t, const Vector& x, Vector& dx) {
@@ -159,7 +161,7 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
     }
     tau_.data += tau_extra_.data;
   }
-  if (const int rc = dynamics_.CartToJnt(scratch_.state, scratch_.velocity, tau_, {}, acc_)) return rc;
+  if (const int rc = dynamics_.CartToJnt(kin_, scratch_.velocity, tau_, {}, acc_)) return rc;
   const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
   const Eigen::Vector4d quat = x.segment<4>(3);
   dx.head<3>() = toEigen(scratch_.velocity.base_twist.vel);
@@ -167,7 +169,7 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   dx(6) = -0.5 * w.dot(quat.head<3>());
   dx.segment(7, n) = x.tail(n);
   const double mass = model().totalMass();
-  const Vector3d& r_g = dynamics_.kinematics().r_g();
+  const Vector3d& r_g = kin_.r_g;
   dx.segment<3>(7 + n) = mass * options_.gravity;                    // dP/dt: external force
   dx.segment<3>(10 + n) = r_g.cross(mass * options_.gravity);        // dL_O/dt: its moment
   dx.tail(n) = acc_.qddot.data;

@@ -1,14 +1,19 @@
 // Free-floating forward dynamics: base and joint accelerations from the state, joint torques and
 // external wrenches, with the velocity-product terms (the paper's c* and the base's own) and an
-// optional gravity. KDL has no floating-base forward dynamics: this is a recursive Newton-Euler
-// pass over the KDL tree for the bias, and the composite-rigid-body inertia of
-// FreeFloatingSolver for the mass matrix.
+// optional gravity, in O(n): Featherstone's articulated-body algorithm with a floating base
+// (Rigid Body Dynamics Algorithms, 2008, ch. 7 and 9), reading the one forward-kinematics
+// pass (kinematics.hpp). KDL has no floating-base forward dynamics. The composite-rigid-body
+// route (M_full solved densely) is the tests' second route (docs/DYNAMICS.md).
 #pragma once
 
 #include <memory>
 #include <vector>
 
-#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/errors.hpp"
+#include "kdl_space/kinematics.hpp"
+#include "kdl_space/model.hpp"
+#include "kdl_space/spatial.hpp"
+#include "kdl_space/state.hpp"
 
 namespace kdl_space {
 
@@ -18,17 +23,30 @@ struct FloatingAcceleration {
   KDL::JntArray qddot;               ///< joint accelerations, model order
 };
 
-/// \brief Forward dynamics of a FloatingModel:
-/// `[[M_a, A_m], [A_m^T, H]] [a_g; qddot] = [-c_0; tau - c_q]`, everything about the system's
-/// CoM at this instant (a fixed point): a_g is the base's spatial acceleration there, c = (c_0;
-/// c_q) the bias from a Newton-Euler pass with zero accelerations (velocity products, gravity,
-/// external wrenches). Locked joints (brakes on) are held: their qddot is 0 and their torque is
-/// whatever holds them. Workspaces are sized in the constructor.
+/// \brief Forward dynamics of a FloatingModel by the articulated-body algorithm with a floating
+/// base, every quantity in world axes about the base frame's origin p_b (a point fixed in the
+/// world for the instant):
+///  1. outward: body twists V_i = V_parent + S_i qdot_i, the bias accelerations of zero joint
+///     accelerations a_i = a_parent + V_i x S_i qdot_i, and the bias forces
+///     p_i = I_i a_i + V_i x* I_i V_i - f_ext,i;
+///  2. inward: articulated inertias I^A_i = I_i + sum_children (I^A_c - U_c D_c^-1 U_c^T) and bias
+///     forces p^A_i = p_i + sum_children (p^A_c + U_c D_c^-1 u_c), with U = I^A S,
+///     D = S^T U + armature, u = tau - S^T p^A;
+///  3. outward: the base's spatial acceleration A_0 = -(I^A_0)^-1 p^A_0, then
+///     qddot_i = D_i^-1 (u_i - U_i^T A_parent), A_i = A_parent + S_i qddot_i;
+/// gravity g as an acceleration -g of the frame (the base's is A_0 + (g; 0)); the base's classical
+/// acceleration follows, p_b'' = A_0,v + w x v_b.
+/// Locked joints (brakes on) are fixed joints in steps 2 and 3 (qddot = 0; their torque is
+/// whatever holds them); a locked joint that still moves keeps its velocity product in step 1.
+/// Workspaces are sized in the constructor; CartToJnt allocates nothing and never throws.
 class ForwardDynamicsSolver {
  public:
   explicit ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model);
+  ~ForwardDynamicsSolver();
+  ForwardDynamicsSolver(const ForwardDynamicsSolver&);
+  ForwardDynamicsSolver& operator=(const ForwardDynamicsSolver&);
 
-  const FloatingModel& model() const { return kinematics_.model(); }
+  const FloatingModel& model() const { return *model_; }
   /// Gravity acceleration (world frame); zero by default (orbit). For ground test beds.
   /// \return 0, or E_NOT_FINITE (and the gravity unchanged) for a NaN or infinite g.
   int setGravity(const Vector3d& g) {
@@ -41,29 +59,32 @@ class ForwardDynamicsSolver {
   int setLocked(const std::vector<bool>& locked);
   const std::vector<bool>& locked() const { return locked_; }
 
-  /// \brief Accelerations from state, velocity, joint torques tau (model order) and external
-  /// wrenches f_ext (one per body in model().bodies() order, world axes, moment about the body
-  /// frame's origin; empty for none).
-  /// \return 0, E_SIZE_MISMATCH (qdot, tau, acceleration.qddot, a non-empty f_ext of another
-  /// size than bodies()), E_NOT_FINITE (an input, or accelerations that overflow) or
-  /// E_NOT_POSITIVE_DEFINITE; `acceleration` is untouched on an error.
+  /// \brief Accelerations at the state of `kin` (forwardKinematics of this model) from the
+  /// velocity, joint torques tau (model order) and external wrenches f_ext (one per body in
+  /// model().bodies() order, world axes, moment about the body frame's origin; empty for none).
+  /// No reference to `kin` is kept.
+  /// \return 0, E_SIZE_MISMATCH (kin of another model, qdot, tau, acceleration.qddot, a non-empty
+  /// f_ext of another size than bodies()), E_NOT_COMPUTED (kin not valid), E_NOT_FINITE (an
+  /// input, or accelerations that overflow) or E_NOT_POSITIVE_DEFINITE (an articulated inertia
+  /// that is not); `acceleration` is untouched on an error.
+  int CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+                const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
+  /// \brief The same from a state: forwardKinematics into the solver's own Kinematics, then the
+  /// above. \return also E_SIZE_MISMATCH (state.q) and E_NOT_FINITE (a non-finite state).
   int CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
 
-  /// The kinematic solver at the state of the last CartToJnt (centroid terms, G*, momentum...).
-  FreeFloatingSolver& kinematics() { return kinematics_; }
-  /// Bias (c_0 at the CoM; c_q) of the last CartToJnt: the generalized force that gives zero
-  /// acceleration. Size 6 + nj().
-  const Eigen::VectorXd& bias() const { return c_; }
-
  private:
-  FreeFloatingSolver kinematics_;
+  /// Per body: the articulated-body recursion's data (world axes, about p_b).
+  struct BodyData;
+
+  std::shared_ptr<const FloatingModel> model_;
   Vector3d gravity_ = Vector3d::Zero();
   std::vector<bool> locked_;
-  std::vector<Vector6d> V_, A_, F_;  ///< per body: twist, spatial acceleration, force, at r_g
-  Eigen::VectorXd c_, rhs_;
-  Eigen::MatrixXd M_;
-  Eigen::LLT<Eigen::MatrixXd> M_llt_;
+  std::vector<char> moving_;       ///< per body: 1 if its joint is movable and not locked
+  Kinematics own_;                 ///< for CartToJnt(State) only
+  std::vector<BodyData> data_;     ///< per body
+  Eigen::VectorXd qddot_;          ///< joint accelerations before they are returned (n)
 };
 
 }  // namespace kdl_space

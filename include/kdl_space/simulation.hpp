@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "kdl_space/forward_dynamics.hpp"
+#include "kdl_space/kinematics.hpp"
+#include "kdl_space/momentum.hpp"
 
 namespace kdl_space {
 
@@ -60,6 +62,9 @@ struct SimulationStats {
 /// momentum (P; L about the world origin), qdot). The base twist follows from the momentum and
 /// the joint rates (eq. 2), so with no external force the momentum is an exact invariant of every
 /// Runge-Kutta step; the orientation is renormalised after every step (no Euler angles).
+/// Each evaluation of the derivative is O(n): one forwardKinematics, the base twist from the
+/// momentum (MomentumSolver::baseTwist) and the articulated-body forward dynamics
+/// (ForwardDynamicsSolver), all reading the same Kinematics; no n x n matrix is built.
 class Simulator {
  public:
   /// \throws ModelError unless step, rtol, atol, max_step are finite and > 0, max_steps > 0,
@@ -93,8 +98,8 @@ class Simulator {
   int run(SimulationState& s, double t_end, double output_dt,
           const std::function<void(const SimulationState&)>& observer);
 
-  /// Kinetic energy and momentum (P; L about the world origin) of a state. \return 0 or the code
-  /// of FreeFloatingSolver::compute / momentum; T and h_O untouched on an error.
+  /// Kinetic energy and momentum (P; L about the world origin) of a state, in O(n). \return 0 or
+  /// the code of forwardKinematics / MomentumSolver::compute; T and h_O untouched on an error.
   int energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O);
 
   const SimulationStats& stats() const { return stats_; }
@@ -111,6 +116,9 @@ class Simulator {
   /// evaluated, which the caller treats as a rejected step.
   int stepDP54(double t, double h, Vector& x, double& error, bool& trial_failed);
 
+  std::shared_ptr<const FloatingModel> model_;
+  Kinematics kin_;             ///< the state of the last unpack() / energyAndMomentum()
+  MomentumSolver momentum_;
   ForwardDynamicsSolver dynamics_;
   SimulationOptions options_;
   std::vector<JointControl> controls_;

@@ -94,6 +94,38 @@ struct Symmetric6d {
       }
     return true;
   }
+  /// \brief x = this^-1 b by the same root-free Cholesky factors A = L D L^T, then forward and
+  /// back substitution (no inverse formed). \return false, `x` unspecified, when a pivot is not
+  /// positive.
+  bool solve(const Vector6d& b, Vector6d& x) const {
+    double L[6][6], LD[6][6], d_inv[6], y[6];
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      double d = a[index(j, j)];
+      for (int k = 0; k < j; ++k) d -= L[j][k] * LD[j][k];
+      if (!(d > 0.0)) return false;
+      d_inv[j] = 1.0 / d;
+      for (int i = j + 1; i < 6; ++i) {
+        double s = a[index(i, j)];
+        for (int k = 0; k < j; ++k) s -= L[i][k] * LD[j][k];
+        LD[i][j] = s;
+        L[i][j] = s * d_inv[j];
+      }
+    }
+#pragma GCC unroll 6
+    for (int i = 0; i < 6; ++i) {  // L y = b
+      double s = b(i);
+      for (int k = 0; k < i; ++k) s -= L[i][k] * y[k];
+      y[i] = s;
+    }
+#pragma GCC unroll 6
+    for (int i = 5; i >= 0; --i) {  // L^T x = D^-1 y
+      double s = y[i] * d_inv[i];
+      for (int k = i + 1; k < 6; ++k) s -= L[k][i] * x(k);
+      x(i) = s;
+    }
+    return true;
+  }
   Matrix6d toDense() const {
     Matrix6d M;
     for (int r = 0; r < 6; ++r)

@@ -154,6 +154,12 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   RecursiveExIITSolver recursive(model);
   ForwardDynamicsSolver fd(model);
   fd.setGravity(Vector3d(0, 0, -9.81));
+  ForwardDynamicsSolver locked_fd(model);
+  std::vector<bool> locked(n, false);
+  locked[n / 2] = true;
+  ASSERT_EQ(locked_fd.setLocked(locked), E_NOERROR);
+  Kinematics kin(*model);
+  MomentumSolver momentum(model);
   KDL::JntArray qdot(n), tau(n), dqdot(n);
   for (unsigned int j = 0; j < n; ++j) qdot(j) = 0.1 * j, tau(j) = 0.5 - 0.1 * j;
   const KDL::Twist base_twist(KDL::Vector(0.01, 0.02, -0.01), KDL::Vector(0.03, -0.01, 0.02));
@@ -222,6 +228,11 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, Response::Grounded, F, d_base, dqdot), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(state, v, tau, no_wrenches, a), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(other, v, tau, wrenches, a), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(forwardKinematics(*model, other, kin), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(kin, v, tau, wrenches, a), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(locked_fd.CartToJnt(kin, v, tau, no_wrenches, a), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(momentum.compute(kin, v), E_NOERROR));
+  NO_ALLOCATION(EXPECT_EQ(momentum.baseTwist(kin, momentum.momentum(), qdot, t), E_NOERROR));
   NO_ALLOCATION(G = rigidBodyG(20.0, Matrix3d::Identity(), Vector3d(0.1, 0.2, 0.3)));
   NO_ALLOCATION(EXPECT_GT(spectralFigures(G).rank, 0));
   NO_ALLOCATION(EXPECT_GT(virtualMass(G, Vector3d::UnitX()), 0.0));

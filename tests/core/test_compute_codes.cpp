@@ -234,6 +234,27 @@ TEST(ForwardDynamicsCodes, CartToJntChecksEverySizeAndValue) {
   EXPECT_EQ(a.qddot.data, Eigen::VectorXd::Constant(n, kSentinel));
   expectCode(E_NOERROR, state, v, tau, none, a, "good");
 
+  // From a Kinematics: one of another model (even of the same robot), one never computed, one
+  // whose last forwardKinematics failed.
+  const ModelPtr twin = std::make_shared<const FloatingModel>(*model);
+  Kinematics other_model(*twin), never(*model), failed(*model);
+  ASSERT_EQ(forwardKinematics(*twin, state, other_model), E_NOERROR);
+  ASSERT_EQ(forwardKinematics(*model, nan_state, failed), E_NOT_FINITE);
+  a.base.setConstant(kSentinel);
+  a.qddot.data.setConstant(kSentinel);
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(other_model, v, tau, none, a), E_SIZE_MISMATCH));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(never, v, tau, none, a), E_NOT_COMPUTED));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(failed, v, tau, none, a), E_NOT_COMPUTED));
+  Kinematics kin(*model);
+  ASSERT_EQ(forwardKinematics(*model, state, kin), E_NOERROR);
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, nan_tau, none, a), E_NOT_FINITE));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, tau, wrenches, a), E_NOT_FINITE));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, tau, none, small), E_SIZE_MISMATCH));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, huge, none, a), E_NOT_FINITE));
+  EXPECT_EQ(a.base, Vector6d::Constant(kSentinel));
+  EXPECT_EQ(a.qddot.data, Eigen::VectorXd::Constant(n, kSentinel));
+  EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, tau, none, a), E_NOERROR));
+
   EXPECT_EQ(fd.setLocked(std::vector<bool>(n + 1)), E_SIZE_MISMATCH);
   EXPECT_EQ(fd.setGravity(Vector3d(0, 0, kNaN)), E_NOT_FINITE);
   EXPECT_EQ(fd.gravity(), Vector3d::Zero()) << "unchanged after a refusal";
