@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kdl_space/errors.hpp"
+#include "kdl_space/export.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/model.hpp"
 #include "kdl_space/spatial.hpp"
@@ -39,7 +40,7 @@ struct FloatingAcceleration {
 /// Locked joints (brakes on) are fixed joints in steps 2 and 3 (qddot = 0; their torque is
 /// whatever holds them); a locked joint that still moves keeps its velocity product in step 1.
 /// Workspaces are sized in the constructor; CartToJnt allocates nothing and never throws.
-class ForwardDynamicsSolver {
+class KDL_SPACE_EXPORT ForwardDynamicsSolver {
  public:
   explicit ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model);
   ~ForwardDynamicsSolver();

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/momentum.hpp"
@@ -65,7 +66,7 @@ struct SimulationStats {
 /// Each evaluation of the derivative is O(n): one forwardKinematics, the base twist from the
 /// momentum (MomentumSolver::baseTwist) and the articulated-body forward dynamics
 /// (ForwardDynamicsSolver), all reading the same Kinematics; no n x n matrix is built.
-class Simulator {
+class KDL_SPACE_EXPORT Simulator {
  public:
   /// \throws ModelError unless step, rtol, atol, max_step are finite and > 0, max_steps > 0,
   /// gravity finite and the integrator an enumerator.

@@ -183,8 +183,6 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   FloatingSide robot_dense(solver.sharedModel(), solver.state(), h, v, Response::FreeFloating, ExIITMethod::Dense);
   FloatingSide robot_grounded(solver.sharedModel(), solver.state(), h, v, Response::Grounded);
   FloatingSide robot_locked(solver.sharedModel(), solver.state(), h, v, Response::JointsLocked);
-  Kinematics kin(*model);
-  MomentumSolver momentum(model);
   RigidBodySide target(box, p_h);
   const Matrix6d G_B = target.G();
 
