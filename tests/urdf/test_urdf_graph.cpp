@@ -125,10 +125,12 @@ std::string chain(int n, int branch = 0) {
   return xml + "</robot>";
 }
 
-std::vector<std::string> urdfFiles(const std::string& folder) {
+/// Every broken file and every fuzz regression.
+std::vector<std::string> brokenFiles() {
   std::vector<std::string> files;
-  for (const auto& entry : std::filesystem::directory_iterator(folder))
-    if (entry.path().extension() == ".urdf") files.push_back(entry.path().string());
+  for (const std::string folder : {"/broken_urdf", "/fuzz_regressions/urdf"})
+    for (const auto& entry : std::filesystem::directory_iterator(dataDir() + folder))
+      if (entry.path().extension() == ".urdf") files.push_back(entry.path().string());
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -136,10 +138,8 @@ std::vector<std::string> urdfFiles(const std::string& folder) {
 TEST(UrdfGraph, SameWalkFromTheLoadersAndTheCheckersReading) {
   // Every broken file, every fuzz regression: where urdfdom reads the document at all, both
   // readers give the walk the same graph.
-  std::vector<std::string> files = urdfFiles(dataDir() + "/broken_urdf");
-  for (const std::string& f : urdfFiles(dataDir() + "/fuzz_regressions/urdf")) files.push_back(f);
   int compared = 0;
-  for (const std::string& path : files) {
+  for (const std::string& path : brokenFiles()) {
     const std::string xml = readFile(path);
     detail::UrdfDocument doc;
     std::vector<Finding> findings;
@@ -204,10 +204,8 @@ TEST(UrdfGraph, DepthBelowTheRoot) {
 TEST(UrdfGraph, TheLoaderRefusesWhatTheCheckerFindsInTheGraph) {
   // Each graph finding of the checker (roots, loops, missing links, depth) is a refusal of the
   // loader; where urdfdom reads the file, the link the checker names in a loop is the loader's.
-  std::vector<std::string> files = urdfFiles(dataDir() + "/broken_urdf");
-  for (const std::string& f : urdfFiles(dataDir() + "/fuzz_regressions/urdf")) files.push_back(f);
   int graph_problems = 0;
-  for (const std::string& path : files) {
+  for (const std::string& path : brokenFiles()) {
     const UrdfReport r = checkUrdfFile(path);
     std::vector<Finding> graph;
     for (const Finding& f : r.errors)
