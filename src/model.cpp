@@ -5,14 +5,11 @@
 #include "kdl_space/errors.hpp"
 #include "kdl_space/spatial.hpp"
 #include "detail/joint_motion.hpp"
+#include "detail/text.hpp"
 #include "model_rules.hpp"
 
 namespace kdl_space {
 namespace {
-
-bool finite(const KDL::Vector& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
 
 /// Mass, CoM and inertia about the CoM of a KDL inertia (KDL keeps the inertia about the
 /// reference frame's origin).
@@ -26,8 +23,6 @@ void splitInertia(const KDL::RigidBodyInertia& I, Body& body) {
   const Matrix3d C = skew(body.com);
   body.I_com = I_origin + body.mass * C * C;  // parallel-axis theorem, back to the CoM
 }
-
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
@@ -81,7 +76,7 @@ namespace {
 KDL::Tree chainAsTree(const KDL::Chain& chain, const std::string& base_name) {
   KDL::Tree tree(base_name);
   if (!tree.addChain(chain, base_name))
-    throw ModelError("chain: cannot hang the chain on base " + quoted(base_name) +
+    throw ModelError("chain: cannot hang the chain on base " + detail::quoted(base_name) +
                      " (duplicate segment names?)");
   return tree;
 }
@@ -93,7 +88,7 @@ FloatingModel::FloatingModel(const KDL::Chain& chain, const KDL::RigidBodyInerti
 
 namespace {
 [[noreturn]] void fail(const std::string& what, const std::string& name, const std::string& message) {
-  throw ModelError(what + " " + quoted(name) + ": " + message);
+  throw ModelError(what + " " + detail::quoted(name) + ": " + message);
 }
 }  // namespace
 
@@ -118,7 +113,7 @@ void FloatingModel::validate() {
         fail("link", link, "the pose of its frame (joint origin) holds NaN or infinite values");
       if (joint.getType() != KDL::Joint::None) {
         const KDL::Vector axis = joint.JointAxis();
-        if (!finite(axis) || !finite(joint.JointOrigin()) || std::abs(axis.Norm() - 1.0) > 1e-9)
+        if (!allFinite(axis) || !allFinite(joint.JointOrigin()) || std::abs(axis.Norm() - 1.0) > 1e-9)
           fail("joint", joint.getName(), "its axis is zero, NaN or infinite");
       }
     }
@@ -152,8 +147,8 @@ int FloatingModel::bodyIndex(const std::string& name) const {
 
 Contact FloatingModel::contact(const std::string& link, const KDL::Vector& offset) const {
   const int body = bodyIndex(link);
-  if (body < 0) throw ModelError("contact: the model has no link " + quoted(link));
-  if (!finite(offset)) throw ModelError("contact on link " + quoted(link) + ": offset is not finite");
+  if (body < 0) throw ModelError("contact: the model has no link " + detail::quoted(link));
+  if (!allFinite(offset)) throw ModelError("contact on link " + detail::quoted(link) + ": offset is not finite");
   return Contact{body, offset};
 }
 
@@ -180,7 +175,7 @@ void copyChildren(const KDL::Tree& source, KDL::SegmentMap::const_iterator from,
 
 FloatingModel FloatingModel::withPayload(const std::string& link, const KDL::RigidBodyInertia& inertia) const {
   const int body = bodyIndex(link);
-  if (body < 0) throw ModelError("payload: the model has no link " + quoted(link));
+  if (body < 0) throw ModelError("payload: the model has no link " + detail::quoted(link));
   // Rebuild the tree with the payload in the link's segment (the base's inertia lives apart).
   const KDL::SegmentMap::const_iterator root = tree_.getRootSegment();
   KDL::Tree tree(root->first);

@@ -7,18 +7,15 @@
 #include <cmath>
 #include <sstream>
 
-namespace kdl_space::rules {
-namespace {
+#include "detail/text.hpp"
 
-std::string named(const std::string& s) { return "'" + s + "'"; }
+namespace kdl_space::rules {
 
 std::string number(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
 }
-
-}  // namespace
 
 Finding error(std::string kind, ElementType type, std::string element, std::string message) {
   return {Severity::Error, std::move(kind), type, std::move(element), std::move(message)};
@@ -142,8 +139,8 @@ void checkMassDistribution(const std::vector<MassNode>& nodes, Findings& out) {
     if (n.mass != 0.0) continue;  // massive, or unknown (NaN)
     if (n.movable && subtree[i] == 0.0) {
       out.push_back(error("non_positive_mass", ElementType::Link, n.link,
-                          "massless, and joint " + named(n.joint) + " moves only massless links (" +
-                              named(n.link) + " and below): that joint has no inertia and H* is "
+                          "massless, and joint " + detail::quoted(n.joint) + " moves only massless links (" +
+                              detail::quoted(n.link) + " and below): that joint has no inertia and H* is "
                               "singular; give the link its mass, or make the joint fixed"));
     } else {
       out.push_back(warning("massless_link", ElementType::Link, n.link,

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/urdf_check.hpp"
+#include "kdl_space/diagnostics.hpp"
 
 namespace kdl_space::rules {
 
@@ -15,6 +15,9 @@ using Findings = std::vector<Finding>;
 
 Finding error(std::string kind, ElementType type, std::string element, std::string message);
 Finding warning(std::string kind, ElementType type, std::string element, std::string message);
+
+/// A number as the findings print it (the stream's default: 6 significant digits).
+std::string number(double v);
 
 /// \brief What an inertia about a CoM is: its principal moments (ascending) and the first rule
 /// it breaks. The one test of links, rigid targets and payloads; each caller words the verdict.

@@ -4,19 +4,17 @@
 #include <kdl_parser/kdl_parser.hpp>
 #include <urdf_parser/urdf_parser.h>
 
-#include <cmath>
 #include <fstream>
 #include <mutex>
-#include <set>
 #include <sstream>
 
 #include "kdl_space/errors.hpp"
+#include "detail/text.hpp"
 #include "model_rules.hpp"
+#include "urdf_graph.hpp"
 
 namespace kdl_space {
 namespace {
-
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
 /// Collects urdfdom's console_bridge messages instead of letting them reach stderr.
 class CapturedLog : public console_bridge::OutputHandler {
@@ -91,18 +89,24 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
   std::vector<Diagnostic> diagnostics;
   auto fail = [&](const std::string& what) -> void { throw ModelError(source + ": " + what); };
 
+  // The links and joints as a graph, walked as the checker walks them (urdf_graph.hpp). urdfdom
+  // refuses several roots and none; it accepts a link with several parents, and cycles no root
+  // reaches.
+  const detail::LinkGraph graph = detail::linkGraph(*model);
+  const std::vector<int> roots = graph.roots();
+  if (roots.empty()) fail("no root link");
+
   // The base: the root link, or the child of a floating joint hanging from a massless root.
-  urdf::LinkConstSharedPtr base = model->getRoot();
-  if (!base) fail("no root link");
-  const urdf::LinkConstSharedPtr root = base;
+  const urdf::LinkConstSharedPtr root = model->getLink(graph.link(roots.front()));
+  urdf::LinkConstSharedPtr base = root;
   std::string dropped_joint;
   if (rules::dropsRootJoint(!root->inertial || root->inertial->mass == 0.0, root->child_joints.size(),
                             root->child_joints.empty() ? "" : typeName(*root->child_joints[0]))) {
     const urdf::JointSharedPtr& free_joint = root->child_joints[0];
     dropped_joint = free_joint->name;
     diagnostics.push_back(
-        {free_joint->name, "floating joint from the massless root " + quoted(root->name) +
-                               " dropped: link " + quoted(free_joint->child_link_name) +
+        {free_joint->name, "floating joint from the massless root " + detail::quoted(root->name) +
+                               " dropped: link " + detail::quoted(free_joint->child_link_name) +
                                " is the free-floating base"});
     base = model->getLink(free_joint->child_link_name);
   }
@@ -119,22 +123,16 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
       rules::checkLimits(name, joint->limits->lower, joint->limits->upper, findings);
   }
   if (base == root) rules::checkRootInertia(root->name, root->inertial != nullptr, findings);
-  // Depth below the base, breadth first (no recursion: the depth is what is being checked), and
-  // links reached twice: urdfdom accepts a link with several parent joints.
-  std::vector<std::pair<urdf::LinkConstSharedPtr, int>> level{{base, 0}};
-  std::set<std::string> reached{base->name};
-  for (std::size_t i = 0; i < level.size() && !rules::firstError(findings); ++i) {
-    rules::checkDepth(level[i].first->name, level[i].second, findings);
-    for (const urdf::LinkSharedPtr& child : level[i].first->child_links) {
-      if (!reached.insert(child->name).second) {
-        findings.push_back(rules::error("loop", ElementType::Link, child->name,
-                                        "reached twice from the base: its joints close a loop, and a URDF "
-                                        "describes a tree"));
-        break;
-      }
-      level.push_back({child, level[i].second + 1});
-    }
-  }
+  // Below the base, breadth first: the problem nearest the base, a link reached twice (its joints
+  // close a loop) or the first link too deep.
+  const detail::Walk below = graph.walk(graph.find(base->name), detail::WalkOrder::BreadthFirst);
+  const int deep = detail::firstDeeperThan(below, rules::kMaxTreeDepth);
+  if (below.reached_twice >= 0 && (deep < 0 || below.reached_twice_from < deep))
+    findings.push_back(rules::error("loop", ElementType::Link, graph.link(below.reached_twice),
+                                    "reached twice from the base: its joints close a loop, and a URDF "
+                                    "describes a tree"));
+  else if (deep >= 0)
+    rules::checkDepth(graph.link(below.steps[deep].link), below.steps[deep].depth, findings);
   if (const Finding* e = rules::firstError(findings)) fail(describe(*e));
   for (const Finding& f : findings) diagnostics.push_back({f.element, f.message});
 
@@ -146,10 +144,10 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
   KDL::Tree tree;
   if (!kdl_parser::treeFromUrdfModel(*for_kdl, tree)) fail("kdl_parser could not build a KDL tree");
   // urdfdom accepts joints that form a loop no root reaches (e.g. a joint whose parent is its own
-  // child); kdl_parser, walking from the base, would leave those links out silently.
-  for (const auto& [name, link] : model->links_)
-    if (name != root->name && !tree.getSegments().count(name))
-      fail("link " + quoted(name) + " is not connected to the base " + quoted(base->name) +
+  // child); kdl_parser, walking from the base, leaves the links the walk did not reach out silently.
+  for (int l = 0; l < graph.size(); ++l)
+    if (!below.reached[l] && graph.link(l) != root->name)
+      fail("link " + detail::quoted(graph.link(l)) + " is not connected to the base " + detail::quoted(base->name) +
            ": its joints form a loop (a URDF describes a tree)");
 
   try {

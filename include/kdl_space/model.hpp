@@ -11,19 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/diagnostics.hpp"
 #include "kdl_space/export.hpp"
 
 namespace kdl_space {
 namespace detail {
 struct MotionTable;  // src/detail/joint_motion.hpp
 }
-
-/// A problem that does not stop the computation (a massless link, a root inertia kdl_parser
-/// would have dropped, a dropped floating joint). The library never prints: callers read these.
-struct Diagnostic {
-  std::string element;  ///< the link or joint concerned ("" for the model as a whole)
-  std::string message;  ///< what was found and what the model does about it
-};
 
 /// One rigid link of the model, in traversal order (a parent always precedes its children).
 struct Body {

@@ -5,39 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include "kdl_space/diagnostics.hpp"
+
 namespace kdl_space {
-
-/// Whether a finding stops the model from being used (error) or only deserves attention.
-enum class Severity { Error, Warning };
-
-/// What `Finding::element` names.
-enum class ElementType {
-  File,   ///< the file as a whole (`element` is empty)
-  Robot,  ///< the <robot> element (`element` is the robot's name)
-  Link,
-  Joint,
-  Tip,    ///< a contact link asked for by the caller
-};
-
-/// \brief One problem found in a URDF description.
-struct Finding {
-  Severity severity = Severity::Error;
-  /// A short, stable, machine-readable identifier: `not_xml`, `not_urdf`, `malformed`,
-  /// `duplicate_name`, `unknown_joint_type`, `no_root`, `several_roots`, `loop`,
-  /// `missing_link`, `free_joint_inside`, `non_positive_mass`, `inertia_not_positive_definite`,
-  /// `triangle_inequality`, `not_finite`, `bad_number`, `zero_axis`, `unknown_tip`,
-  /// `base_without_mass`, `too_deep`, `singular_inertia`, `unreadable`, `refused_by_loader` (errors);
-  /// `root_inertia_dropped_by_kdl_parser`, `massless_link`, `axis_not_unit`,
-  /// `limits_exclude_zero`, `mass_ratio` (warnings).
-  std::string kind;
-  ElementType element_type = ElementType::File;
-  std::string element;  ///< link, joint or tip name; the robot's name; "" for the file
-  std::string message;  ///< what is wrong and, where it helps, what to do; without the element
-};
-
-/// The element and the message in one line: "link 'forearm': inertia is not positive definite
-/// (...)"; only the message for a finding about the file as a whole.
-std::string describe(const Finding& finding);
 
 /// \brief Figures of the model, as far as the file could be read.
 struct ModelSummary {
