@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "kdl_space/export.hpp"
+
 namespace kdl_space {
 
 /// Whether a finding stops the model from being used (error) or only deserves attention.
@@ -37,7 +39,7 @@ struct Finding {
 
 /// The element and the message in one line: "link 'forearm': inertia is not positive definite
 /// (...)"; only the message for a finding about the file as a whole.
-std::string describe(const Finding& finding);
+KDL_SPACE_EXPORT std::string describe(const Finding& finding);
 
 /// A problem that does not stop the computation (a massless link, a root inertia kdl_parser
 /// would have dropped, a dropped floating joint). The library never prints: callers read these.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kdl_space/diagnostics.hpp"
+#include "kdl_space/export.hpp"
 
 namespace kdl_space {
 
@@ -50,10 +51,10 @@ struct UrdfReport {
 /// The rules are the ones loadUrdfFile applies (one implementation): a file without errors
 /// loads. Never throws (beyond std::bad_alloc) and never prints.
 /// \param tips contact links to check and to compute G* at.
-UrdfReport checkUrdfFile(const std::string& path, const std::vector<std::string>& tips = {});
+KDL_SPACE_EXPORT UrdfReport checkUrdfFile(const std::string& path, const std::vector<std::string>& tips = {});
 
 /// Same as checkUrdfFile for a URDF document in memory; `source` names it in the report.
-UrdfReport checkUrdfString(const std::string& xml, const std::string& source = "<urdf string>",
+KDL_SPACE_EXPORT UrdfReport checkUrdfString(const std::string& xml, const std::string& source = "<urdf string>",
                            const std::vector<std::string>& tips = {});
 
 }  // namespace kdl_space

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/model.hpp"
 
 namespace kdl_space {
@@ -16,9 +17,9 @@ namespace kdl_space {
 /// captured into the error or the diagnostics. The rules are checkUrdfFile's (urdf_check.hpp),
 /// which reports every problem of a file at once; this throws at the first.
 /// \throws ModelError whose message starts with the file name and names the link or joint.
-FloatingModel loadUrdfFile(const std::string& path);
+KDL_SPACE_EXPORT FloatingModel loadUrdfFile(const std::string& path);
 
 /// Same as loadUrdfFile for a URDF document in memory; `source` names it in messages.
-FloatingModel loadUrdfString(const std::string& xml, const std::string& source = "<urdf string>");
+KDL_SPACE_EXPORT FloatingModel loadUrdfString(const std::string& xml, const std::string& source = "<urdf string>");
 
 }  // namespace kdl_space
