@@ -1,6 +1,5 @@
 #include "kdl_space/forward_dynamics.hpp"
 
-#include "detail/joint_motion.hpp"
 #include "detail/multiversion.hpp"
 #include "detail/symmetric6d.hpp"
 
@@ -13,6 +12,10 @@ namespace kdl_space {
 // still base) and enter the bias forces p_i = I_i a_i + V_i x* I_i V_i - f_ext; the unknowns are
 // then A_i - a_i, whose recursion has no velocity term (so the inward pass needs no I^A c).
 struct ForwardDynamicsSolver::BodyData {
+  // The topology, beside the numbers (every pass reads it; the model's per-body records are large)
+  int parent = -1, joint = -1;     ///< as Body
+  bool moving = false;             ///< a movable joint whose brakes are off
+  double mass = 0.0;               ///< [kg]
   detail::Symmetric6d IA;          ///< articulated inertia I^A
   Vector6d V = Vector6d::Zero();   ///< twist
   Vector6d a = Vector6d::Zero();   ///< outward: bias acceleration a_i; last pass: A_i - a_i
@@ -49,10 +52,15 @@ ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel
   if (!model_) throw ModelError("ForwardDynamicsSolver: null model");
   const std::size_t nb = model_->bodies().size();
   locked_.assign(model_->nj(), false);
-  moving_.resize(nb);
-  for (std::size_t i = 0; i < nb; ++i) moving_[i] = model_->bodies()[i].joint >= 0;
   own_ = Kinematics(*model_);
   data_.resize(nb);
+  for (std::size_t i = 0; i < nb; ++i) {
+    const Body& b = model_->bodies()[i];
+    data_[i].parent = b.parent;
+    data_[i].joint = b.joint;
+    data_[i].moving = b.joint >= 0;
+    data_[i].mass = b.mass;
+  }
   qddot_.setZero(model_->nj());
 }
 
@@ -63,8 +71,7 @@ ForwardDynamicsSolver& ForwardDynamicsSolver::operator=(const ForwardDynamicsSol
 int ForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
   if (locked.size() != model_->nj()) return E_SIZE_MISMATCH;
   locked_ = locked;
-  const std::vector<Body>& bodies = model_->bodies();
-  for (std::size_t i = 0; i < bodies.size(); ++i) moving_[i] = bodies[i].joint >= 0 && !locked_[bodies[i].joint];
+  for (BodyData& b : data_) b.moving = b.joint >= 0 && !locked_[b.joint];
   return E_NOERROR;
 }
 
@@ -78,8 +85,7 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
                                                             const KDL::JntArray& tau,
                                                             const std::vector<KDL::Wrench>& f_ext,
                                                             FloatingAcceleration& acceleration) {
-  const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
-  const std::size_t nb = bodies.size();
+  const std::size_t nb = data_.size();
   const unsigned int n = model_->nj();
   if (kin.model != model_.get() || kin.R.size() != nb || velocity.qdot.rows() != n || tau.rows() != n ||
       acceleration.qddot.rows() != n || (!f_ext.empty() && f_ext.size() != nb))
@@ -95,15 +101,14 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
   // 1. Outward: twists, bias accelerations, rigid-body inertias and bias forces (Table 7.1's
   // first loop; the base's twist is given, its bias acceleration is zero).
   for (std::size_t i = 0; i < nb; ++i) {
-    const detail::JointMotion& j = bodies[i];
     BodyData& b = data_[i];
-    if (j.parent < 0) {
+    if (b.parent < 0) {
       b.V = toEigen(velocity.base_twist);
       b.a.setZero();
     } else {
-      const BodyData& parent = data_[j.parent];
-      if (j.joint >= 0) {
-        const Vector6d Sqd = kin.S[i] * qdot[j.joint];
+      const BodyData& parent = data_[b.parent];
+      if (b.joint >= 0) {
+        const Vector6d Sqd = kin.S[i] * qdot[b.joint];
         b.V = parent.V + Sqd;
         b.a = parent.a + crossMotion(parent.V, Sqd);  // c_i = V_parent x S qdot (= V_i x S qdot)
       } else {
@@ -111,17 +116,18 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
         b.a = parent.a;
       }
     }
-    b.IA.setZero();
-    b.pA.setZero();
-    if (j.mass > 0.0) {  // else a frame: no inertia
+    if (b.mass > 0.0) {  // else a frame: no inertia
       const Vector3d c = kin.com[i] - p_b;
       const Matrix3d& I_c = kin.I_com[i];
-      b.IA.addRigidBody(j.mass, c, I_c);
-      const Vector6d h = rigidTimes(j.mass, c, I_c, b.V);  // momentum I V
+      b.IA.setRigidBody(b.mass, c, I_c);
+      const Vector6d h = rigidTimes(b.mass, c, I_c, b.V);  // momentum I V
       const Vector3d w = b.V.tail<3>();
-      b.pA = rigidTimes(j.mass, c, I_c, b.a);
+      b.pA = rigidTimes(b.mass, c, I_c, b.a);
       b.pA.head<3>() += w.cross(h.head<3>());  // V x* I V
       b.pA.tail<3>() += w.cross(h.tail<3>()) + b.V.head<3>().cross(h.head<3>());
+    } else {
+      b.IA.setZero();
+      b.pA.setZero();
     }
     if (!f_ext.empty()) {
       const Vector3d f = toEigen(f_ext[i].force);
@@ -133,20 +139,19 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
   // 2. Inward: articulated inertias and bias forces (Table 7.1's second loop, c = 0 here). A
   // fixed or locked joint passes its body's on whole.
   for (std::size_t i = nb; i-- > 1;) {
-    const detail::JointMotion& j = bodies[i];
     BodyData& b = data_[i];
-    BodyData& parent = data_[j.parent];
-    if (!moving_[i]) {
+    BodyData& parent = data_[b.parent];
+    if (!b.moving) {
       parent.IA += b.IA;
       parent.pA += b.pA;
       continue;
     }
     const Vector6d& S = kin.S[i];
     b.U = b.IA * S;
-    const double D = S.dot(b.U) + armature[j.joint];
+    const double D = S.dot(b.U) + armature[b.joint];
     if (!(D > 0.0)) return E_NOT_POSITIVE_DEFINITE;
     b.D_inv = 1.0 / D;
-    b.u = tau(j.joint) - S.dot(b.pA);
+    b.u = tau(b.joint) - S.dot(b.pA);
     parent.IA.addMinusRank1(b.IA, b.U, b.D_inv);
     parent.pA += b.pA + b.U * (b.u * b.D_inv);
   }
@@ -157,15 +162,14 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
   if (!data_[0].IA.solve(-data_[0].pA, A0)) return E_NOT_POSITIVE_DEFINITE;
   data_[0].a = A0;
   for (std::size_t i = 1; i < nb; ++i) {
-    const detail::JointMotion& j = bodies[i];
     BodyData& b = data_[i];
-    const Vector6d& a_parent = data_[j.parent].a;
-    if (moving_[i]) {
+    const Vector6d& a_parent = data_[b.parent].a;
+    if (b.moving) {
       const double qdd = (b.u - b.U.dot(a_parent)) * b.D_inv;
-      qddot_(j.joint) = qdd;
+      qddot_(b.joint) = qdd;
       b.a = a_parent + kin.S[i] * qdd;
     } else {
-      if (j.joint >= 0) qddot_(j.joint) = 0.0;  // brakes on
+      if (b.joint >= 0) qddot_(b.joint) = 0.0;  // brakes on
       b.a = a_parent;
     }
   }

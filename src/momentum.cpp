@@ -2,6 +2,9 @@
 
 #include <Eigen/Cholesky>
 
+#include "detail/joint_motion.hpp"
+#include "detail/multiversion.hpp"
+
 namespace kdl_space {
 
 MomentumSolver::MomentumSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
@@ -12,16 +15,14 @@ MomentumSolver::MomentumSolver(std::shared_ptr<const FloatingModel> model) : mod
   p_.assign(nb, Vector3d::Zero());
 }
 
-void MomentumSolver::sweep(const Kinematics& kin, const Vector6d& V_b, const Eigen::VectorXd& qdot, Vector6d& h_b,
-                           double& twoT) {
-  const std::vector<Body>& bodies = model_->bodies();
-  h_b.setZero();
-  twoT = 0.0;
-  I_tot_.setZero();
-  Vector3d first_moment = Vector3d::Zero();
-  Matrix3d I_b = Matrix3d::Zero();  // rotational inertia about p_b
+KDL_SPACE_MULTIVERSION void MomentumSolver::sweep(const Kinematics& kin, const Vector6d& V_b, const Eigen::VectorXd& qdot,
+                                                  Vector6d& h_b, double& twoT) {
+  const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
+  Vector3d P_sum = Vector3d::Zero(), L_sum = Vector3d::Zero(), first_moment = Vector3d::Zero();
+  Matrix3d I_sum = Matrix3d::Zero(), mrr = Matrix3d::Zero();  // sum_i I_i, sum_i m_i r_i r_i^T
+  double energy = 0.0, mr2 = 0.0;                               // 2 T, sum_i m_i |r_i|^2
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    const Body& b = bodies[i];
+    const detail::JointMotion& b = bodies[i];
     if (b.parent < 0) V_[i] = V_b;
     else V_[i] = b.joint >= 0 ? Vector6d(V_[b.parent] + kin.S[i] * qdot(b.joint)) : V_[b.parent];
     if (!(b.mass > 0.0)) continue;  // a frame-only link
@@ -30,17 +31,23 @@ void MomentumSolver::sweep(const Kinematics& kin, const Vector6d& V_b, const Eig
     const Vector3d v_c = V_[i].head<3>() + w.cross(r);  // CoM velocity
     const Vector3d P = b.mass * v_c;
     const Vector3d Iw = kin.I_com[i] * w;
-    h_b.head<3>() += P;
-    h_b.tail<3>() += Iw + r.cross(P);  // about p_b
-    twoT += b.mass * v_c.squaredNorm() + w.dot(Iw);
-    first_moment += b.mass * r;
-    I_b += kin.I_com[i] + b.mass * (r.squaredNorm() * Matrix3d::Identity() - r * r.transpose());
+    P_sum += P;
+    L_sum += Iw + r.cross(P);  // about p_b
+    energy += P.dot(v_c) + w.dot(Iw);
+    const Vector3d mr = b.mass * r;
+    first_moment += mr;
+    mr2 += mr.dot(r);
+    mrr.noalias() += mr * r.transpose();
+    I_sum += kin.I_com[i];
   }
-  // sum_i I_i about p_b (spatialInertia's blocks): [[w E, -skew(c)], [skew(c), I_b]], c = first moment
+  h_b << P_sum, L_sum;
+  twoT = energy;
+  // sum_i I_i about p_b (spatialInertia's blocks): [[w E, -skew(c)], [skew(c), I_b]], c = first
+  // moment, I_b = sum_i (I_i + m_i (|r_i|^2 E - r_i r_i^T)) (parallel axes)
   I_tot_.topLeftCorner<3, 3>() = model_->totalMass() * Matrix3d::Identity();
   I_tot_.topRightCorner<3, 3>() = -skew(first_moment);
   I_tot_.bottomLeftCorner<3, 3>() = skew(first_moment);
-  I_tot_.bottomRightCorner<3, 3>() = I_b;
+  I_tot_.bottomRightCorner<3, 3>() = I_sum + mr2 * Matrix3d::Identity() - mrr;
 }
 
 int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {

@@ -127,8 +127,8 @@ int RecursiveExIITSolver::velocityJump(const Contact& h, const Vector6d& F, Vect
   return velocityJump(h, Response::FreeFloating, F, d_base_twist, dqdot);
 }
 
-int RecursiveExIITSolver::velocityJump(const Contact& h, Response response, const Vector6d& F,
-                                       Vector6d& d_base_twist, KDL::JntArray& dqdot) {
+KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, Response response, const Vector6d& F,
+                                                              Vector6d& d_base_twist, KDL::JntArray& dqdot) {
   if (const int rc = ready(h)) return rc;
   if (response != Response::FreeFloating && response != Response::Grounded) return E_BAD_ARGUMENT;
   if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;

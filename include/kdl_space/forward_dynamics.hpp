@@ -76,13 +76,13 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
 
  private:
-  /// Per body: the articulated-body recursion's data (world axes, about p_b).
+  /// Per body: its parent, joint and mass, and the articulated-body recursion's data (world
+  /// axes, about p_b).
   struct BodyData;
 
   std::shared_ptr<const FloatingModel> model_;
   Vector3d gravity_ = Vector3d::Zero();
   std::vector<bool> locked_;
-  std::vector<char> moving_;       ///< per body: 1 if its joint is movable and not locked
   Kinematics own_;                 ///< for CartToJnt(State) only
   std::vector<BodyData> data_;     ///< per body
   Eigen::VectorXd qddot_;          ///< joint accelerations before they are returned (n)

@@ -56,6 +56,20 @@ struct Symmetric6d {
     a[19] += I_c(2, 1) - my * c.z();
     a[20] += I_c(2, 2) + mx * c.x() + my * c.y();
   }
+  /// The spatial inertia of one rigid body (as addRigidBody), replacing the contents.
+  void setRigidBody(double m, const Vector3d& c, const Matrix3d& I_c) {
+    const double mx = m * c.x(), my = m * c.y(), mz = m * c.z();
+    a[0] = m, a[1] = 0.0, a[2] = m, a[3] = 0.0, a[4] = 0.0, a[5] = m;  // m E
+    a[6] = 0.0, a[7] = -mz, a[8] = my;                                 // m skew(c)
+    a[10] = mz, a[11] = 0.0, a[12] = -mx;
+    a[15] = -my, a[16] = mx, a[17] = 0.0;
+    a[9] = I_c(0, 0) + my * c.y() + mz * c.z();                        // I_c + m (|c|^2 E - c c^T)
+    a[13] = I_c(1, 0) - mx * c.y();
+    a[14] = I_c(1, 1) + mx * c.x() + mz * c.z();
+    a[18] = I_c(2, 0) - mx * c.z();
+    a[19] = I_c(2, 1) - my * c.z();
+    a[20] = I_c(2, 2) + mx * c.x() + my * c.y();
+  }
   /// \brief The inverse, from the root-free Cholesky factors A = L D L^T (L unit lower
   /// triangular; no pivoting, as for any symmetric positive definite matrix):
   /// A^-1 = X^T D^-1 X with X = L^-1. \return false, `inverse` unspecified, when a pivot is not

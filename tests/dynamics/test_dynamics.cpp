@@ -1,7 +1,8 @@
-// Free-floating forward dynamics (ForwardDynamicsSolver::CartToJnt) against the INDEPENDENT
-// virtual-joint route (virtual_joint_route.hpp): the floating system as a grounded KDL tree with
-// six virtual joints TransX, TransY, TransZ, RotX, RotY, RotZ in front of the base, evaluated by
-// KDL's solvers only:
+// Free-floating forward dynamics (ForwardDynamicsSolver::CartToJnt, the articulated-body
+// algorithm; test_articulated_body.cpp compares it with the composite-rigid-body route) against
+// the INDEPENDENT virtual-joint route (virtual_joint_route.hpp): the floating system as a
+// grounded KDL tree with six virtual joints TransX, TransY, TransZ, RotX, RotY, RotZ in front of
+// the base, evaluated by KDL's solvers only:
 //   M_full  from VirtualJointTree (TreeIdSolver_RNE, unit accelerations),
 //   c       from KDL::TreeIdSolver_RNE with the virtual joint rates, zero accelerations, the
 //           gravity vector and the external wrenches (KDL's WrenchMap),

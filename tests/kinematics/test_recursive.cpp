@@ -242,7 +242,7 @@ INSTANTIATE_TEST_SUITE_P(RecursiveModels, RecursiveBundled, ::testing::ValuesIn(
 // --- Random trees ----------------------------------------------------------------------------
 
 // The packed symmetric 6x6 of the recursions against the dense spatial algebra it replaces.
-TEST(Symmetric6d, AgreesWithDenseAlgebra) {
+TEST(Symmetric6d, AgreesWithDenseAlgebra) {  // also what the forward dynamics uses: setRigidBody, solve
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1.0, 1.0);
   for (int trial = 0; trial < 50; ++trial) {
@@ -267,6 +267,10 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     D.bottomRightCorner<3, 3>() = Eigen::Map<const Matrix3d>(rb.getRotationalInertia().data);
     EXPECT_LT((S.toDense() - D).norm(), 1e-14 * D.norm()) << "addRigidBody";
     EXPECT_LT((S * x - D * x).norm(), 1e-14 * D.norm() * x.norm()) << "product";
+    detail::Symmetric6d set;
+    for (double& a : set.a) a = std::nan("");  // every number replaced
+    set.setRigidBody(m, c, I_c);
+    for (int k = 0; k < 21; ++k) EXPECT_EQ(set.a[k], S.a[k]) << "setRigidBody, packed element " << k;
     S += S;
     D += D;
     detail::Symmetric6d other;  // another rigid body
@@ -288,17 +292,23 @@ TEST(Symmetric6d, AgreesWithDenseAlgebra) {
     const Matrix6d expected = ldlt.solve(Matrix6d::Identity());
     EXPECT_LT((P_inv.toDense() - expected).norm(), 1e-12 * expected.norm()) << "invert";
     EXPECT_LT((P_dense * P_inv.toDense() - Matrix6d::Identity()).norm(), 1e-12 * P_dense.norm() * expected.norm());
+    Vector6d solution;
+    ASSERT_TRUE(P.solve(x, solution));
+    EXPECT_LT((solution - ldlt.solve(x)).norm(), 1e-12 * expected.norm() * x.norm()) << "solve";
     const Vector6d e = Vector6d::Unit(trial % 6);
     detail::Symmetric6d zero;
     zero.setZero();
     P.addMinusRank1(zero, e, 2.0 / expected(trial % 6, trial % 6));  // e^T P^-1 e = 1/(that): crosses zero
     EXPECT_FALSE(P.invert(P_inv)) << "not positive definite";
+    EXPECT_FALSE(P.solve(x, solution)) << "not positive definite";
   }
   detail::Symmetric6d nan, out;
   nan.setZero();
   nan.addRigidBody(1.0, Vector3d::Zero(), Matrix3d::Identity());
   nan.a[detail::Symmetric6d::index(4, 2)] = std::nan("");
   EXPECT_FALSE(nan.invert(out));
+  Vector6d x;
+  EXPECT_FALSE(nan.solve(Vector6d::Ones(), x));
 }
 
 TEST(RecursiveRandomTrees, GeneratorCoversTheCases) {
