@@ -17,6 +17,14 @@ std::shared_ptr<const FloatingModel> checkedModel(std::shared_ptr<const Floating
   if (!model) refuse("null model");
   return model;
 }
+
+/// The kinematics of `state`, or a ModelError naming the state.
+Kinematics kinematicsAt(const FloatingModel* model, const State& state) {
+  if (!model) refuse("null model");
+  Kinematics kin(*model);
+  if (const int rc = forwardKinematics(*model, state, kin)) refuse("the state", rc);
+  return kin;
+}
 }  // namespace
 
 FloatingSide::FloatingSide(const FloatingSystem& s, ExIITMethod method)
@@ -26,8 +34,12 @@ FloatingSide::~FloatingSide() = default;
 
 FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
                            const FloatingVelocity& before, Response response, ExIITMethod method)
+    : FloatingSide(model, kinematicsAt(model.get(), state), h, before, response, method) {}
+
+FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
+                           const FloatingVelocity& before, Response response, ExIITMethod method)
     : model_(checkedModel(std::move(model))),
-      kin_(*model_),
+      kin_(std::move(kin)),
       momentum_(model_),
       h_(h),
       response_(response),
@@ -46,7 +58,8 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const Sta
     refuse("the method is not one of Recursive, Dense");
   if (h_.body < 0 || h_.body >= static_cast<int>(model_->bodies().size())) refuse("contact point", E_BAD_CONTACT);
   if (!allFinite(h_.offset)) refuse("contact point", E_NOT_FINITE);
-  if (const int rc = forwardKinematics(*model_, state, kin_)) refuse("the state", rc);
+  if (kin_.model != model_.get() || kin_.R.size() != model_->bodies().size()) refuse("the kinematics", E_SIZE_MISMATCH);
+  if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::Grounded) {
     // The grounded base does not move, whatever twist was given.
     before_.base_twist = after_.base_twist = trial_.base_twist = KDL::Twist::Zero();

@@ -79,6 +79,12 @@ class FloatingSide : public ImpactSide {
   FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
                const FloatingVelocity& before, Response response = Response::FreeFloating,
                ExIITMethod method = ExIITMethod::Recursive);
+  /// \brief The same from the kinematics of the side's state, already computed by
+  /// forwardKinematics for `model` (the side keeps them: it owns its state). \throws ModelError
+  /// as above, or if `kin` is not a successful forwardKinematics of `model`.
+  FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
+               const FloatingVelocity& before, Response response = Response::FreeFloating,
+               ExIITMethod method = ExIITMethod::Recursive);
   explicit FloatingSide(const FloatingSystem& system, ExIITMethod method = ExIITMethod::Recursive);
   ~FloatingSide() override;
 
