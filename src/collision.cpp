@@ -95,9 +95,7 @@ int FloatingSide::applyImpulse(const Vector6d& F) {
   trial_.qdot.data = before_.qdot.data;
   if (response_ == Response::JointsLocked) {
     // One rigid body: the momentum changes by the impulse (eq. 21), the joints stay still.
-    Vector6d h = h_before_;
-    h.head<3>() += F.head<3>();
-    h.tail<3>() += F.tail<3>() + kin_.point(h_).cross(Vector3d(F.head<3>()));  // moment about the origin
+    const Vector6d h = h_before_ + shiftMomentum(F, -kin_.point(h_));  // its moment about the origin
     if (const int rc = momentum_.baseTwist(kin_, h, trial_.qdot, trial_.base_twist)) return rc;
   } else {
     const int rc = recursive_ ? recursive_->velocityJump(h_, response_, F, d_base_, dqdot_)
@@ -155,10 +153,9 @@ int RigidBodySide::applyImpulse(const Vector6d& F) {
 }
 
 Vector6d RigidBodySide::momentum(const Vector6d& twist) const {
-  Vector6d m;
-  m.head<3>() = body_.mass * twist.head<3>();
-  m.tail<3>() = body_.I_com * twist.tail<3>() + body_.com.cross(m.head<3>());
-  return m;
+  Vector6d m;  // (P; L about the CoM), then L about the origin: L_O = L_c + c x P
+  m << body_.mass * twist.head<3>(), body_.I_com * twist.tail<3>();
+  return shiftMomentum(m, -body_.com);
 }
 
 double RigidBodySide::energy(const Vector6d& twist) const {

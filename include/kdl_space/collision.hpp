@@ -64,9 +64,9 @@ struct FloatingSystem {
 
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
 ///
-/// The side owns what it answers from: the model (shared), its state and velocity, and its own
-/// solvers and kinematics, computed once in the constructor; nothing a caller does later can
-/// make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
+/// The side owns what it answers from: the model (shared), its state and velocity, its
+/// kinematics (computed in the constructor, or handed to it) and its own solvers, computed once
+/// in the constructor; nothing a caller does later can make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
 /// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
 /// energy and twists by MomentumSolver; no n x n matrix is built. ExIITMethod::Dense uses the
 /// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
