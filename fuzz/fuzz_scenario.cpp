@@ -1,6 +1,6 @@
-// libFuzzer target: scenario text (YAML or JSON) -> kdl_space::cli::loadScenario, the parser
-// of `kdl_space capture` and `simulate` (tools/scenario.cpp, linked in).
-// Expected outcomes: a scenario, or kdl_space::cli::InputError naming the file and the field
+// libFuzzer target: scenario text (YAML or JSON) -> kdl_space::loadScenario, the library's
+// loader that `kdl_space capture` and `simulate` call.
+// Expected outcomes: a scenario, or kdl_space::InputError naming the file and the field
 // (scenario.hpp's contract). Anything else -- a crash, another exception, a sanitizer report, a
 // hang -- is a bug. Built by KDL_SPACE_FUZZ=ON, run by tools/fuzz.sh on fuzz/corpus/scenario/.
 //
@@ -17,8 +17,7 @@
 #include <iostream>
 #include <string>
 
-#include "cli_common.hpp"
-#include "scenario.hpp"
+#include "kdl_space/scenario.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -57,8 +56,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   try {
-    kdl_space::cli::loadScenario(g_input);
-  } catch (const kdl_space::cli::InputError&) {
+    kdl_space::loadScenario(g_input);
+  } catch (const kdl_space::InputError&) {
     // A refused scenario: the expected outcome for most inputs.
   }
   return 0;

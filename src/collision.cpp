@@ -17,6 +17,14 @@ std::shared_ptr<const FloatingModel> checkedModel(std::shared_ptr<const Floating
   if (!model) refuse("null model");
   return model;
 }
+
+/// The kinematics of `state`, or a ModelError naming the state.
+Kinematics kinematicsAt(const FloatingModel* model, const State& state) {
+  if (!model) refuse("null model");
+  Kinematics kin(*model);
+  if (const int rc = forwardKinematics(*model, state, kin)) refuse("the state", rc);
+  return kin;
+}
 }  // namespace
 
 FloatingSide::FloatingSide(const FloatingSystem& s, ExIITMethod method)
@@ -26,8 +34,12 @@ FloatingSide::~FloatingSide() = default;
 
 FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
                            const FloatingVelocity& before, Response response, ExIITMethod method)
+    : FloatingSide(model, kinematicsAt(model.get(), state), h, before, response, method) {}
+
+FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
+                           const FloatingVelocity& before, Response response, ExIITMethod method)
     : model_(checkedModel(std::move(model))),
-      kin_(*model_),
+      kin_(std::move(kin)),
       momentum_(model_),
       h_(h),
       response_(response),
@@ -46,7 +58,8 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const Sta
     refuse("the method is not one of Recursive, Dense");
   if (h_.body < 0 || h_.body >= static_cast<int>(model_->bodies().size())) refuse("contact point", E_BAD_CONTACT);
   if (!allFinite(h_.offset)) refuse("contact point", E_NOT_FINITE);
-  if (const int rc = forwardKinematics(*model_, state, kin_)) refuse("the state", rc);
+  if (kin_.model != model_.get() || kin_.R.size() != model_->bodies().size()) refuse("the kinematics", E_SIZE_MISMATCH);
+  if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::Grounded) {
     // The grounded base does not move, whatever twist was given.
     before_.base_twist = after_.base_twist = trial_.base_twist = KDL::Twist::Zero();
@@ -82,9 +95,7 @@ int FloatingSide::applyImpulse(const Vector6d& F) {
   trial_.qdot.data = before_.qdot.data;
   if (response_ == Response::JointsLocked) {
     // One rigid body: the momentum changes by the impulse (eq. 21), the joints stay still.
-    Vector6d h = h_before_;
-    h.head<3>() += F.head<3>();
-    h.tail<3>() += F.tail<3>() + kin_.point(h_).cross(Vector3d(F.head<3>()));  // moment about the origin
+    const Vector6d h = h_before_ + shiftMomentum(F, -kin_.point(h_));  // its moment about the origin
     if (const int rc = momentum_.baseTwist(kin_, h, trial_.qdot, trial_.base_twist)) return rc;
   } else {
     const int rc = recursive_ ? recursive_->velocityJump(h_, response_, F, d_base_, dqdot_)
@@ -142,10 +153,9 @@ int RigidBodySide::applyImpulse(const Vector6d& F) {
 }
 
 Vector6d RigidBodySide::momentum(const Vector6d& twist) const {
-  Vector6d m;
-  m.head<3>() = body_.mass * twist.head<3>();
-  m.tail<3>() = body_.I_com * twist.tail<3>() + body_.com.cross(m.head<3>());
-  return m;
+  Vector6d m;  // (P; L about the CoM), then L about the origin: L_O = L_c + c x P
+  m << body_.mass * twist.head<3>(), body_.I_com * twist.tail<3>();
+  return shiftMomentum(m, -body_.com);
 }
 
 double RigidBodySide::energy(const Vector6d& twist) const {

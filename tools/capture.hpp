@@ -1,14 +1,13 @@
 // `kdl_space capture SCENARIO [--json]`: the impact of the robot with its target, everything
-// before and after.
+// before and after (the library's loadScenario and solveCapture, printed).
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <memory>
 #include <ostream>
 #include <string>
 
 #include "cli_common.hpp"
-#include "scenario.hpp"
+#include "kdl_space/scenario.hpp"
 
 namespace kdl_space::cli {
 
@@ -17,21 +16,21 @@ struct CaptureOptions {
   bool json = false;
 };
 
-/// A solved impact: both sides (holding their state after), the impulse, the contact point.
-struct CaptureRun {
-  std::unique_ptr<FreeFloatingSolver> robot_solver, target_solver;
-  std::unique_ptr<FloatingSide> robot;
-  std::unique_ptr<ImpactSide> target;
-  Impulse impulse;
-  Vector3d p_h = Vector3d::Zero();
-};
+/// \brief Runs `f` (a library call on the scenario's capture problem); an InputError it throws
+/// ("target: ...") comes back with the scenario's file in front ("FILE: target: ...").
+template <typename F>
+auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(scenario.file + ": " + e.what());
+  }
+}
 
-/// Solves the scenario's impact; throws InputError for anything unusable.
-CaptureRun solveCapture(const Scenario& scenario);
 /// The capture JSON object (the keys are a contract: see the README).
-Json captureJson(const Scenario& scenario, const CaptureRun& run);
+Json captureJson(const Scenario& scenario, const CaptureResult& result);
 /// The readable summary.
-void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureRun& run);
+void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);
 
 CLI::App* addCapture(CLI::App& app, CaptureOptions& options);
 void runCapture(const CaptureOptions& options, std::ostream& out);

@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/errors.hpp"
+#include "kdl_space/input_file.hpp"  // checkInputFile, parseFiniteNumber
+
 namespace CLI {
 class Validator;
 }
@@ -21,10 +24,9 @@ enum Exit : int { kOk = 0, kUsage = 2, kUnusable = 3 };
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-/// A model or an input that cannot be used (exit 3).
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+/// A model or an input that cannot be used (exit 3): the library's, which the scenario loader
+/// and the capture throw too.
+using InputError = kdl_space::InputError;
 
 using Json = nlohmann::ordered_json;
 
@@ -41,17 +43,9 @@ void printMatrix(std::ostream& os, const std::string& title, const Eigen::Matrix
 /// Parses "NAME=VALUE"; throws UsageError naming `option` if malformed.
 std::pair<std::string, double> parseAssignment(const std::string& text, const std::string& option);
 
-/// \brief Parses a whole string as a finite double ("1e400", "nan", "1.5x" are refused).
-/// \return false, with `why` saying what is wrong (e.g. "'abc' is not a number").
-bool parseFiniteNumber(const std::string& text, double& value, std::string& why);
-
 /// CLI11 validators with messages a user can act on (CLI11's own Range prints 300-digit bounds).
 CLI::Validator finiteNumber();   ///< any finite number
 CLI::Validator positiveNumber(); ///< a finite number > 0
-
-/// \brief Refuses an input file that cannot be read: missing, a directory, unreadable or empty.
-/// Throws InputError "PATH: what is wrong"; `kind` names what the file should be ("URDF file").
-void checkInputFile(const std::string& path, const std::string& kind);
 
 /// \brief Refuses, before any work, an output file that could not be written: its folder is
 /// missing, not a folder or not writable, or the path is a folder. Throws InputError naming the

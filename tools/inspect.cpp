@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "detail/text.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
@@ -44,12 +45,7 @@ std::vector<ContactRequest> pairContacts(const CLI::App& command, const InspectO
 
 std::string describe(const Diagnostic& d) { return d.element.empty() ? d.message : d.element + ": " + d.message; }
 
-/// "a, b, c" of names, for messages that list what the model has.
-std::string listNames(const std::vector<std::string>& names) {
-  std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  return list.empty() ? "none" : list;
-}
+using detail::listNames;
 
 /// The --tip (and --offset) options of a contact, for messages.
 std::string contactOption(const ContactRequest& r) {

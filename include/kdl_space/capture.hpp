@@ -72,14 +72,18 @@ struct CaptureResult {
   KDL::Frame contact_body_pose = KDL::Frame::Identity();
 };
 
-/// \brief Solves the capture problem: both sides at their states, the impulse from the law,
-/// everything after. A set-up call: \throws InputError with a message that starts with the part
-/// concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
+/// \brief Solves the capture problem: both sides at their states (FloatingSide, RigidBodySide),
+/// the impulse from the law (collide), everything after. O(n) per free-floating side with
+/// ExIITMethod::Recursive. A set-up call: \throws InputError with a message that starts with the
+/// part concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
 KDL_SPACE_EXPORT CaptureResult solveCapture(const CaptureProblem& problem);
 
-/// \brief The robot's model after a rigid capture of a rigid target: the target merged into the
-/// robot's contact link (its inertia in that link's frame at the impact). \throws InputError
-/// ("target: ...") if it cannot be attached.
+/// \brief The model that moves on after the impact solved by `result = solveCapture(problem)`:
+/// after a rigid capture of a rigid target, the robot with the target merged into its contact
+/// link (the target's inertia in that link's frame at the impact, result.contact_body_pose);
+/// after a point impact (frictional or not), the robot's own model, the same pointer (the target
+/// separates). A set-up call: \throws InputError ("law.type: ..." for a translational capture,
+/// "target.urdf: ..." for a free-floating target, "target: ..." if the merged model is refused).
 KDL_SPACE_EXPORT std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
 
 }  // namespace kdl_space

@@ -65,9 +65,9 @@ struct FloatingSystem {
 
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
 ///
-/// The side owns what it answers from: the model (shared), its state and velocity, and its own
-/// solvers and kinematics, computed once in the constructor; nothing a caller does later can
-/// make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
+/// The side owns what it answers from: the model (shared), its state and velocity, its
+/// kinematics (computed in the constructor, or handed to it) and its own solvers, computed once
+/// in the constructor; nothing a caller does later can make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
 /// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
 /// energy and twists by MomentumSolver; no n x n matrix is built. ExIITMethod::Dense uses the
 /// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
@@ -78,6 +78,12 @@ class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
   /// finite, `response` or `method` is no enumerator, or the response is unavailable (grounded
   /// with a singular H). The message starts with "FloatingSide: ".
   FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
+               const FloatingVelocity& before, Response response = Response::FreeFloating,
+               ExIITMethod method = ExIITMethod::Recursive);
+  /// \brief The same from the kinematics of the side's state, already computed by
+  /// forwardKinematics for `model` (the side keeps them: it owns its state). \throws ModelError
+  /// as above, or if `kin` is not a successful forwardKinematics of `model`.
+  FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
                const FloatingVelocity& before, Response response = Response::FreeFloating,
                ExIITMethod method = ExIITMethod::Recursive);
   explicit FloatingSide(const FloatingSystem& system, ExIITMethod method = ExIITMethod::Recursive);

@@ -1,6 +1,7 @@
 // Small text helpers of the library's messages, written once.
 #pragma once
 
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -8,6 +9,13 @@ namespace kdl_space::detail {
 
 /// 'name', as every message quotes a link, joint or file.
 inline std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+/// A number as a message shows it: 6 significant digits, the stream's default ("0.2", "1e+06").
+inline std::string number(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
 
 /// "a, b, c" of names, for messages that list what a model has ("none" for an empty list).
 inline std::string listNames(const std::vector<std::string>& names) {

@@ -28,6 +28,7 @@
 #include <sstream>
 
 #include "kdl_space/collision.hpp"
+#include "impact_robots.hpp"
 #include "impact_util.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"
@@ -47,26 +48,6 @@ using ModelPtr = std::shared_ptr<const FloatingModel>;
 // inverse) gives O(1) relative errors, so the tolerance separates the two by orders of magnitude.
 constexpr double kRel = 1e-12;
 constexpr int kTrials = 30;
-
-struct RobotSpec {
-  std::string name;
-  std::string path;
-  std::string tip;
-};
-
-std::vector<RobotSpec> robots() {
-  return {{"space_arm7", urdfDir() + "/space_arm7.urdf", "end_effector"},
-          {"dual_arm", urdfDir() + "/dual_arm.urdf", "left_tool"},
-          {"spacedyn_twolink", urdfDir() + "/spacedyn_twolink.urdf", "hand"},
-          {"arm6_public", dataDir() + "/reference/models/arm6_public.urdf", "tool"}};
-}
-
-ModelPtr load(const std::string& path) {
-  static std::map<std::string, ModelPtr> cache;
-  auto it = cache.find(path);
-  if (it == cache.end()) it = cache.emplace(path, std::make_shared<const FloatingModel>(loadUrdfFile(path))).first;
-  return it->second;
-}
 
 Vector3d randomVec(std::mt19937& rng, double scale) {
   std::uniform_real_distribution<double> u(-scale, scale);
@@ -126,7 +107,7 @@ struct Scene {
 Scene makeScene(const RobotSpec& spec, std::mt19937& rng) {
   Scene s;
   s.robot = spec.name;
-  s.model = load(spec.path);
+  s.model = cachedModel(spec.path);
   s.solver = std::make_unique<FreeFloatingSolver>(s.model);
   s.state = randomState(*s.model, rng);
   EXPECT_EQ(s.solver->compute(s.state), E_NOERROR);
@@ -640,7 +621,7 @@ TEST_P(Robots, GroundedResponseIsEq23) {
 }
 
 TEST(GroundedCapture, SingularStraightTwoLink) {
-  const ModelPtr model = load(urdfDir() + "/spacedyn_twolink.urdf");
+  const ModelPtr model = cachedModel(urdfDir() + "/spacedyn_twolink.urdf");
   FreeFloatingSolver solver(model);
   State state(*model);  // q = 0: straight arm along x, both joint axes z
   ASSERT_EQ(solver.compute(state), E_NOERROR);
@@ -755,7 +736,7 @@ ModelPtr heavyBase(const FloatingModel& model, double k) {
 // which makes the base 1e8 times heavier than everything it meets, and the first-order
 // convergence itself is checked: k / 100 must give a difference ~100 times larger.
 TEST_P(Robots, HeavyBaseCaptureApproachesGrounded) {
-  const ModelPtr model = load(GetParam().path);
+  const ModelPtr model = cachedModel(GetParam().path);
   FreeFloatingSolver solver(model);
   std::mt19937 rng(6006);
   double worst = 0.0;
@@ -816,7 +797,7 @@ inline void PrintTo(const RobotPair& p, std::ostream* os) { *os << p.a.name << "
 TEST_P(RobotPairs, CaptureConservesMomentumAndMatchesTwists) {
   std::mt19937 rng(7007);
   double worst_m = 0.0, worst_t = 0.0;
-  const ModelPtr model_a = load(GetParam().a.path), model_b = load(GetParam().b.path);
+  const ModelPtr model_a = cachedModel(GetParam().a.path), model_b = cachedModel(GetParam().b.path);
   FreeFloatingSolver solver_a(model_a), solver_b(model_b);
   const Contact h_a = model_a->contact(GetParam().a.tip), h_b = model_b->contact(GetParam().b.tip);
   for (int trial = 0; trial < kTrials; ++trial) {
@@ -853,13 +834,13 @@ std::string pairName(const ::testing::TestParamInfo<RobotPair>& info) {
   return info.param.a.name + "_" + info.param.a.tip + "__" + info.param.b.name + "_" + info.param.b.tip;
 }
 
-INSTANTIATE_TEST_SUITE_P(AllRobots, Robots, ::testing::ValuesIn(robots()), specName);
+INSTANTIATE_TEST_SUITE_P(AllRobots, Robots, ::testing::ValuesIn(impactRobots()), specName);
 
 INSTANTIATE_TEST_SUITE_P(
     AllPairs, RobotPairs,
-    ::testing::Values(RobotPair{robots()[0], {"dual_arm", urdfDir() + "/dual_arm.urdf", "right_tool"}},
-                      RobotPair{robots()[2], robots()[3]}, RobotPair{robots()[3], robots()[3]},
-                      RobotPair{robots()[1], {"dual_arm", urdfDir() + "/dual_arm.urdf", "right_tool"}}),
+    ::testing::Values(RobotPair{impactRobots()[0], {"dual_arm", urdfDir() + "/dual_arm.urdf", "right_tool"}},
+                      RobotPair{impactRobots()[2], impactRobots()[3]}, RobotPair{impactRobots()[3], impactRobots()[3]},
+                      RobotPair{impactRobots()[1], {"dual_arm", urdfDir() + "/dual_arm.urdf", "right_tool"}}),
     pairName);
 
 }  // namespace

@@ -1,0 +1,40 @@
+// Capture scenarios (YAML or JSON files): what the robot is, where and how fast it moves, what it
+// hits and with which impact law (a CaptureProblem), and what to simulate after the impact. What
+// `kdl_space capture` and `simulate` read; a library user can build the same types in code.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kdl_space/capture.hpp"
+#include "kdl_space/export.hpp"
+#include "kdl_space/simulation.hpp"
+
+namespace kdl_space {
+
+/// The `simulation` section: what happens after the impact.
+struct SimulationSpec {
+  double duration = 20.0;     ///< [s] (the tool's --duration overrides it)
+  double output_step = 0.05;  ///< output row spacing [s]
+  SimulationOptions options;
+  std::vector<std::pair<unsigned int, JointControl>> joints;  ///< by joint index of the robot
+};
+
+/// A scenario file, read and checked.
+struct Scenario {
+  std::string file;         ///< the path it was read from
+  std::string robot_urdf;   ///< the robot's URDF (resolved path)
+  std::string target_urdf;  ///< a free-floating target's URDF (resolved path); empty for a rigid target
+  CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
+  SimulationSpec simulation;
+};
+
+/// \brief Reads and checks a scenario file; URDF paths are relative to the scenario's folder.
+/// Every number is finite, every name exists in its model, a rigid target's mass and inertia
+/// are those of a rigid body; a free-floating target's contact is checked by solveCapture.
+/// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
+/// be > 0 kg, got -3") for every problem, the file's own (missing, empty, not YAML) included.
+KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
+
+}  // namespace kdl_space

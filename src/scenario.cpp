@@ -1,0 +1,251 @@
+#include "kdl_space/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "detail/text.hpp"
+#include "kdl_space/input_file.hpp"
+#include "kdl_space/urdf_loader.hpp"
+#include "model_rules.hpp"
+#include "scenario_fields.hpp"
+
+namespace kdl_space {
+namespace {
+
+using detail::listNames;
+using detail::number;
+using fields::echo;
+using fields::Field;
+
+std::vector<std::string> linkNames(const FloatingModel& model) {
+  std::vector<std::string> names;
+  for (const Body& b : model.bodies()) names.push_back(b.name);
+  return names;
+}
+
+/// A pose from optional `position` and `rpy` fields of f (URDF convention).
+KDL::Frame pose(const Field& f) {
+  const Eigen::VectorXd p = f.has("position") ? f.at("position").vector(3) : Eigen::VectorXd::Zero(3);
+  const Eigen::VectorXd r = f.has("rpy") ? f.at("rpy").vector(3) : Eigen::VectorXd::Zero(3);
+  return basePose(KDL::Vector(p(0), p(1), p(2)), r(0), r(1), r(2));
+}
+
+/// Joint values by name; an unknown name is reported at its field.
+KDL::JntArray joints(const Field& f, const FloatingModel& model) {
+  const std::map<std::string, double> values = f.namedNumbers();
+  for (const auto& [name, value] : values)
+    if (model.jointIndex(name) < 0)
+      f.at(name).fail("the model has no movable joint " + echo(name) + " (its movable joints: " +
+                      listNames(model.jointNames()) + ")");
+  return jointsByName(model, values);
+}
+
+/// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
+FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode"});
+  FloatingSystem s;
+  const Field urdf = f.at("urdf");
+  urdf_path = urdf.text();
+  if (urdf_path.empty()) urdf.fail("the file name is empty");
+  if (std::filesystem::path(urdf_path).is_relative())
+    urdf_path = (std::filesystem::path(folder) / urdf_path).lexically_normal().string();
+  try {
+    checkInputFile(urdf_path, "URDF file");
+    s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
+  } catch (const InputError& e) {
+    urdf.fail(e.what());
+  } catch (const ModelError& e) {
+    urdf.fail(e.what());
+  }
+  s.state = State(*s.model);
+  s.velocity = FloatingVelocity(*s.model);
+  if (f.has("base")) {
+    const Field base = f.at("base");
+    base.onlyKeys({"position", "rpy", "twist"});
+    s.state.world_T_base = pose(base);
+    if (base.has("twist")) s.velocity.base_twist = toTwist(Vector6d(base.at("twist").vector(6)));
+  }
+  if (f.has("q")) s.state.q = joints(f.at("q"), *s.model);
+  if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model);
+  const Field contact = f.at("contact");
+  contact.onlyKeys({"link", "offset"});
+  const std::string link = contact.at("link").text();
+  const Eigen::VectorXd o = contact.has("offset") ? contact.at("offset").vector(3) : Eigen::VectorXd::Zero(3);
+  if (s.model->bodyIndex(link) < 0)
+    contact.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*s.model)) + ")");
+  s.contact = s.model->contact(link, KDL::Vector(o(0), o(1), o(2)));
+  if (f.has("mode")) {
+    const std::string mode = f.at("mode").text();
+    if (mode == "free") s.response = Response::FreeFloating;
+    else if (mode == "grounded") s.response = Response::Grounded;
+    else if (mode == "locked") s.response = Response::JointsLocked;
+    else f.at("mode").fail(echo(mode) + " is not one of free, grounded, locked");
+  }
+  return s;
+}
+
+/// A rigid target in the file's terms; its mass and inertia those of a rigid body.
+RigidTarget rigidTarget(const Field& f) {
+  f.onlyKeys({"mass", "inertia", "pose", "com", "twist"});
+  RigidTarget b;
+  b.mass = f.at("mass").number();
+  if (!(b.mass > 0.0)) f.at("mass").fail("must be > 0 kg, got " + number(b.mass));
+  const Field inertia = f.at("inertia");
+  const Matrix3d I = inertia.matrix3();
+  const rules::InertiaVerdict verdict = rules::judgeInertia(I);
+  if (!verdict.symmetric) {
+    Eigen::Index i = 0, j = 0;
+    (I - I.transpose()).cwiseAbs().maxCoeff(&i, &j);
+    inertia.fail("must be symmetric, but row " + std::to_string(i + 1) + " column " + std::to_string(j + 1) + " is " +
+                 number(I(i, j)) + " and row " + std::to_string(j + 1) + " column " + std::to_string(i + 1) + " is " +
+                 number(I(j, i)));
+  }
+  const Vector3d& l = verdict.moments;  // ascending
+  const std::string moments = "(principal moments " + number(l(0)) + ", " + number(l(1)) + ", " + number(l(2)) + " kg m^2)";
+  if (verdict.kind == rules::InertiaVerdict::NotPositiveDefinite) inertia.fail("must be positive definite " + moments);
+  if (verdict.kind == rules::InertiaVerdict::TriangleInequality)
+    inertia.fail("is no rigid body's inertia: its principal moments break the triangle inequality I1 + I2 >= I3 " +
+                 moments);
+  b.inertia = I;
+  if (f.has("pose")) {
+    f.at("pose").onlyKeys({"position", "rpy"});
+    b.pose = pose(f.at("pose"));
+  }
+  if (f.has("com")) b.com = f.at("com").vector(3);
+  if (f.has("twist")) b.twist = f.at("twist").vector(6);
+  return b;
+}
+
+/// The impact law; `has_normal` is set when a normal is given.
+ImpactLaw law(const Field& f, bool& has_normal) {
+  f.onlyKeys({"type", "normal", "restitution", "friction"});
+  ImpactLaw l;
+  const std::string type = f.at("type").text();
+  if (type == "capture") l.kind = ImpactKind::Capture;
+  else if (type == "point") l.kind = ImpactKind::PointImpact;
+  else if (type == "friction") l.kind = ImpactKind::FrictionalImpact;
+  else if (type == "translational") l.kind = ImpactKind::TranslationalCapture;
+  else f.at("type").fail(echo(type) + " is not one of capture, point, friction, translational");
+  const bool point = l.kind == ImpactKind::PointImpact || l.kind == ImpactKind::FrictionalImpact;
+  has_normal = f.has("normal");
+  if (point && !has_normal) f.at("normal");  // reports "missing"
+  if (has_normal) {
+    const Vector3d n = f.at("normal").vector(3);
+    if (!(n.norm() > 1e-12)) f.at("normal").fail("has zero length");
+    l.normal = n.normalized();
+  }
+  if (f.has("restitution")) {
+    l.restitution = f.at("restitution").number();
+    if (l.restitution < 0.0 || l.restitution > 1.0) f.at("restitution").fail("must lie in [0, 1], got " + number(l.restitution));
+  } else if (point) {
+    f.at("restitution");  // reports "missing"
+  }
+  if (f.has("friction")) {
+    l.friction = f.at("friction").number();
+    if (l.friction < 0.0) f.at("friction").fail("must be >= 0, got " + number(l.friction));
+  } else if (l.kind == ImpactKind::FrictionalImpact) {
+    f.at("friction");  // reports "missing"
+  }
+  return l;
+}
+
+/// One joint's control in the simulation section: free, locked or {pd: {kp, kd, set_point}}.
+JointControl jointControl(const Field& j) {
+  JointControl c;
+  if (j.isScalar()) {
+    const std::string mode = j.text();
+    if (mode == "free") c.mode = JointControl::Mode::Free;
+    else if (mode == "locked") c.mode = JointControl::Mode::Locked;
+    else j.fail(echo(mode) + " is not one of free, locked, {pd: {kp, kd, set_point}}");
+    return c;
+  }
+  j.onlyKeys({"pd"});
+  const Field pd = j.at("pd");
+  pd.onlyKeys({"kp", "kd", "set_point"});
+  c.mode = JointControl::Mode::PD;
+  c.kp = pd.at("kp").number();
+  c.kd = pd.at("kd").number();
+  c.set_point = pd.at("set_point").number();
+  if (c.kp < 0.0) pd.at("kp").fail("must be >= 0, got " + number(c.kp));
+  if (c.kd < 0.0) pd.at("kd").fail("must be >= 0, got " + number(c.kd));
+  return c;
+}
+
+SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
+  f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "max_steps", "gravity",
+              "joints"});
+  SimulationSpec s;
+  const auto positive = [&](const char* key, double& value) {
+    if (!f.has(key)) return;
+    value = f.at(key).number();
+    if (!(value > 0.0)) f.at(key).fail("must be > 0, got " + number(value));
+  };
+  positive("duration", s.duration);
+  positive("output_step", s.output_step);
+  positive("step", s.options.step);
+  positive("rtol", s.options.rtol);
+  positive("atol", s.options.atol);
+  positive("max_step", s.options.max_step);
+  if (f.has("max_steps")) {
+    const double budget = f.at("max_steps").number();
+    if (!(budget >= 1.0) || budget != std::floor(budget) || budget > 1e12)
+      f.at("max_steps").fail("must be a whole number of steps from 1 to 1e12, got " + number(budget));
+    s.options.max_steps = static_cast<long>(budget);
+  }
+  if (f.has("integrator")) {
+    const std::string name = f.at("integrator").text();
+    if (name == "rk4") s.options.integrator = Integrator::RK4;
+    else if (name == "dopri5") s.options.integrator = Integrator::DormandPrince54;
+    else f.at("integrator").fail(echo(name) + " is not one of rk4, dopri5");
+  }
+  if (f.has("gravity")) s.options.gravity = f.at("gravity").vector(3);
+  if (f.has("joints")) {
+    const Field joints = f.at("joints");
+    for (const std::string& name : joints.keys()) {
+      const Field j = joints.at(name);
+      const int index = robot.jointIndex(name);
+      if (index < 0)
+        j.fail("the robot has no movable joint " + echo(name) + " (its movable joints: " + listNames(robot.jointNames()) + ")");
+      s.joints.emplace_back(static_cast<unsigned int>(index), jointControl(j));
+    }
+  }
+  return s;
+}
+
+/// The file's YAML (or JSON, which YAML reads), or an InputError saying why not.
+YAML::Node parse(const std::string& file) {
+  checkInputFile(file, "scenario file (YAML or JSON)");
+  try {
+    return YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw InputError(file + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    std::string msg;  // yaml-cpp quotes the offending byte: keep it printable
+    for (const char c : e.msg) msg += static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f ? c : '?';
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML or JSON: " + msg);
+  } catch (const std::exception& e) {
+    throw InputError(file + ": cannot read the file: " + e.what());
+  }
+}
+
+}  // namespace
+
+Scenario loadScenario(const std::string& path) {
+  Scenario s;
+  s.file = path;
+  const YAML::Node root = parse(path);
+  const Field top(root, "", &s.file);
+  if (root.IsNull()) throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law");
+  if (!root.IsMap()) top.fail("a scenario is a mapping with robot, target and law, not " + fields::kindOf(root));
+  top.onlyKeys({"robot", "target", "law", "simulation"});
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
+  const Field target = top.at("target");
+  if (target.has("urdf")) s.capture.target = system(target, folder, s.target_urdf);
+  else s.capture.target = rigidTarget(target);
+  s.capture.law = law(top.at("law"), s.capture.has_normal);
+  if (top.has("simulation")) s.simulation = simulation(top.at("simulation"), *s.capture.robot.model);
+  return s;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,60 @@
+// The scenario loader's field reader: a YAML node with its dotted path ("target.inertia[1]") and
+// its file, whose reads check the value and throw InputError "FILE:LINE: PATH: what is wrong".
+// Private to the library (yaml-cpp is a private dependency).
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <initializer_list>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace kdl_space::fields {
+
+/// A text from the file, quoted for a message: at most 40 characters, anything but printable
+/// ASCII shown as '?' (a binary file must not flood the terminal).
+std::string echo(const std::string& text);
+
+/// What a YAML node is, for messages ("no value", "a list of 2", "a mapping", or its text).
+std::string kindOf(const YAML::Node& node);
+
+/// A YAML node with its dotted path, for messages that name the field.
+class Field {
+ public:
+  /// `file` names the file in messages; it must outlive the Field.
+  Field(YAML::Node node, std::string path, const std::string* file);
+
+  /// Throws InputError "FILE[:LINE]: PATH: what".
+  [[noreturn]] void fail(const std::string& what) const;
+  /// The key is present (with a value or without: at() reports "has no value").
+  bool has(const std::string& key) const;
+  /// The value of a required key ("missing (a required field)", "has no value").
+  Field at(const std::string& key) const;
+  /// Refuses keys not in `keys`, keys given twice and keys that are not names.
+  void onlyKeys(std::initializer_list<const char*> keys) const;
+  /// The keys of a mapping, in file order; refuses a key given twice or one that is not a name.
+  std::vector<std::string> keys() const;
+
+  std::string text() const;
+  /// A finite number (YAML's forms too: .inf and .nan are read, then refused).
+  double number() const;
+  /// A list of `size` finite numbers.
+  Eigen::VectorXd vector(int size) const;
+  /// 3 rows of 3 finite numbers.
+  Eigen::Matrix3d matrix3() const;
+  /// A mapping NAME: finite number.
+  std::map<std::string, double> namedNumbers() const;
+
+  const std::string& path() const { return path_; }
+  bool isScalar() const { return node_.IsScalar(); }
+
+ private:
+  Field child(const YAML::Node& node, const std::string& path) const { return Field(node, path, file_); }
+  YAML::Node node_;
+  std::string path_;
+  const std::string* file_;
+};
+
+}  // namespace kdl_space::fields

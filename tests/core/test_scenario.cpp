@@ -1,0 +1,131 @@
+// loadScenario (scenario.hpp): the bundled and test scenarios load into the library's types with
+// the values their files hold, and a broken file is refused with an InputError that names the
+// file, the line and the field (the same messages `kdl_space capture` prints: tests/cli checks
+// the whole corpus end to end; here a few through the library alone).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "kdl_space/scenario.hpp"
+#include "test_util.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kShipped = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+const std::string kBroken = dataDir() + "/broken_scenarios/";
+
+TEST(LoadScenario, ARigidTargetInTheFilesTerms) {
+  const Scenario s = loadScenario(kShipped + "tumbling_box_capture.yaml");
+  EXPECT_EQ(s.file, kShipped + "tumbling_box_capture.yaml");
+  EXPECT_EQ(s.robot_urdf, fs::path(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/space_arm7.urdf").lexically_normal().string());
+  EXPECT_EQ(s.target_urdf, "");
+  const CaptureProblem& p = s.capture;
+  ASSERT_TRUE(p.robot.model);
+  EXPECT_EQ(p.robot.model->jointNames().size(), 7u);
+  EXPECT_EQ(p.robot.contact.body, p.robot.model->bodyIndex("end_effector"));
+  EXPECT_TRUE(near(toEigen(p.robot.contact.offset), Vector3d(0, 0, 0.05), 0.0, 0.0, "offset"));
+  EXPECT_EQ(p.robot.response, Response::FreeFloating);
+  EXPECT_EQ(p.robot.state.q(p.robot.model->jointIndex("joint3")), 0.9);
+  EXPECT_EQ(p.robot.state.q(p.robot.model->jointIndex("joint1")), 0.0);
+  EXPECT_EQ(p.robot.velocity.qdot(p.robot.model->jointIndex("joint4")), -0.03);
+  EXPECT_TRUE(near(toEigen(p.robot.velocity.base_twist), (Vector6d() << 0.002, 0, 0, 0, 0, 0.001).finished(), 0, 0, "twist"));
+  ASSERT_TRUE(std::holds_alternative<RigidTarget>(p.target));
+  const RigidTarget& t = std::get<RigidTarget>(p.target);
+  EXPECT_EQ(t.mass, 50.0);
+  EXPECT_TRUE(near(t.inertia, Vector3d(2.1, 2.6, 3.0).asDiagonal().toDenseMatrix(), 0, 0, "inertia in the target frame"));
+  EXPECT_TRUE(near(toEigen(t.pose.p), Vector3d(0.32, -2.88, 1.69), 0, 0, "pose.position"));
+  EXPECT_TRUE(near(toEigen(t.pose.M), toEigen(KDL::Rotation::RPY(0.3, -0.2, 0.5)), 0, 0, "pose.rpy"));
+  EXPECT_TRUE(near(t.com, Vector3d::Zero(), 0, 0, "com"));
+  EXPECT_TRUE(near(t.twist, (Vector6d() << 0.03, -0.02, 0.01, 0.05, 0.08, -0.06).finished(), 0, 0, "twist"));
+  EXPECT_EQ(p.law.kind, ImpactKind::Capture);
+  EXPECT_TRUE(p.has_normal);
+  EXPECT_TRUE(near(p.law.normal, Vector3d(0, -1, 0), 0, 0, "normal"));
+  EXPECT_EQ(p.method, ExIITMethod::Recursive);
+  // The simulation section.
+  EXPECT_EQ(s.simulation.duration, 20.0);
+  EXPECT_EQ(s.simulation.output_step, 0.05);
+  EXPECT_EQ(s.simulation.options.integrator, Integrator::DormandPrince54);
+  EXPECT_EQ(s.simulation.options.rtol, 1e-10);
+  ASSERT_EQ(s.simulation.joints.size(), 7u);
+  EXPECT_EQ(s.simulation.joints[1].first, static_cast<unsigned int>(p.robot.model->jointIndex("joint2")));
+  EXPECT_EQ(s.simulation.joints[1].second.mode, JointControl::Mode::PD);
+  EXPECT_EQ(s.simulation.joints[1].second.set_point, 0.7);
+  // It solves.
+  EXPECT_NO_THROW(solveCapture(p));
+}
+
+TEST(LoadScenario, AFreeFloatingTarget) {
+  const Scenario s = loadScenario(kShipped + "robot_to_robot_capture.yaml");
+  ASSERT_TRUE(std::holds_alternative<FloatingSystem>(s.capture.target));
+  const FloatingSystem& t = std::get<FloatingSystem>(s.capture.target);
+  ASSERT_TRUE(t.model);
+  EXPECT_EQ(t.model->jointNames(), (std::vector<std::string>{"joint1", "joint2"}));
+  EXPECT_EQ(t.contact.body, t.model->bodyIndex("hand"));
+  EXPECT_EQ(t.velocity.qdot(1), -0.02);
+  EXPECT_EQ(s.target_urdf,
+            fs::path(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/spacedyn_twolink.urdf").lexically_normal().string());
+  EXPECT_FALSE(s.capture.has_normal);
+  // No simulation section: the defaults.
+  EXPECT_EQ(s.simulation.duration, SimulationSpec().duration);
+  EXPECT_TRUE(s.simulation.joints.empty());
+  const CaptureResult r = solveCapture(s.capture);
+  EXPECT_TRUE(r.floating_target.has_value());
+}
+
+TEST(LoadScenario, EveryShippedAndTestScenarioLoadsAndSolves) {
+  int count = 0;
+  for (const std::string& folder : {kShipped, dataDir() + "/scenarios/"})
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".yaml" && ext != ".json") continue;
+      SCOPED_TRACE(entry.path().string());
+      const Scenario s = loadScenario(entry.path().string());
+      ASSERT_TRUE(s.capture.robot.model);
+      const bool point = s.capture.law.kind == ImpactKind::PointImpact || s.capture.law.kind == ImpactKind::FrictionalImpact;
+      if (point) EXPECT_TRUE(s.capture.has_normal);
+      EXPECT_NO_THROW(solveCapture(s.capture));
+      ++count;
+    }
+  EXPECT_GE(count, 10);
+}
+
+TEST(LoadScenario, PointImpactLaw) {
+  const Scenario s = loadScenario(kShipped + "restitution_bounce.yaml");
+  EXPECT_EQ(s.capture.law.kind, ImpactKind::PointImpact);
+  EXPECT_EQ(s.capture.law.restitution, 0.6);
+  EXPECT_TRUE(s.capture.has_normal);
+}
+
+/// The message loadScenario throws for `file`, or "" if it loads.
+std::string refusal(const std::string& file) {
+  try {
+    loadScenario(file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
+  EXPECT_EQ(refusal(kBroken + "valid.yaml"), "");
+  EXPECT_EQ(refusal(kBroken + "negative_mass.yaml"), kBroken + "negative_mass.yaml:10: target.mass: must be > 0 kg, got -3");
+  EXPECT_EQ(refusal(kBroken + "inertia_not_symmetric.yaml"),
+            kBroken + "inertia_not_symmetric.yaml:11: target.inertia: must be symmetric, but row 2 column 1 is 0 and "
+                      "row 1 column 2 is 0.2");
+  EXPECT_EQ(refusal(kBroken + "inertia_triangle_inequality.yaml"),
+            kBroken + "inertia_triangle_inequality.yaml:11: target.inertia: is no rigid body's inertia: its principal "
+                      "moments break the triangle inequality I1 + I2 >= I3 (principal moments 1, 1, 3 kg m^2)");
+  EXPECT_EQ(refusal(kBroken + "unknown_joint.yaml"),
+            kBroken + "unknown_joint.yaml:6: robot.q.elbow: the model has no movable joint 'elbow' (its movable "
+                      "joints: joint1, joint2)");
+  EXPECT_EQ(refusal(kBroken + "huge_number.yaml"),
+            kBroken + "huge_number.yaml:10: target.mass: '1e400' is too large (not a finite number)");
+  EXPECT_EQ(refusal(kBroken + "empty.yaml"), kBroken + "empty.yaml: the file is empty; expected a scenario file (YAML or JSON)");
+  EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
+}
+
+}  // namespace
+}  // namespace kdl_space::test

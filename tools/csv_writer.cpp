@@ -1,0 +1,33 @@
+#include "csv_writer.hpp"
+
+#include <iomanip>
+
+namespace kdl_space::cli {
+
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints) : file_(path, "--csv") {
+  out_.open(file_.tmp());
+  if (!out_) throw InputError("--csv " + path + ": cannot write in its folder");
+  out_ << std::setprecision(17);
+  out_ << "t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx,base_vy,base_vz,base_wx,base_wy,base_wz";
+  for (const auto& j : joints) out_ << ",q_" << j;
+  for (const auto& j : joints) out_ << ",qdot_" << j;
+  out_ << ",P_x,P_y,P_z,L_x,L_y,L_z,kinetic_energy\n";
+}
+
+void CsvWriter::write(const Sample& s) {
+  out_ << s.t;
+  for (int i = 0; i < 3; ++i) out_ << ',' << s.p(i);
+  for (int i = 0; i < 4; ++i) out_ << ',' << s.quat(i);
+  for (int i = 0; i < 6; ++i) out_ << ',' << s.twist(i);
+  for (Eigen::Index i = 0; i < s.q.size(); ++i) out_ << ',' << s.q(i);
+  for (Eigen::Index i = 0; i < s.qd.size(); ++i) out_ << ',' << s.qd(i);
+  for (int i = 0; i < 6; ++i) out_ << ',' << s.h(i);
+  out_ << ',' << s.T << '\n';
+}
+
+void CsvWriter::close() {
+  out_.close();
+  if (!out_) throw InputError("--csv " + file_.path() + ": write failed (disk full?)");
+}
+
+}  // namespace kdl_space::cli

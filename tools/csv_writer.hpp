@@ -1,0 +1,29 @@
+// The CSV of `kdl_space simulate --csv FILE`: a header and one row per output step (the columns
+// are a contract: see the README), written under a temporary name until committed.
+#pragma once
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "sample.hpp"
+
+namespace kdl_space::cli {
+
+class CsvWriter {
+ public:
+  /// Opens the temporary file and writes the header; throws InputError if it cannot.
+  CsvWriter(const std::string& path, const std::vector<std::string>& joints);
+  void write(const Sample& s);
+  /// Flushes and closes the temporary file; throws InputError if a write failed.
+  void close();
+  /// The file, to commit (or retract) once every output is complete.
+  AtomicFile& file() { return file_; }
+
+ private:
+  AtomicFile file_;
+  std::ofstream out_;
+};
+
+}  // namespace kdl_space::cli

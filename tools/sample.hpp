@@ -1,0 +1,18 @@
+// One output row of `kdl_space simulate`: what the CSV and the plot show.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace kdl_space::cli {
+
+struct Sample {
+  double t = 0.0;                              ///< [s]
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< base position [m]
+  Eigen::Vector4d quat = Eigen::Vector4d::Zero();  ///< base attitude: x y z w
+  Eigen::Matrix<double, 6, 1> twist;           ///< base twist (v; w)
+  Eigen::VectorXd q, qd;                       ///< joint positions and rates
+  Eigen::Matrix<double, 6, 1> h;               ///< total momentum (P; L about the world origin)
+  double T = 0.0;                              ///< kinetic energy [J]
+};
+
+}  // namespace kdl_space::cli
