@@ -60,43 +60,73 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
   if (!allFinite(h_.offset)) refuse("contact point", E_NOT_FINITE);
   if (kin_.model != model_.get() || kin_.R.size() != model_->bodies().size()) refuse("the kinematics", E_SIZE_MISMATCH);
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
-  if (response_ == Response::Grounded) {
-    // The grounded base does not move, whatever twist was given.
-    before_.base_twist = after_.base_twist = trial_.base_twist = KDL::Twist::Zero();
-  }
-  int rc = momentum_.compute(kin_, before_);
-  if (rc) refuse("the state before the impact", rc);
-  const char* what = response_ == Response::Grounded ? "grounded G at the contact point"
-                     : response_ == Response::FreeFloating ? "G* at the contact point"
-                                                           : "G at the contact point";
   if (response_ == Response::JointsLocked) {
-    rc = momentum_.G_locked(h_, G_);  // eq. 20
+    // eq. 20: no recursion
   } else if (method == ExIITMethod::Recursive) {
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
+  } else {
+    dense_ = std::make_unique<FreeFloatingSolver>(model_);
+  }
+  const char* stage = "";
+  if (const int rc = prepare(stage)) refuse(stage, rc);
+}
+
+int FloatingSide::reset(const State& state, const FloatingVelocity& before) {
+  ready_ = false;
+  if (before.qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
+  if (!before.qdot.data.allFinite() || !allFinite(before.base_twist)) return E_NOT_FINITE;
+  if (const int rc = forwardKinematics(*model_, state, kin_)) return rc;
+  before_.base_twist = before.base_twist;
+  before_.qdot.data = before.qdot.data;  // sizes checked: no allocation
+  const char* stage = "";
+  return prepare(stage);
+}
+
+int FloatingSide::prepare(const char*& stage) {
+  ready_ = false;
+  // The grounded base does not move, whatever twist was given.
+  if (response_ == Response::Grounded) before_.base_twist = KDL::Twist::Zero();
+  after_.base_twist = trial_.base_twist = before_.base_twist;
+  after_.qdot.data = trial_.qdot.data = before_.qdot.data;
+  stage = "the state before the impact";
+  if (const int rc = momentum_.compute(kin_, before_)) return rc;
+  stage = response_ == Response::Grounded       ? "grounded G at the contact point"
+          : response_ == Response::FreeFloating ? "G* at the contact point"
+                                                : "G at the contact point";
+  int rc = E_NOERROR;
+  if (response_ == Response::JointsLocked) {
+    rc = momentum_.G_locked(h_, G_);  // eq. 20
+  } else if (recursive_) {
     rc = recursive_->compute(kin_);
     if (rc == E_NOERROR) rc = recursive_->G(h_, response_, G_);
   } else {
-    dense_ = std::make_unique<FreeFloatingSolver>(model_);
     rc = dense_->compute(kin_);
     if (rc == E_NOERROR) rc = dense_->G(h_, response_, G_);
   }
-  if (rc) refuse(what, rc);
+  if (rc) return rc;
+  stage = "the state before the impact";
+  if ((rc = momentum_.contactTwist(h_, t_before_))) return rc;
+  I_g_llt_.compute(momentum_.I_g());
+  if (I_g_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
+  r_gh_ = kin_.point(h_) - momentum_.r_g();
   h_before_ = h_after_ = momentum_.momentum();
   T_before_ = T_after_ = momentum_.kineticEnergy();
   v_g_before_ = v_g_after_ = momentum_.centroidTwist();
-  if ((rc = momentum_.contactTwist(h_, t_before_))) refuse("the state before the impact", rc);
   t_after_ = t_before_;
+  ready_ = true;
+  return E_NOERROR;
 }
 
 int FloatingSide::applyImpulse(const Vector6d& F) {
+  if (!ready_) return E_NOT_COMPUTED;
   if (!F.allFinite()) return E_NOT_FINITE;
-  // Everything after the impulse goes to trial_ first: the state after changes only when all of
-  // it is good.
+  // Everything after the impulse goes to trial_ and locals first: the state after changes only
+  // when all of it is good.
   trial_.qdot.data = before_.qdot.data;
+  const Vector6d F_at_origin = shiftMomentum(F, -kin_.point(h_));  // (f; n + p_h x f)
   if (response_ == Response::JointsLocked) {
     // One rigid body: the momentum changes by the impulse (eq. 21), the joints stay still.
-    const Vector6d h = h_before_ + shiftMomentum(F, -kin_.point(h_));  // its moment about the origin
-    if (const int rc = momentum_.baseTwist(kin_, h, trial_.qdot, trial_.base_twist)) return rc;
+    if (const int rc = momentum_.baseTwist(kin_, h_before_ + F_at_origin, trial_.qdot, trial_.base_twist)) return rc;
   } else {
     const int rc = recursive_ ? recursive_->velocityJump(h_, response_, F, d_base_, dqdot_)
                               : dense_->velocityJump(h_, response_, F, d_base_, dqdot_);
@@ -113,15 +143,34 @@ int FloatingSide::applyImpulse(const Vector6d& F) {
       if (const int rc = dense_->baseTwist(PL_g + d_base_, trial_.qdot, trial_.base_twist)) return rc;
     }
   }
-  Vector6d t_h;
-  if (const int rc = momentum_.compute(kin_, trial_)) return rc;
-  if (const int rc = momentum_.contactTwist(h_, t_h)) return rc;
+  // What the impulse does to the whole side. Free-floating, without another pass over the
+  // bodies: the contact twist jumps by G* F (eq. 18), the impulse does the work
+  // F^T (t_before + t_after) / 2 and the momentum jumps by it (eq. 8). A grounded base (the
+  // ground takes a share of the momentum) and braked joints that keep their rates (not a passive
+  // response: the energy is not the impulse's work) are measured from the velocities after.
+  Vector6d t_h, h_O, v_g;
+  double T = 0.0;
+  if (response_ != Response::FreeFloating) {
+    if (const int rc = momentum_.compute(kin_, trial_)) return rc;
+    if (const int rc = momentum_.contactTwist(h_, t_h)) return rc;
+    T = momentum_.kineticEnergy();
+    h_O = momentum_.momentum();
+    v_g = momentum_.centroidTwist();
+  } else {
+    t_h = t_before_ + G_ * F;
+    T = T_before_ + 0.5 * F.dot(t_before_ + t_h);
+    h_O = h_before_ + F_at_origin;
+    v_g = v_g_before_;
+    v_g.head<3>() += F.head<3>() / model_->totalMass();                                  // eq. 12
+    v_g.tail<3>() += I_g_llt_.solve(Vector3d(F.tail<3>() + r_gh_.cross(Vector3d(F.head<3>()))));  // R_h^T F
+  }
+  if (!t_h.allFinite() || !std::isfinite(T) || !h_O.allFinite() || !v_g.allFinite()) return E_NOT_FINITE;
   after_.base_twist = trial_.base_twist;
   after_.qdot.data = trial_.qdot.data;
-  h_after_ = momentum_.momentum();
-  T_after_ = momentum_.kineticEnergy();
+  h_after_ = h_O;
+  T_after_ = T;
   t_after_ = t_h;
-  v_g_after_ = momentum_.centroidTwist();
+  v_g_after_ = v_g;
   return E_NOERROR;
 }
 

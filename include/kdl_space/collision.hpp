@@ -3,6 +3,7 @@
 // free-floating robot), with momentum and energy accounting.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <memory>
 
 #include "kdl_space/export.hpp"
@@ -89,6 +90,13 @@ class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
   explicit FloatingSide(const FloatingSystem& system, ExIITMethod method = ExIITMethod::Recursive);
   ~FloatingSide() override;
 
+  /// \brief The same side at another state and velocity (same model, contact, response and
+  /// method), reusing its solvers and workspaces: a compute call, allocation-free, that never
+  /// throws. \return 0, or the code of the part that refused (E_SIZE_MISMATCH, E_NOT_FINITE,
+  /// E_NOT_POSITIVE_DEFINITE...); on an error the side answers nothing (applyImpulse returns
+  /// E_NOT_COMPUTED) until a successful reset.
+  int reset(const State& state, const FloatingVelocity& before);
+
   const Matrix6d& G() const override { return G_; }
   const Vector6d& contactTwistBefore() const override { return t_before_; }
   Vector6d contactTwistAfter() const override { return t_after_; }
@@ -126,6 +134,12 @@ class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
   FloatingVelocity before_, after_;
   Vector6d h_before_, h_after_, t_before_, t_after_, v_g_before_, v_g_after_;
   double T_before_ = 0.0, T_after_ = 0.0;
+  /// The state before: momentum, energy, G and twists of kin_ and before_ (the constructor's and
+  /// reset's common part); `stage` names the part that refused.
+  int prepare(const char*& stage);
+  bool ready_ = false;
+  Vector3d r_gh_ = Vector3d::Zero();         ///< contact point from the system CoM
+  Eigen::LLT<Matrix3d> I_g_llt_;             ///< the locked inertia about the CoM, factorised
   Vector6d d_base_ = Vector6d::Zero();  ///< workspace
   KDL::JntArray dqdot_;      ///< workspace
   FloatingVelocity trial_;   ///< workspace: the state after, until it is known to be good
@@ -137,6 +151,13 @@ class KDL_SPACE_EXPORT RigidBodySide : public ImpactSide {
   /// \throws ModelError (a set-up call) if the mass is not a finite value > 0, the inertia is not
   /// symmetric positive definite, or an input is not finite. The message starts with "target: ".
   RigidBodySide(const RigidBody& body, const Vector3d& contact_point);
+
+  /// \brief The same side at another state and velocity (same model, contact, response and
+  /// method), reusing its solvers and workspaces: a compute call, allocation-free, that never
+  /// throws. \return 0, or the code of the part that refused (E_SIZE_MISMATCH, E_NOT_FINITE,
+  /// E_NOT_POSITIVE_DEFINITE...); on an error the side answers nothing (applyImpulse returns
+  /// E_NOT_COMPUTED) until a successful reset.
+  int reset(const State& state, const FloatingVelocity& before);
 
   const Matrix6d& G() const override { return G_; }
   const Vector6d& contactTwistBefore() const override { return t_before_; }

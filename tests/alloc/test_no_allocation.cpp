@@ -240,6 +240,10 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
     Impulse impulse;
     NO_ALLOCATION(impulse = solveImpact(robot.G(), G_B, robot.contactTwistBefore(), target.contactTwistBefore(), law));
     EXPECT_TRUE(impulse.F.allFinite());
+    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded, &robot_locked}) {
+      NO_ALLOCATION(EXPECT_EQ(side->reset(other, v), E_NOERROR));
+      NO_ALLOCATION(EXPECT_EQ(side->reset(state, v), E_NOERROR));
+    }
     for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded, &robot_locked})
       NO_ALLOCATION(EXPECT_EQ(side->applyImpulse(impulse.F), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(target.applyImpulse(-impulse.F), E_NOERROR));
