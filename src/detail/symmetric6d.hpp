@@ -70,12 +70,11 @@ struct Symmetric6d {
     a[19] = I_c(2, 1) - my * c.z();
     a[20] = I_c(2, 2) + mx * c.x() + my * c.y();
   }
-  /// \brief The inverse, from the root-free Cholesky factors A = L D L^T (L unit lower
-  /// triangular; no pivoting, as for any symmetric positive definite matrix):
-  /// A^-1 = X^T D^-1 X with X = L^-1. \return false, `inverse` unspecified, when a pivot is not
-  /// positive: the matrix is not positive definite (or holds NaN).
-  bool invert(Symmetric6d& inverse) const {
-    double L[6][6], LD[6][6], d_inv[6];  // LD(i, k) = L(i, k) d_k
+  /// \brief The root-free Cholesky factors A = L D L^T (L unit lower triangular, only its
+  /// strictly lower part written; d_inv = D^-1; no pivoting, as for any symmetric positive
+  /// definite matrix). \return false when a pivot is not positive (not positive definite, NaN).
+  bool factor(double (&L)[6][6], double (&d_inv)[6]) const {
+    double LD[6][6];  // LD(i, k) = L(i, k) d_k
 #pragma GCC unroll 6
     for (int j = 0; j < 6; ++j) {
       double d = a[index(j, j)];
@@ -89,6 +88,15 @@ struct Symmetric6d {
         L[i][j] = s * d_inv[j];
       }
     }
+    return true;
+  }
+  /// \brief The inverse, from the root-free Cholesky factors A = L D L^T (L unit lower
+  /// triangular; no pivoting, as for any symmetric positive definite matrix):
+  /// A^-1 = X^T D^-1 X with X = L^-1. \return false, `inverse` unspecified, when a pivot is not
+  /// positive: the matrix is not positive definite (or holds NaN).
+  bool invert(Symmetric6d& inverse) const {
+    double L[6][6], d_inv[6];
+    if (!factor(L, d_inv)) return false;
     double X[6][6];  // X = L^-1, unit lower triangular: X(i, c) = -sum_{c <= k < i} L(i, k) X(k, c)
 #pragma GCC unroll 6
     for (int c = 0; c < 6; ++c) {
@@ -112,20 +120,8 @@ struct Symmetric6d {
   /// back substitution (no inverse formed). \return false, `x` unspecified, when a pivot is not
   /// positive.
   bool solve(const Vector6d& b, Vector6d& x) const {
-    double L[6][6], LD[6][6], d_inv[6], y[6];
-#pragma GCC unroll 6
-    for (int j = 0; j < 6; ++j) {
-      double d = a[index(j, j)];
-      for (int k = 0; k < j; ++k) d -= L[j][k] * LD[j][k];
-      if (!(d > 0.0)) return false;
-      d_inv[j] = 1.0 / d;
-      for (int i = j + 1; i < 6; ++i) {
-        double s = a[index(i, j)];
-        for (int k = 0; k < j; ++k) s -= L[i][k] * LD[j][k];
-        LD[i][j] = s;
-        L[i][j] = s * d_inv[j];
-      }
-    }
+    double L[6][6], d_inv[6], y[6];
+    if (!factor(L, d_inv)) return false;
 #pragma GCC unroll 6
     for (int i = 0; i < 6; ++i) {  // L y = b
       double s = b(i);
