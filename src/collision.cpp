@@ -56,8 +56,7 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
     refuse("the response is not one of FreeFloating, Grounded, JointsLocked");
   if (method != ExIITMethod::Recursive && method != ExIITMethod::Dense)
     refuse("the method is not one of Recursive, Dense");
-  if (h_.body < 0 || h_.body >= static_cast<int>(model_->bodies().size())) refuse("contact point", E_BAD_CONTACT);
-  if (!allFinite(h_.offset)) refuse("contact point", E_NOT_FINITE);
+  if (const int rc = contactCode(true, h_, model_->bodies().size())) refuse("contact point", rc);
   if (kin_.model != model_.get() || kin_.R.size() != model_->bodies().size()) refuse("the kinematics", E_SIZE_MISMATCH);
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::JointsLocked) {

@@ -195,12 +195,9 @@ int FreeFloatingSolver::J_star(const Contact& h, KDL::Jacobian& J_star) {
 }
 
 int FreeFloatingSolver::G_locked(const Contact& h, Matrix6d& G) const {
-  Matrix6d R;
-  if (const int rc = R_h(h, R)) return rc;
-  Matrix6d X = R.transpose();
-  M_a_solveInPlace(X);
-  Matrix6d G_locked;
-  G_locked.noalias() = R * X;  // eq. 20
+  Vector3d p_h;
+  if (const int rc = contactPoint(h, p_h)) return rc;
+  Matrix6d G_locked = rigidBodyG(w(), I_g_, p_h - r_g_);  // eq. 20: R_h M_a^-1 R_h^T
   symmetrize(G_locked);
   if (!G_locked.allFinite()) return E_NOT_FINITE;
   G = G_locked;

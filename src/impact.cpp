@@ -94,22 +94,4 @@ int virtualMass(const Matrix6d& G, const Vector3d& n, double& m) {
 
 double virtualMass(const Matrix6d& G, const Vector3d& n) { return 1.0 / n.dot(G.topLeftCorner<3, 3>() * n); }
 
-int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B) {
-  if (!std::isfinite(m) || !I_com.allFinite() || !r_bc.allFinite()) return E_NOT_FINITE;
-  if (!(m > 0.0)) return E_BAD_ARGUMENT;
-  if ((0.5 * (I_com + I_com.transpose())).llt().info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  const Matrix6d G = rigidBodyG(m, I_com, r_bc);
-  if (!G.allFinite()) return E_NOT_FINITE;
-  G_B = G;
-  return E_NOERROR;
-}
-
-Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc) {
-  const Matrix6d R_b = transfer(r_bc);  // eq. 16: twist at the CoM -> twist at c
-  Matrix6d M_inv_Rt = R_b.transpose();
-  M_inv_Rt.topRows<3>() /= m;
-  M_inv_Rt.bottomRows<3>() = I_com.llt().solve(M_inv_Rt.bottomRows<3>().eval());
-  return R_b * M_inv_Rt;  // eq. 17: G_B = R_b M_b^-1 R_b^T
-}
-
 }  // namespace kdl_space

@@ -90,13 +90,8 @@ int MomentumSolver::contactTwist(const Contact& h, Vector6d& t_h) const {
 
 int MomentumSolver::G_locked(const Contact& h, Matrix6d& G) const {
   if (const int rc = contactCode(computed_, h, V_.size())) return rc;
-  const Matrix6d R = transfer(R_[h.body] * toEigen(h.offset) + p_[h.body] - r_g_);  // R_h, eq. 5
-  Matrix6d X = R.transpose();
-  X.topRows<3>() /= model_->totalMass();
-  const Eigen::LLT<Matrix3d> I_g_llt(I_g_);
-  for (int c = 0; c < 6; ++c) X.col(c).tail<3>() = I_g_llt.solve(Vector3d(X.col(c).tail<3>()));
-  Matrix6d result;
-  result.noalias() = R * X;  // eq. 20
+  // eq. 20: the whole system as one rigid body (w, I_g) touched at r_gh = p_h - r_g
+  Matrix6d result = rigidBodyG(model_->totalMass(), I_g_, R_[h.body] * toEigen(h.offset) + p_[h.body] - r_g_);
   symmetrize(result);
   if (!result.allFinite()) return E_NOT_FINITE;
   G = result;

@@ -69,12 +69,5 @@ KDL_SPACE_EXPORT int virtualMass(const Matrix6d& G, const Vector3d& n, double& m
 /// The same for a unit n, unchecked: +inf where n^T G_vv n = 0.
 KDL_SPACE_EXPORT double virtualMass(const Matrix6d& G, const Vector3d& n);
 
-/// \brief Inverse inertia of a rigid body B at a point c: G_B = R_b M_b^-1 R_b^T (eq. 15-17),
-/// mass m, inertia I_com about the CoM (world axes), r_bc = p_c - p_b.
-/// \return 0, E_NOT_FINITE (an input, or the result overflows), E_BAD_ARGUMENT (m <= 0) or
-/// E_NOT_POSITIVE_DEFINITE (I_com). `G_B` untouched on an error.
-KDL_SPACE_EXPORT int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B);
-/// The same, unchecked (m > 0 and I_com symmetric positive definite are the caller's).
-KDL_SPACE_EXPORT Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
 
 }  // namespace kdl_space

@@ -59,6 +59,14 @@ inline Vector6d shiftMomentum(const Vector6d& PL, const Vector3d& r) {
 /// Maps a twist at the reference point to the momentum (P; L about the reference point).
 KDL_SPACE_EXPORT Matrix6d spatialInertia(double m, const Vector3d& c, const Matrix3d& I_c);
 
+/// \brief Inverse inertia of a rigid body B at a point c: G_B = R_b M_b^-1 R_b^T (eq. 15-17; with the whole system locked, w, I_g and r_gh, it is eq. 20),
+/// mass m, inertia I_com about the CoM (world axes), r_bc = p_c - p_b.
+/// \return 0, E_NOT_FINITE (an input, or the result overflows), E_BAD_ARGUMENT (m <= 0) or
+/// E_NOT_POSITIVE_DEFINITE (I_com). `G_B` untouched on an error.
+KDL_SPACE_EXPORT int rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc, Matrix6d& G_B);
+/// The same, unchecked (m > 0 and I_com symmetric positive definite are the caller's).
+KDL_SPACE_EXPORT Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc);
+
 /// \brief Centroid inertia M_a = diag(w E, I_g) (eq. 12).
 KDL_SPACE_EXPORT Matrix6d centroidInertia(double w, const Matrix3d& I_g);
 

@@ -91,53 +91,7 @@ TEST_F(SolverCodes, MomentumBaseTwistAndEnergyCheckSizesAndFiniteness) {
   EXPECT_EQ(T, kSentinel);
 }
 
-TEST_F(SolverCodes, EveryContactQueryRefusesABadContact) {
-  const int nb = static_cast<int>(model->bodies().size());
-  const struct {
-    Contact h;
-    int code;
-  } cases[] = {
-      {Contact{-1, KDL::Vector::Zero()}, E_BAD_CONTACT},
-      {Contact{nb, KDL::Vector::Zero()}, E_BAD_CONTACT},
-      {Contact{1 << 30, KDL::Vector::Zero()}, E_BAD_CONTACT},
-      {Contact{tip.body, KDL::Vector(kNaN, 0, 0)}, E_NOT_FINITE},
-      {Contact{tip.body, KDL::Vector(0, -kInf, 0)}, E_NOT_FINITE},
-  };
-  for (const auto& c : cases) {
-    SCOPED_TRACE("body " + std::to_string(c.h.body) + ", offset x " + std::to_string(c.h.offset.x()));
-    Vector3d p = Vector3d::Constant(kSentinel);
-    Matrix6d M = Matrix6d::Constant(kSentinel);
-    KDL::Jacobian J(n);
-    J.data.setConstant(kSentinel);
-    KDL::JntArray qdot(n), dqdot(n);
-    dqdot.data.setConstant(kSentinel);
-    Vector6d PL = Vector6d::Zero(), dPL = Vector6d::Constant(kSentinel);
-    KDL::Twist t = KDL::Twist::Zero();
-    Eigen::MatrixXd G_all = Eigen::MatrixXd::Constant(12, 12, kSentinel);
-    EXPECT_NO_THROW({
-      EXPECT_EQ(solver.contactPoint(c.h, p), c.code) << "contactPoint";
-      EXPECT_EQ(solver.R_h(c.h, M), c.code) << "R_h";
-      EXPECT_EQ(solver.J(c.h, J), c.code) << "J";
-      EXPECT_EQ(solver.J_star(c.h, J), c.code) << "J_star";
-      EXPECT_EQ(solver.G_star(c.h, M), c.code) << "G_star";
-      EXPECT_EQ(solver.G_grounded(c.h, M), c.code) << "G_grounded";
-      EXPECT_EQ(solver.G_locked(c.h, M), c.code) << "G_locked";
-      EXPECT_EQ(solver.handTwist(c.h, qdot, PL, t), c.code) << "handTwist";
-      for (Response r : {Response::FreeFloating, Response::Grounded, Response::JointsLocked}) {
-        EXPECT_EQ(solver.G(c.h, r, M), c.code) << "G";
-        EXPECT_EQ(solver.velocityJump(c.h, r, Vector6d::Ones(), dPL, dqdot), c.code) << "velocityJump";
-      }
-      EXPECT_EQ(solver.G_star(std::vector<Contact>{tip, c.h}, G_all), c.code) << "G_star(contacts)";
-    });
-    EXPECT_EQ(p, Vector3d::Constant(kSentinel));
-    EXPECT_EQ(M, Matrix6d::Constant(kSentinel));
-    EXPECT_EQ(J.data, Matrix6Xd::Constant(6, n, kSentinel));
-    EXPECT_EQ(dPL, Vector6d::Constant(kSentinel));
-    EXPECT_EQ(dqdot.data, Eigen::VectorXd::Constant(n, kSentinel));
-    EXPECT_TRUE(same(t, KDL::Twist::Zero()));
-    EXPECT_EQ(G_all, Eigen::MatrixXd::Constant(12, 12, kSentinel));
-  }
-}
+// Every contact query of every solver against bad contacts: test_compute_codes_all_solvers.cpp.
 
 TEST_F(SolverCodes, AnInverseInertiaThatOverflowsIsRefused) {
   // A finite offset so large that the lever arms squared overflow: the point, J and J* are

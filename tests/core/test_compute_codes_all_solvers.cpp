@@ -145,8 +145,25 @@ TEST_F(EverySolver, ContactQueriesRefuseTheSameHostileContacts) {
     Vector6d v = Vector6d::Constant(kSentinel);
     KDL::JntArray dqdot(n);
     dqdot.data.setConstant(kSentinel);
+    Vector3d p = Vector3d::Constant(kSentinel);
+    KDL::Jacobian J(n);
+    J.data.setConstant(kSentinel);
+    KDL::Twist t = KDL::Twist::Zero();
+    Eigen::MatrixXd G_all = Eigen::MatrixXd::Constant(12, 12, kSentinel);
     EXPECT_NO_THROW({
+      EXPECT_EQ(dense.contactPoint(c.h, p), c.code) << "FreeFloatingSolver::contactPoint";
+      EXPECT_EQ(dense.R_h(c.h, M), c.code) << "FreeFloatingSolver::R_h";
+      EXPECT_EQ(dense.J(c.h, J), c.code) << "FreeFloatingSolver::J";
+      EXPECT_EQ(dense.J_star(c.h, J), c.code) << "FreeFloatingSolver::J_star";
       EXPECT_EQ(dense.G_star(c.h, M), c.code) << "FreeFloatingSolver::G_star";
+      EXPECT_EQ(dense.G_grounded(c.h, M), c.code) << "FreeFloatingSolver::G_grounded";
+      EXPECT_EQ(dense.G_locked(c.h, M), c.code) << "FreeFloatingSolver::G_locked";
+      EXPECT_EQ(dense.handTwist(c.h, velocity.qdot, Vector6d::Zero(), t), c.code) << "FreeFloatingSolver::handTwist";
+      for (Response r : {Response::FreeFloating, Response::Grounded, Response::JointsLocked}) {
+        EXPECT_EQ(dense.G(c.h, r, M), c.code) << "FreeFloatingSolver::G";
+        EXPECT_EQ(dense.velocityJump(c.h, r, Vector6d::Ones(), v, dqdot), c.code) << "FreeFloatingSolver::velocityJump";
+      }
+      EXPECT_EQ(dense.G_star(std::vector<Contact>{tip, c.h}, G_all), c.code) << "FreeFloatingSolver::G_star(contacts)";
       EXPECT_EQ(recursive.G_star(c.h, M), c.code) << "RecursiveExIITSolver::G_star";
       for (Response r : {Response::FreeFloating, Response::Grounded}) {
         EXPECT_EQ(recursive.G(c.h, r, M), c.code) << "RecursiveExIITSolver::G";
@@ -158,6 +175,10 @@ TEST_F(EverySolver, ContactQueriesRefuseTheSameHostileContacts) {
     EXPECT_EQ(M, Matrix6d::Constant(kSentinel));
     EXPECT_EQ(v, Vector6d::Constant(kSentinel));
     EXPECT_EQ(dqdot.data, Eigen::VectorXd::Constant(n, kSentinel));
+    EXPECT_EQ(p, Vector3d::Constant(kSentinel));
+    EXPECT_EQ(J.data, Matrix6Xd::Constant(6, n, kSentinel));
+    EXPECT_TRUE(toEigen(t) == Vector6d::Zero());
+    EXPECT_EQ(G_all, Eigen::MatrixXd::Constant(12, 12, kSentinel));
   }
   // A finite offset so large that the lever arms squared overflow: every G is refused.
   const Contact far{tip.body, KDL::Vector(1e308, 1e308, 0)};
