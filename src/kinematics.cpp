@@ -14,7 +14,8 @@ Kinematics::Kinematics(const FloatingModel& m)
       p(m.bodies().size(), Vector3d::Zero()),
       S(m.bodies().size(), Vector6d::Zero()),
       com(m.bodies().size(), Vector3d::Zero()),
-      I_com(m.bodies().size(), Matrix3d::Zero()) {}
+      I_com(m.bodies().size(), Matrix3d::Zero()),
+      sc_(m.bodies().size(), Eigen::Vector2d(0.0, 0.0)) {}
 
 KDL::Frame Kinematics::pose(int i) const {
   KDL::Rotation M;
@@ -34,6 +35,13 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
   kin.R[0] = toEigen(state.world_T_base.M);
   kin.p[0] = p_b;
   Vector3d first_moment = Vector3d::Zero();
+  // The joints' sines first: a call in the pass below would spill its registers every body.
+  for (std::size_t i = 1; i < nb; ++i) {
+    const detail::JointMotion& j = bodies[i];
+    if (j.kind != detail::JointMotion::Revolute) continue;
+    const double t = j.scale * state.q.data(j.joint);
+    kin.sc_[i] = Eigen::Vector2d(std::sin(t), 1.0 - std::cos(t));
+  }
   // Parents first. Each result is built in registers and stored once (a store read back in
   // pieces stalls).
   for (std::size_t i = 0; i < nb; ++i) {
@@ -42,7 +50,7 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
       const Matrix3d& R_parent = kin.R[j.parent];
       const Vector3d& p_parent = kin.p[j.parent];
       if (j.kind == detail::JointMotion::Revolute) {  // rotation about the joint's axis line, then pose(0)
-        const double t = j.scale * state.q.data(j.joint), s = std::sin(t), c1 = 1.0 - std::cos(t);
+        const double s = kin.sc_[i].x(), c1 = kin.sc_[i].y();
         kin.R[i].noalias() = R_parent * (j.R0 + s * j.K1 + c1 * j.K2);
         kin.p[i] = p_parent + R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
       } else {

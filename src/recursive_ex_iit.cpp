@@ -18,10 +18,11 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   IA_.resize(nb);
   U_.assign(nb, Vector6d::Zero());
   D_.assign(nb, 0.0);
+  Dinv_.assign(nb, 0.0);
   path_.resize(nb);
   dq_.setZero(model_->nj());
   a_.resize(nb);
-  pa_.resize(nb);
+  pa_.assign(nb, Vector6d::Zero());
 }
 
 RecursiveExIITSolver::~RecursiveExIITSolver() = default;
@@ -47,8 +48,8 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
     R_[i] = kin.R[i];
     p_[i] = kin.p[i];
     S_[i] = kin.S[i];
-    IA_[i].setZero();
-    if (bodies[i].mass > 0.0) IA_[i].addRigidBody(bodies[i].mass, kin.com[i] - p_b_, kin.I_com[i]);  // else a frame
+    if (bodies[i].mass > 0.0) IA_[i].setRigidBody(bodies[i].mass, kin.com[i] - p_b_, kin.I_com[i]);
+    else IA_[i].setZero();  // a frame
   }
   // Articulated-body inertias, leaves first.
   for (std::size_t i = nb; i-- > 1;) {
@@ -60,7 +61,8 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
     U_[i] = IA_[i] * S_[i];
     D_[i] = S_[i].dot(U_[i]) + armature[j.joint];
     if (!(D_[i] > 0.0)) return E_NOT_POSITIVE_DEFINITE;
-    IA_[j.parent].addMinusRank1(IA_[i], U_[i], 1.0 / D_[i]);
+    Dinv_[i] = 1.0 / D_[i];
+    IA_[j.parent].addMinusRank1(IA_[i], U_[i], Dinv_[i]);
   }
   detail::Symmetric6d Omega0;
   if (!IA_[0].invert(Omega0)) return E_NOT_POSITIVE_DEFINITE;
@@ -101,7 +103,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response re
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
     if (bodies[i].joint < 0) continue;
-    const double d = 1.0 / D_[i];
+    const double d = Dinv_[i];
     const Vector6d& S = S_[i];
     const Vector6d w = O.leftCols<3>() * U_[i].head<3>() + O.rightCols<3>() * U_[i].tail<3>();  // two chains
     const Vector6d y = d * w - (0.5 * d * (d * U_[i].dot(w) + 1.0)) * S;
@@ -136,12 +138,11 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
   const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
   const Vector3d r = R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_;
   const int count = walkPath(h);
-  for (auto& p : pa_) p.setZero();
   Vector6d p = -transfer(r).transpose() * F;  // the impulse as a bias force at p_b
   for (int k = 0; k < count - 1; ++k) {
     const int i = path_[k];
     pa_[i] = p;
-    if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) / D_[i]);
+    if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) * Dinv_[i]);
   }
   // The base's jump (eq. 18); a grounded base does not move (eq. 23). The joints' jumps outward.
   a_[0] = response == Response::FreeFloating ? Vector6d(-(Omega0_ * p)) : Vector6d::Zero();
@@ -149,11 +150,12 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
     const detail::JointMotion& b = bodies[i];
     a_[i] = a_[b.parent];
     if (b.joint >= 0) {
-      const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) / D_[i];
+      const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) * Dinv_[i];
       dq_(b.joint) = qdd;
       a_[i] += S_[i] * qdd;
     }
   }
+  for (int k = 0; k < count - 1; ++k) pa_[path_[k]].setZero();  // zero off the path, as it was
   if (!a_[0].allFinite() || !dq_.allFinite()) return E_NOT_FINITE;
   d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
   dqdot.data = dq_;

@@ -86,11 +86,12 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::vector<detail::Symmetric6d> IA_;            ///< per body: articulated inertia at p_b
   std::vector<Vector6d> U_;                        ///< per body: I^A S
   std::vector<double> D_;                          ///< per body: S^T I^A S + armature
+  std::vector<double> Dinv_;                       ///< per body: 1 / D (no division in the queries)
   Matrix6d Omega0_ = Matrix6d::Zero();            ///< (I^A_0)^-1
   std::vector<int> path_;                          ///< scratch: contact path
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   Eigen::VectorXd dq_;                             ///< scratch: joint-rate jumps (n)
-  std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse)
+  std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse; zero between calls)
 };
 
 }  // namespace kdl_space
