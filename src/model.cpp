@@ -143,6 +143,7 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   build(kdlInertia(links.front().body));
   if (armature.empty()) armature.assign(nj(), 0.0);
   armature_ = std::move(armature);
+  joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
   validate();
 }
@@ -297,6 +298,25 @@ Contact FloatingModel::contact(const std::string& link, const KDL::Vector& offse
   return Contact{body, offset};
 }
 
+FloatingModel FloatingModel::withJointProperties(const std::map<std::string, JointProperties>& by_name) const {
+  FloatingModel copy(*this);
+  for (const auto& [name, p] : by_name) {
+    const int j = jointIndex(name);
+    if (j < 0) {
+      bool fixed = false;
+      for (const FixedJoint& f : fixed_joints_) fixed |= f.joint == name;
+      if (fixed) continue;
+      throw ModelError("joint properties: the model has no joint " + detail::quoted(name));
+    }
+    if (std::isnan(p.lower) || std::isnan(p.upper) || !(p.lower <= p.upper))
+      fail("joint", name, "position limits [" + rules::number(p.lower) + ", " + rules::number(p.upper) + "] are not an interval");
+    for (const double v : {p.effort, p.velocity, p.damping, p.friction})
+      if (!(v >= 0.0)) fail("joint", name, "effort and velocity limits, damping and friction must be >= 0");
+    copy.joint_properties_[j] = p;
+  }
+  return copy;
+}
+
 FloatingModel FloatingModel::withArmature(std::vector<double> armature) const {
   FloatingModel copy(*this);
   copy.armature_ = std::move(armature);
@@ -335,6 +355,7 @@ FloatingModel FloatingModel::withPayload(const std::string& link, const KDL::Rig
   FloatingModel merged(tree, base, armature_, {});
   merged.diagnostics_ = std::move(diagnostics);
   merged.fixed_joints_ = fixed_joints_;
+  merged.joint_properties_ = joint_properties_;
   return merged;
 }
 

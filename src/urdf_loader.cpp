@@ -5,6 +5,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <sstream>
 
@@ -78,6 +79,24 @@ std::string typeName(const urdf::Joint& j) {
     case urdf::Joint::FIXED: return "fixed";
     default: return "unknown";
   }
+}
+
+/// Limits, damping and friction of the movable joints, as urdfdom read them. An effort or velocity
+/// limit of 0 (files write it for "not given": no joint could move) is no limit.
+std::map<std::string, JointProperties> properties(const urdf::ModelInterface& model) {
+  std::map<std::string, JointProperties> by_name;
+  for (const auto& [name, joint] : model.joints_) {
+    if (!rules::isMovable(typeName(*joint))) continue;
+    JointProperties p;
+    if (const urdf::JointLimitsSharedPtr& l = joint->limits) {
+      if (joint->type != urdf::Joint::CONTINUOUS) p.lower = l->lower, p.upper = l->upper;
+      if (l->effort > 0.0) p.effort = l->effort;
+      if (l->velocity > 0.0) p.velocity = l->velocity;
+    }
+    if (const urdf::JointDynamicsSharedPtr& d = joint->dynamics) p.damping = d->damping, p.friction = d->friction;
+    by_name[name] = p;
+  }
+  return by_name;
 }
 
 }  // namespace
@@ -160,7 +179,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
            ": its joints form a loop (a URDF describes a tree)");
 
   try {
-    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics));
+    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics)).withJointProperties(properties(*model));
   } catch (const ModelError& e) {
     throw ModelError(source + ": " + e.what());
   }

@@ -7,7 +7,9 @@
 #include <kdl/chain.hpp>
 #include <kdl/rigidbodyinertia.hpp>
 #include <kdl/tree.hpp>
+#include <limits>
 #include <memory>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,18 @@ struct Body {
   double mass = 0.0;       ///< [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< CoM, this body's frame [m]
   Eigen::Matrix3d I_com = Eigen::Matrix3d::Zero();     ///< inertia about the CoM, body axes [kg m^2]
+};
+
+/// \brief What a description says of a joint beyond its motion (URDF <limit> and <dynamics>): read
+/// into the model, used by the simulation. Infinite where the description gives no limit (the
+/// URDF loader reads an effort or velocity limit of 0, which files write for "not given", as none).
+struct JointProperties {
+  double lower = -std::numeric_limits<double>::infinity();  ///< position limits [rad or m]
+  double upper = std::numeric_limits<double>::infinity();
+  double effort = std::numeric_limits<double>::infinity();    ///< [N m or N]
+  double velocity = std::numeric_limits<double>::infinity();  ///< [rad/s or m/s]
+  double damping = 0.0;   ///< viscous [N m s/rad or N s/m]
+  double friction = 0.0;  ///< Coulomb [N m or N]
 };
 
 /// A movable joint of the description that the model treats as fixed (at q = 0), and why.
@@ -77,6 +91,13 @@ class KDL_SPACE_EXPORT FloatingModel {
   const std::vector<std::string>& jointNames() const { return joint_names_; }
   /// Index of the body each joint moves (model order).
   const std::vector<int>& jointBody() const { return joint_body_; }
+  /// Limits, damping and friction per joint (model order; none unless given).
+  const std::vector<JointProperties>& jointProperties() const { return joint_properties_; }
+  /// \brief A copy of this model with the joints' limits, damping and friction, by joint name
+  /// (names of joints that are not coordinates are ignored: they are fixed).
+  /// \throws ModelError for a name that is no joint of the description's, or a property that
+  /// is NaN, a negative damping, friction, effort or velocity limit, or lower > upper.
+  FloatingModel withJointProperties(const std::map<std::string, JointProperties>& by_name) const;
   /// Rotor inertia per joint (zeros unless given).
   const std::vector<double>& armature() const { return armature_; }
   /// Problems found that do not stop the computation, and what was assumed to read the tree.
@@ -118,6 +139,7 @@ class KDL_SPACE_EXPORT FloatingModel {
   std::vector<std::string> joint_names_;
   std::vector<int> joint_body_;
   std::vector<double> armature_;
+  std::vector<JointProperties> joint_properties_;
   std::vector<Diagnostic> diagnostics_;
   std::vector<FixedJoint> fixed_joints_;
   double total_mass_ = 0.0;
