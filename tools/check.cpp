@@ -1,5 +1,6 @@
 #include "check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -39,15 +40,38 @@ Json summaryJson(const ModelSummary& m) {
   return j;
 }
 
-/// One line about the model that loaded: what it is and how well conditioned at q = 0.
-std::string modelNote(const ModelSummary& m) {
+/// Whether condition number `a` is worse than `b`: larger, infinite, or not a number at all.
+bool worse(double a, double b) {
+  const auto rank = [](double c) { return std::isnan(c) ? 2 : std::isinf(c) ? 1 : 0; };
+  return rank(a) != rank(b) ? rank(a) > rank(b) : rank(a) == 0 && a > b;
+}
+
+/// Leaves named in the note when no --tip was given; the JSON has them all.
+constexpr std::size_t kLeavesInNote = 3;
+
+/// One line about the model that loaded: what it is and how well conditioned at q = 0. cond(G*)
+/// at every requested tip, in their order; without --tip, at the kLeavesInNote worst leaves,
+/// worst first, and how many more the JSON holds.
+std::string modelNote(const ModelSummary& m, bool tips_requested) {
   std::ostringstream s;
   s << "base '" << m.base << "', " << plural(m.links, "link") << ", " << plural(m.joint_names.size(), "movable joint")
     << ", total mass " << m.total_mass << " kg";
   if (!m.joint_names.empty()) s << "; at q = 0: cond(H*) = " << m.condition_H_star;
-  for (std::size_t i = 0; i < m.condition_G_star.size(); ++i)
+  std::vector<std::pair<std::string, double>> shown = m.condition_G_star;
+  std::size_t more = 0;
+  if (!tips_requested) {
+    std::stable_sort(shown.begin(), shown.end(), [](const auto& a, const auto& b) { return worse(a.second, b.second); });
+    if (shown.size() > kLeavesInNote) {
+      more = shown.size() - kLeavesInNote;
+      shown.resize(kLeavesInNote);
+    }
+  }
+  for (std::size_t i = 0; i < shown.size(); ++i)
     s << (i == 0 ? (m.joint_names.empty() ? "; at q = 0: cond(G*) = " : ", cond(G*) = ") : ", ")
-      << m.condition_G_star[i].second << " at '" << m.condition_G_star[i].first << "'";
+      << shown[i].second << " at '" << shown[i].first << "'";
+  if (more)
+    s << " (the " << kLeavesInNote << " largest), and " << more << " more " << (more == 1 ? "leaf" : "leaves")
+      << " (all in --json)";
   return s.str();
 }
 
@@ -78,7 +102,7 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";
     for (const Finding& f : report.notes) out << report.source << ": note: " << describe(f) << "\n";
-    if (report.model.loaded) out << report.source << ": note: " << modelNote(report.model) << "\n";
+    if (report.model.loaded) out << report.source << ": note: " << modelNote(report.model, !o.tips.empty()) << "\n";
     out << plural(report.errors.size(), "error") << ", " << plural(report.warnings.size(), "warning");
     if (o.strict && !report.warnings.empty()) out << " (--strict: warnings fail the check)";
     out << "\n";
