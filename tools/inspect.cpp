@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "detail/text.hpp"
 #include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/urdf_check.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 namespace kdl_space::cli {
@@ -89,7 +90,11 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   try {
     model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
   } catch (const ModelError& e) {
-    throw InputError(e.what());
+    // In check's words (one set of rules): every error of the file, not only the loader's first.
+    const UrdfReport report = checkUrdfFile(o.urdf);
+    std::string all;
+    for (const Finding& f : report.errors) all += (all.empty() ? "" : "\n") + report.source + ": error: " + describe(f);
+    throw InputError(all.empty() ? e.what() : all);
   }
   for (const auto& [name, value] : q_by_name)
     if (model->jointIndex(name) < 0)

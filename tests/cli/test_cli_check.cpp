@@ -196,6 +196,17 @@ TEST_P(CheckTool, JsonHasTheSameEntries) {
   EXPECT_EQ(j.at("model").at("loaded").get<bool>(), c.errors.empty());
 }
 
+TEST_P(CheckTool, InspectOfAFileThatDoesNotLoadSaysWhatCheckSays) {
+  const Case& c = GetParam();
+  if (c.errors.empty() || !c.args.empty()) return;  // it loads (an unknown --tip is check's own)
+  const std::string path = kBroken + c.file + ".urdf";
+  const ToolRun r = kdlSpace("inspect --urdf " + path + " --tip base");
+  EXPECT_EQ(r.rc, 3);
+  std::string expected;
+  for (const Expected& e : c.errors) expected += (expected.empty() ? "" : "\n") + path + ": error: " + e.text();
+  EXPECT_EQ(r.err, "kdl_space: " + expected + "\n");
+}
+
 INSTANTIATE_TEST_SUITE_P(BrokenUrdf, CheckTool, ::testing::ValuesIn(cases()));
 
 TEST(CheckTool, EveryFileOfTheCorpusIsTested) {
