@@ -37,7 +37,35 @@ Json summaryJson(const ModelSummary& m) {
   Json g = Json::array();
   for (const auto& [link, condition] : m.condition_G_star) g.push_back(Json{{"link", link}, {"condition", jsonNumber(condition)}});
   j["condition_G_star"] = g;
+  Json props = Json::array();  // limits (null: none), damping, friction of each movable joint
+  for (std::size_t i = 0; i < m.joint_properties.size() && i < m.joint_names.size(); ++i) {
+    const JointProperties& p = m.joint_properties[i];
+    props.push_back(Json{{"joint", m.joint_names[i]}, {"lower", jsonNumber(p.lower)}, {"upper", jsonNumber(p.upper)},
+                         {"effort", jsonNumber(p.effort)}, {"velocity", jsonNumber(p.velocity)},
+                         {"damping", p.damping}, {"friction", p.friction}});
+  }
+  j["joint_properties"] = m.loaded ? props : Json(nullptr);
+  Json fixed = Json::array();
+  for (const FixedJoint& f : m.joints_treated_as_fixed) fixed.push_back(Json{{"joint", f.joint}, {"reason", f.reason}});
+  j["joints_treated_as_fixed"] = m.loaded ? fixed : Json(nullptr);
   return j;
+}
+
+/// One line of what the joints' <limit> and <dynamics> gave (the values are in --json).
+std::string propertiesNote(const ModelSummary& m) {
+  std::size_t position = 0, effort = 0, velocity = 0, damping = 0, friction = 0;
+  for (const JointProperties& p : m.joint_properties) {
+    position += std::isfinite(p.lower) || std::isfinite(p.upper);
+    effort += std::isfinite(p.effort);
+    velocity += std::isfinite(p.velocity);
+    damping += p.damping > 0.0;
+    friction += p.friction > 0.0;
+  }
+  std::ostringstream s;
+  s << "of the " << plural(m.joint_properties.size(), "movable joint") << ": position limits on " << position
+    << ", effort limits on " << effort << ", velocity limits on " << velocity << ", damping on " << damping
+    << ", friction on " << friction << " (values in --json)";
+  return s.str();
 }
 
 /// Whether condition number `a` is worse than `b`: larger, infinite, or not a number at all.
@@ -102,7 +130,11 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";
     for (const Finding& f : report.notes) out << report.source << ": note: " << describe(f) << "\n";
-    if (report.model.loaded) out << report.source << ": note: " << modelNote(report.model, !o.tips.empty()) << "\n";
+    if (report.model.loaded) {
+      if (!report.model.joint_properties.empty())
+        out << report.source << ": note: " << propertiesNote(report.model) << "\n";
+      out << report.source << ": note: " << modelNote(report.model, !o.tips.empty()) << "\n";
+    }
     out << plural(report.errors.size(), "error") << ", " << plural(report.warnings.size(), "warning");
     if (o.strict && !report.warnings.empty()) out << " (--strict: warnings fail the check)";
     out << "\n";

@@ -172,6 +172,10 @@ TEST_P(CheckTool, ReportsEachProblemWithItsLineAndExitCode) {
     ASSERT_FALSE(got.empty());
     EXPECT_EQ(got.back().rfind(path + ": note: base 'base', ", 0), 0u) << got.back();
     got.pop_back();
+    // What the joints' <limit> and <dynamics> gave: every file here limits all its joints.
+    ASSERT_FALSE(got.empty());
+    EXPECT_EQ(got.back().rfind(path + ": note: of the ", 0), 0u) << got.back();
+    got.pop_back();
   }
   EXPECT_EQ(got, expected);
 }
