@@ -61,7 +61,7 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::JointsLocked) {
     // eq. 20: no recursion
-  } else if (method == ExIITMethod::Recursive) {
+  } else if (method == ExIITMethod::Recursive && model_->mimic().empty()) {  // mimic joints: dense
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
   } else {
     dense_ = std::make_unique<FreeFloatingSolver>(model_);

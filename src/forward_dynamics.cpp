@@ -50,6 +50,7 @@ inline Vector6d rigidTimes(double m, const Vector3d& c, const Matrix3d& I_c, con
 
 ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("ForwardDynamicsSolver: null model");
+  model_->refuseMimic("ForwardDynamicsSolver");
   const std::size_t nb = model_->bodies().size();
   locked_.assign(model_->nj(), false);
   own_ = Kinematics(*model_);

@@ -14,6 +14,7 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   I_c_.resize(nb);
   I_body_.resize(nb);
   S_.resize(n);
+  Sb_.assign(nb, Vector6d::Zero());
   A_m_.setZero(6, n);
   Am_work_.setZero(6, n);
   J_work_.setZero(6, n);
@@ -54,18 +55,27 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
   }
   for (std::size_t i = bodies.size(); i-- > 1;) I_c_[bodies[i].parent] += I_c_[i];
 
-  // Joint twists moved to r_g; A_m and H by the composite-rigid-body pass.
-  for (unsigned int j = 0; j < n; ++j) S_[j] = shiftTwist(kin.S[model_->jointBody()[j]], r_g_ - kin.p_b);
-  for (unsigned int j = 0; j < n; ++j) {
-    const int b = model_->jointBody()[j];
-    const Vector6d F = I_c_[b] * S_[j];  // momentum about r_g of the subtree moved by joint j
-    A_m_.col(j) = F;
-    H_(j, j) = S_[j].dot(F) + model_->armature()[j];
+  // Joint twists moved to r_g; A_m and H by the composite-rigid-body pass, body by body: a
+  // coordinate that moves several joints (mimic) sums their terms (H = T^T H_joints T).
+  for (std::size_t b = 1; b < bodies.size(); ++b)
+    if (bodies[b].joint >= 0) Sb_[b] = shiftTwist(kin.S[b], r_g_ - kin.p_b);
+  for (unsigned int j = 0; j < n; ++j) S_[j] = Sb_[model_->jointBody()[j]];
+  A_m_.setZero();
+  for (std::size_t b = 1; b < bodies.size(); ++b) {
+    const int j = bodies[b].joint;
+    if (j < 0) continue;
+    const Vector6d F = I_c_[b] * Sb_[b];  // momentum about r_g of the subtree moved by this joint
+    A_m_.col(j) += F;
+    H_(j, j) += Sb_[b].dot(F);
     for (int a = bodies[b].parent; a >= 0; a = bodies[a].parent) {
       const int k = bodies[a].joint;
-      if (k >= 0) H_(k, j) = H_(j, k) = S_[k].dot(F);
+      if (k < 0) continue;
+      const double x = Sb_[a].dot(F);
+      H_(k, j) += x;
+      H_(j, k) += x;
     }
   }
+  for (unsigned int j = 0; j < n; ++j) H_(j, j) += model_->armature()[j];
 
   I_g_ = I_c_[0].bottomRightCorner<3, 3>();  // eq. 3 (about r_g the coupling block vanishes)
   M_a_ = centroidInertia(w(), I_g_);          // eq. 12
@@ -162,7 +172,7 @@ void FreeFloatingSolver::fixedBaseJacobian(const Contact& h, Eigen::Ref<Matrix6X
   const Vector3d r_gh = toEigen(world_T_body_[h.body] * h.offset) - r_g_;
   J.setZero();
   for (int b = h.body; b >= 0; b = bodies[b].parent)
-    if (bodies[b].joint >= 0) J.col(bodies[b].joint) = shiftTwist(S_[bodies[b].joint], r_gh);
+    if (bodies[b].joint >= 0) J.col(bodies[b].joint) += shiftTwist(Sb_[b], r_gh);
 }
 
 void FreeFloatingSolver::generalizedJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J_star) const {

@@ -14,7 +14,7 @@ MotionTable::MotionTable(const std::vector<Body>& model_bodies) : bodies(model_b
     j.com = b.com;
     j.I_com = b.I_com;
     if (b.parent < 0) continue;
-    const KDL::Frame pose0 = b.segment.pose(0.0);
+    const KDL::Frame pose0 = b.segment.pose(b.offset);  // at q = 0 of its coordinate (a mimic's offset)
     j.R0 = toEigen(pose0.M);
     j.p0 = toEigen(pose0.p);
     if (b.joint < 0) continue;

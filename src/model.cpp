@@ -2,32 +2,17 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <map>
 #include <cmath>
 
 #include "kdl_space/errors.hpp"
 #include "kdl_space/spatial.hpp"
 #include "detail/joint_motion.hpp"
 #include "detail/text.hpp"
+#include "model_build.hpp"
 #include "model_rules.hpp"
 
 namespace kdl_space {
-namespace {
-
-/// Mass, CoM and inertia about the CoM of a KDL inertia (KDL keeps the inertia about the
-/// reference frame's origin).
-void splitInertia(const KDL::RigidBodyInertia& I, Body& body) {
-  body.mass = I.getMass();
-  body.com = toEigen(I.getCOG());
-  const KDL::RotationalInertia Io = I.getRotationalInertia();
-  Matrix3d I_origin;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) I_origin(i, j) = Io.data[3 * i + j];
-  const Matrix3d C = skew(body.com);
-  body.I_com = I_origin + body.mass * C * C;  // parallel-axis theorem, back to the CoM
-}
-
-}  // namespace
-
 namespace {
 
 /// The links of a KDL tree, depth first (parents first), as the mass rules read them.
@@ -53,7 +38,7 @@ std::vector<ReadLink> readLinks(const KDL::Tree& tree, const KDL::RigidBodyInert
     link.element = element;
     link.body.name = link.node.link = element->first;
     link.body.parent = link.node.parent = parent;
-    splitInertia(parent < 0 ? base_inertia : segment.getInertia(), link.body);
+    detail::splitInertia(parent < 0 ? base_inertia : segment.getInertia(), link.body);
     link.node.mass = link.body.mass;
     if (parent >= 0 && segment.getJoint().getType() != KDL::Joint::None) {
       link.node.joint = segment.getJoint().getName();
@@ -71,11 +56,6 @@ std::vector<ReadLink> readLinks(const KDL::Tree& tree, const KDL::RigidBodyInert
   return links;
 }
 
-KDL::RigidBodyInertia kdlInertia(const Body& b) {
-  const Matrix3d& I = b.I_com;
-  return KDL::RigidBodyInertia(b.mass, toKDL(b.com),
-                               KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
-}
 
 /// The given tree as the dynamics read it: the joints in `fixed` made fixed (at q = 0), the
 /// links in `corrected` with those inertias.
@@ -85,7 +65,7 @@ KDL::Tree rebuiltTree(const std::vector<ReadLink>& links, const std::vector<bool
   for (std::size_t i = 1; i < links.size(); ++i) {
     const KDL::Segment& seg = GetTreeElementSegment(links[i].element->second);
     const KDL::Joint joint = fixed[i] ? KDL::Joint(seg.getJoint().getName(), KDL::Joint::Fixed) : seg.getJoint();
-    const KDL::RigidBodyInertia inertia = corrected[i] ? kdlInertia(links[i].body) : seg.getInertia();
+    const KDL::RigidBodyInertia inertia = corrected[i] ? detail::kdlInertia(links[i].body) : seg.getInertia();
     tree.addSegment(KDL::Segment(seg.getName(), joint, seg.pose(0.0), inertia), links[links[i].body.parent].body.name);
   }
   return tree;
@@ -94,8 +74,9 @@ KDL::Tree rebuiltTree(const std::vector<ReadLink>& links, const std::vector<bool
 }  // namespace
 
 FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
-                             std::vector<double> armature, std::vector<Diagnostic> diagnostics)
-    : diagnostics_(std::move(diagnostics)) {
+                             std::vector<double> armature, std::vector<Diagnostic> diagnostics,
+                             std::vector<Mimic> mimic)
+    : diagnostics_(std::move(diagnostics)), mimic_(std::move(mimic)) {
   if (!armature.empty() && armature.size() != tree.getNrOfJoints())
     throw ModelError("armature: " + std::to_string(armature.size()) + " values given for " +
                      std::to_string(tree.getNrOfJoints()) + " joints");
@@ -140,52 +121,24 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
         armature[GetTreeElementQNr(e->second)] = kept[k++];
       }
   }
-  build(kdlInertia(links.front().body));
-  if (armature.empty()) armature.assign(nj(), 0.0);
-  armature_ = std::move(armature);
+  // A mimic joint made fixed (it moves no mass) follows nothing.
+  mimic_.erase(std::remove_if(mimic_.begin(), mimic_.end(),
+                              [&](const Mimic& m) {
+                                for (const FixedJoint& f : fixed_joints_)
+                                  if (f.joint == m.joint) return true;
+                                return false;
+                              }),
+               mimic_.end());
+  build(detail::kdlInertia(links.front().body), armature);
+  if (!mimic_.empty())
+    diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: G*, the velocity "
+                                "jumps and the capture take the dense route (the O(n) recursion cannot couple joints)",
+                            "dense_route", Severity::Note});
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
   validate();
 }
 
-void FloatingModel::build(const KDL::RigidBodyInertia& base_inertia) {
-  const KDL::SegmentMap::const_iterator root = tree_.getRootSegment();
-  joint_names_.assign(tree_.getNrOfJoints(), std::string());
-  joint_body_.assign(tree_.getNrOfJoints(), -1);
-
-  // Depth-first traversal, computed once: parents precede children.
-  struct Item {
-    KDL::SegmentMap::const_iterator element;
-    int parent;
-  };
-  std::vector<Item> stack{{root, -1}};
-  while (!stack.empty()) {
-    const Item item = stack.back();
-    stack.pop_back();
-    const KDL::Segment& segment = GetTreeElementSegment(item.element->second);
-    Body body;
-    body.name = item.element->first;
-    body.parent = item.parent;
-    body.segment = segment;
-    if (item.parent < 0) {
-      splitInertia(base_inertia, body);
-    } else {
-      splitInertia(segment.getInertia(), body);
-      if (segment.getJoint().getType() != KDL::Joint::None) {
-        // KDL gives the twist at the tip; the rotation axis (or sliding direction) is fixed in
-        // the parent frame, so at the parent's origin the twist does not depend on q.
-        body.joint_twist = toEigen(segment.twist(0.0, 1.0).RefPoint(-segment.pose(0.0).p));
-        body.joint = static_cast<int>(GetTreeElementQNr(item.element->second));
-        joint_names_[body.joint] = segment.getJoint().getName();
-        joint_body_[body.joint] = static_cast<int>(bodies_.size());
-      }
-    }
-    const int index = static_cast<int>(bodies_.size());
-    bodies_.push_back(body);
-    const auto& children = GetTreeElementChildren(item.element->second);
-    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back({*it, index});
-  }
-}
 
 namespace {
 KDL::Tree chainAsTree(const KDL::Chain& chain, const std::string& base_name) {
@@ -279,6 +232,15 @@ void FloatingModel::checkComposites() {
   }
 }
 
+void FloatingModel::refuseMimic(const std::string& who) const {
+  if (mimic_.empty()) return;
+  std::vector<std::string> names;
+  for (const Mimic& m : mimic_) names.push_back(detail::quoted(m.joint));
+  throw ModelError(who + ": the model has mimic joints (" + detail::listNames(names) +
+                   "): the O(n) recursion cannot couple joints; use the dense route (FreeFloatingSolver, "
+                   "ExIITMethod::Dense)");
+}
+
 int FloatingModel::jointIndex(const std::string& name) const {
   for (std::size_t j = 0; j < joint_names_.size(); ++j)
     if (joint_names_[j] == name) return static_cast<int>(j);
@@ -303,9 +265,10 @@ FloatingModel FloatingModel::withJointProperties(const std::map<std::string, Joi
   for (const auto& [name, p] : by_name) {
     const int j = jointIndex(name);
     if (j < 0) {
-      bool fixed = false;
-      for (const FixedJoint& f : fixed_joints_) fixed |= f.joint == name;
-      if (fixed) continue;
+      bool not_coordinate = false;  // fixed (it moves no mass), or a mimic joint
+      for (const FixedJoint& f : fixed_joints_) not_coordinate |= f.joint == name;
+      for (const Mimic& m : mimic_) not_coordinate |= m.joint == name;
+      if (not_coordinate) continue;
       throw ModelError("joint properties: the model has no joint " + detail::quoted(name));
     }
     if (std::isnan(p.lower) || std::isnan(p.upper) || !(p.lower <= p.upper))
@@ -315,6 +278,14 @@ FloatingModel FloatingModel::withJointProperties(const std::map<std::string, Joi
     copy.joint_properties_[j] = p;
   }
   return copy;
+}
+
+std::vector<double> FloatingModel::treeArmature() const {
+  // Back to the tree's joints (q_nr order): a coordinate's on its own joint, none on mimic joints.
+  std::vector<double> tree(tree_.getNrOfJoints(), 0.0);
+  for (unsigned int j = 0; j < nj(); ++j)
+    tree[GetTreeElementQNr(tree_.getSegment(bodies_[joint_body_[j]].name)->second)] = armature_[j];
+  return tree;
 }
 
 FloatingModel FloatingModel::withArmature(std::vector<double> armature) const {
@@ -352,7 +323,7 @@ FloatingModel FloatingModel::withPayload(const std::string& link, const KDL::Rig
   std::vector<Diagnostic> diagnostics = diagnostics_;
   diagnostics.push_back(
       {link, "carries a rigid payload of " + std::to_string(inertia.getMass()) + " kg", "payload", Severity::Warning});
-  FloatingModel merged(tree, base, armature_, {});
+  FloatingModel merged(tree, base, treeArmature(), {}, mimic_);
   merged.diagnostics_ = std::move(diagnostics);
   merged.fixed_joints_ = fixed_joints_;
   merged.joint_properties_ = joint_properties_;

@@ -72,7 +72,9 @@ void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I
                             "products of inertia and the units"));
     return;
   }
-  if (I_com.isZero(0.0)) {
+  // A point mass: no moment beyond the round-off of moving an inertia between the CoM and the
+  // link origin (KDL keeps it about the origin: m |c|^2 eps for |c| up to 10 m).
+  if (l(2) <= mass * 1e-12) {
     out.push_back(warning("point_mass", ElementType::Link, link,
                           "a point mass (" + number(mass) + " kg, no rotational inertia): read as one; the "
                           "body it belongs to needs its inertia from other links"));
@@ -156,11 +158,23 @@ void checkRevoluteWithoutLimit(const std::string& joint, Findings& out) {
                         "without position, effort or velocity limits"));
 }
 
-void checkMimic(const std::string& joint, const std::string& leader, Findings& out) {
-  out.push_back(warning("mimic_ignored", ElementType::Joint, joint,
-                        "mimics joint " + detail::quoted(leader) +
-                            ", but kdl_space does not couple joints yet: it is an independent coordinate "
-                            "(give it the leader's motion yourself)"));
+void checkMimic(const std::string& joint, const std::string& leader, bool leader_movable, double multiplier,
+                double offset, Findings& out) {
+  if (!leader_movable) {
+    out.push_back(error("bad_mimic", ElementType::Joint, joint,
+                        "mimics " + detail::quoted(leader) + ", which is no movable joint of the file: name a "
+                        "revolute, continuous or prismatic joint, or remove the <mimic>"));
+    return;
+  }
+  if (!std::isfinite(multiplier) || multiplier == 0.0 || !std::isfinite(offset)) {
+    out.push_back(error("bad_mimic", ElementType::Joint, joint,
+                        "its <mimic> multiplier must be finite and non-zero, its offset finite"));
+    return;
+  }
+  out.push_back(note("mimic_joint", ElementType::Joint, joint,
+                     "follows joint " + detail::quoted(leader) + " (q = " + number(multiplier) + " q_" + leader +
+                         (offset == 0.0 ? std::string() : " + " + number(offset)) +
+                         "): not a coordinate"));
 }
 
 std::vector<int> composite(const std::vector<MassNode>& nodes, int head) {
@@ -230,8 +244,19 @@ std::string xacroProblem(const std::string& xml) {
                                                        {"$(arg ", "an $(arg ...)"},
                                                        {"$(find ", "a $(find ...)"},
                                                        {"${", "a ${...} expression"}};
+  // Outside comments: xacro copies them into its output as written, ${...} and all.
+  const auto outsideComments = [&xml](const char* mark) {
+    for (std::size_t from = 0;;) {
+      const std::size_t found = xml.find(mark, from);
+      if (found == std::string::npos) return found;
+      const std::size_t open = xml.rfind("<!--", found);
+      const std::size_t close = open == std::string::npos ? std::string::npos : xml.find("-->", open + 4);
+      if (open == std::string::npos || close == std::string::npos || close + 3 <= found) return found;
+      from = close + 3;  // inside a comment: look after it
+    }
+  };
   for (const auto& [mark, name] : marks) {
-    const std::size_t found = xml.find(mark);
+    const std::size_t found = outsideComments(mark);
     if (found < at) at = found, what = name;
   }
   if (at == std::string::npos) return "";

@@ -40,7 +40,7 @@ constexpr double kRoundOffLength = 1e-3;  ///< [m]
 /// (only its principal moments matter). Errors: `not_finite`, `non_positive_mass` (negative, or
 /// zero with a rotational inertia), `inertia_not_positive_definite` (a negative principal moment
 /// beyond round-off). Warnings, for what is read as it is written or within round-off:
-/// `point_mass` (no rotational inertia), `inertia_round_off` (a principal moment zero or
+/// `point_mass` (no rotational inertia beyond m 1e-12 m^2), `inertia_round_off` (a principal moment zero or
 /// negative within round-off: read as 0), `triangle_inequality` (I1 + I2 < I3, with the amount).
 /// The composite bodies are what must be positive definite, not every link.
 void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I_com, Findings& out);
@@ -75,9 +75,11 @@ void checkLimits(const std::string& joint, double lower, double upper, Findings&
 /// it) is read as continuous.
 void checkRevoluteWithoutLimit(const std::string& joint, Findings& out);
 
-/// \brief Warning `mimic_ignored`: a <mimic> joint is an independent coordinate (kdl_space does
-/// not couple joints yet).
-void checkMimic(const std::string& joint, const std::string& leader, Findings& out);
+/// \brief Note `mimic_joint`: a movable joint with <mimic> follows its leader (q = multiplier *
+/// q_leader + offset): not a coordinate. Error `bad_mimic` when the leader is no movable joint
+/// (`leader_movable`) or the multiplier is zero or not finite, or the offset not finite.
+void checkMimic(const std::string& joint, const std::string& leader, bool leader_movable, double multiplier,
+                double offset, Findings& out);
 
 /// One link of a tree for the mass rules below; node 0 is the base, parents precede children.
 struct MassNode {
@@ -121,8 +123,8 @@ constexpr int kMaxXmlDepth = 2000;
 std::string xmlDepthProblem(const std::string& xml);
 
 /// \brief Empty when `xml` is not an unexpanded xacro file; otherwise what gives it away (a
-/// <xacro:...> element, ${...}, $(arg ...) or $(find ...); not the xmlns:xacro attribute, which
-/// xacro's output keeps) and on which line.
+/// <xacro:...> element, ${...}, $(arg ...) or $(find ...) outside comments; not the xmlns:xacro
+/// attribute, which xacro's output keeps) and on which line.
 std::string xacroProblem(const std::string& xml);
 
 /// The first error of `findings`, or nullptr.

@@ -10,6 +10,7 @@ namespace kdl_space {
 
 RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("RecursiveExIITSolver: null model");
+  model_->refuseMimic("RecursiveExIITSolver");
   const std::size_t nb = model_->bodies().size();
   own_ = Kinematics(*model_);
   R_.assign(nb, Matrix3d::Identity());

@@ -154,6 +154,13 @@ void Checker::checkTree() {
   for (std::size_t j = 0; j < doc_.joints.size(); ++j)
     if (doc_.joints[j].known_type && static_cast<int>(j) != dropped_joint_)
       rules::checkJointType(doc_.joints[j].name, doc_.joints[j].type, found);
+  for (const detail::XmlJoint& joint : doc_.joints) {
+    if (!joint.has_mimic) continue;
+    bool leader_movable = false;
+    for (const detail::XmlJoint& other : doc_.joints)
+      leader_movable |= other.name == joint.mimic_leader && other.known_type && rules::isMovable(other.type);
+    rules::checkMimic(joint.name, joint.mimic_leader, leader_movable, joint.mimic_multiplier, joint.mimic_offset, found);
+  }
   if (base_ >= 0) {
     const detail::XmlLink& base = doc_.links[base_];
     if (base_ == root_) rules::checkRootInertia(base.name, base.has_inertial, found);

@@ -140,11 +140,17 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
   }
 
   // The shared rules (the same as checkUrdfFile's); the first error refuses the file.
+  std::vector<Mimic> mimic;
   for (const auto& [name, joint] : model->joints_) {
     if (name == dropped_joint) continue;
     const std::string type = typeName(*joint);
     rules::checkJointType(name, type, findings);
-    if (joint->mimic) rules::checkMimic(name, joint->mimic->joint_name, findings);
+    if (joint->mimic && rules::isMovable(type)) {
+      const urdf::JointConstSharedPtr leader = model->getJoint(joint->mimic->joint_name);
+      rules::checkMimic(name, joint->mimic->joint_name, leader && rules::isMovable(typeName(*leader)),
+                        joint->mimic->multiplier, joint->mimic->offset, findings);
+      mimic.push_back({name, joint->mimic->joint_name, joint->mimic->multiplier, joint->mimic->offset});
+    }
     if (rules::isMovable(type))
       rules::checkAxis(name, Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z), findings);
     if ((type == "revolute" || type == "prismatic") && joint->limits)
@@ -179,7 +185,8 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
            ": its joints form a loop (a URDF describes a tree)");
 
   try {
-    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics)).withJointProperties(properties(*model));
+    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics), std::move(mimic))
+        .withJointProperties(properties(*model));
   } catch (const ModelError& e) {
     throw ModelError(source + ": " + e.what());
   }

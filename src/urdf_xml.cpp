@@ -329,8 +329,15 @@ void Reader::readJoint(const TiXmlElement* e) {
   if (const TiXmlElement* calibration = e->FirstChildElement("calibration"))
     for (const char* a : {"rising", "falling"}) readOptional(calibration, a, owner, "<calibration", unused);
   if (const TiXmlElement* mimic = e->FirstChildElement("mimic")) {
-    if (readRequired(mimic, {"joint"}, owner, "<mimic")) rules::checkMimic(joint.name, mimic->Attribute("joint"), findings_);
-    for (const char* a : {"multiplier", "offset"}) readOptional(mimic, a, owner, "<mimic", unused);
+    double multiplier = 1.0, offset = 0.0;
+    const bool ok = readOptional(mimic, "multiplier", owner, "<mimic", multiplier) &
+                    readOptional(mimic, "offset", owner, "<mimic", offset);
+    if (readRequired(mimic, {"joint"}, owner, "<mimic") && ok && rules::isMovable(joint.type)) {
+      joint.has_mimic = true;
+      joint.mimic_leader = mimic->Attribute("joint");
+      joint.mimic_multiplier = multiplier;
+      joint.mimic_offset = offset;
+    }
   }
   if (const TiXmlElement* dynamics = e->FirstChildElement("dynamics")) {
     if (!dynamics->Attribute("damping") && !dynamics->Attribute("friction"))

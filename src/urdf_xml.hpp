@@ -26,6 +26,9 @@ struct XmlJoint {
   std::string type;           ///< as written ("" if missing)
   bool known_type = false;    ///< a URDF joint type
   std::string parent, child;  ///< link names ("" if missing)
+  bool has_mimic = false;     ///< a readable <mimic joint=...> (checked once all joints are read)
+  std::string mimic_leader;
+  double mimic_multiplier = 1.0, mimic_offset = 0.0;
 };
 
 /// What readUrdfXml read.

@@ -10,7 +10,7 @@ function(layer_of name out)
   get_filename_component(stem "${name}" NAME_WE)
   set(table
     "export,spatial,errors,text,symmetric6d,multiversion,response=0"
-    "diagnostics,model,model_rules,joint_motion=1"
+    "diagnostics,model,model_build,model_rules,joint_motion=1"
     "state,kinematics,momentum=2"
     "free_floating_solver,recursive_ex_iit=3"
     "impact,impact_friction,collision=4"

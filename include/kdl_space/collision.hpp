@@ -70,7 +70,8 @@ struct FloatingSystem {
 /// kinematics (computed in the constructor, or handed to it) and its own solvers, computed once
 /// in the constructor; nothing a caller does later can make it stale. With ExIITMethod::Recursive (the default) every step is O(n): G* or the
 /// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
-/// energy and twists by MomentumSolver; no n x n matrix is built. ExIITMethod::Dense uses the
+/// energy and twists by MomentumSolver; no n x n matrix is built. A model with mimic joints
+/// always takes the dense route (the recursion cannot couple joints). ExIITMethod::Dense uses the
 /// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
 class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
  public:

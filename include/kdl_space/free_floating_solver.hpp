@@ -146,7 +146,8 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   KDL::Frame world_T_base_;
   State state_;                           ///< copy of the last computed state
   std::vector<KDL::Frame> world_T_body_;  ///< per body
-  std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world
+  std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world (its leader body's)
+  std::vector<Vector6d> Sb_;              ///< per body: its joint's twist per coordinate rate at r_g
   std::vector<Matrix6d> I_body_;          ///< per body: its spatial inertia about r_g
   std::vector<Matrix6d> I_c_;             ///< per body: composite spatial inertia about r_g
   Vector3d r_g_ = Vector3d::Zero();

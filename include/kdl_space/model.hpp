@@ -25,10 +25,16 @@ struct MotionTable;  // src/detail/joint_motion.hpp
 struct Body {
   std::string name;        ///< link (KDL segment) name
   int parent = -1;         ///< index of the parent body; -1 for the base
-  int joint = -1;          ///< index of the movable joint from the parent; -1 if fixed or base
+  /// Index of the coordinate that moves the joint from the parent (for a mimic joint, its
+  /// leader's); -1 if fixed or base.
+  int joint = -1;
+  /// The joint's own value is multiplier * q(joint) + offset (1 and 0 but for a mimic joint).
+  double multiplier = 1.0;
+  double offset = 0.0;
   KDL::Segment segment;    ///< joint + pose of this body's frame in the parent body's frame
-  /// Unit joint twist (v; w) in the parent's axes at the parent frame's origin: constant for
-  /// revolute and prismatic joints (zero if fixed). Computed once from KDL's Segment::twist.
+  /// Joint twist (v; w) per unit rate of its coordinate (times the multiplier of a mimic joint),
+  /// in the parent's axes at the parent frame's origin: constant for revolute and prismatic
+  /// joints (zero if fixed). Computed once from KDL's Segment::twist.
   Eigen::Matrix<double, 6, 1> joint_twist = Eigen::Matrix<double, 6, 1>::Zero();
   double mass = 0.0;       ///< [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< CoM, this body's frame [m]
@@ -45,6 +51,13 @@ struct JointProperties {
   double velocity = std::numeric_limits<double>::infinity();  ///< [rad/s or m/s]
   double damping = 0.0;   ///< viscous [N m s/rad or N s/m]
   double friction = 0.0;  ///< Coulomb [N m or N]
+};
+
+/// A joint that follows another: its value is multiplier * (the leader's) + offset (URDF <mimic>).
+struct Mimic {
+  std::string joint, leader;
+  double multiplier = 1.0;
+  double offset = 0.0;
 };
 
 /// A movable joint of the description that the model treats as fixed (at q = 0), and why.
@@ -76,14 +89,22 @@ class KDL_SPACE_EXPORT FloatingModel {
   /// \param armature optional rotor inertia per joint of `tree` (its q_nr order), added to H's
   /// diagonal; kept for the joints that stay coordinates.
   /// \throws ModelError naming the link or joint when the model cannot be used.
+  /// \param mimic joints that follow others: they are not coordinates (J T, T^T H T); the O(n)
+  /// solvers refuse such a model, the dense ones and the capture's sides use the coupling.
   FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
-                std::vector<double> armature = {}, std::vector<Diagnostic> diagnostics = {});
+                std::vector<double> armature = {}, std::vector<Diagnostic> diagnostics = {},
+                std::vector<Mimic> mimic = {});
 
   /// \brief Same from a chain: its first segment hangs on a base named `base_name`.
   FloatingModel(const KDL::Chain& chain, const KDL::RigidBodyInertia& base_inertia,
                 const std::string& base_name = "base", std::vector<double> armature = {});
 
-  /// Number of movable joints n.
+  /// The joints that follow others (not coordinates).
+  const std::vector<Mimic>& mimic() const { return mimic_; }
+  /// \brief Throws ModelError naming `who` and the mimic joints when the model has any: for the
+  /// O(n) recursions, which cannot couple joints (the dense solvers can).
+  void refuseMimic(const std::string& who) const;
+  /// Number of movable joints n (the coordinates: mimic joints are not).
   unsigned int nj() const { return static_cast<unsigned int>(joint_names_.size()); }
   /// Bodies in traversal order; body 0 is the base.
   const std::vector<Body>& bodies() const { return bodies_; }
@@ -94,7 +115,7 @@ class KDL_SPACE_EXPORT FloatingModel {
   /// Limits, damping and friction per joint (model order; none unless given).
   const std::vector<JointProperties>& jointProperties() const { return joint_properties_; }
   /// \brief A copy of this model with the joints' limits, damping and friction, by joint name
-  /// (names of joints that are not coordinates are ignored: they are fixed).
+  /// (names of joints that are not coordinates, fixed or mimic, are ignored).
   /// \throws ModelError for a name that is no joint of the description's, or a property that
   /// is NaN, a negative damping, friction, effort or velocity limit, or lower > upper.
   FloatingModel withJointProperties(const std::map<std::string, JointProperties>& by_name) const;
@@ -129,10 +150,11 @@ class KDL_SPACE_EXPORT FloatingModel {
   FloatingModel withPayload(const std::string& link, const KDL::RigidBodyInertia& inertia) const;
 
  private:
-  void build(const KDL::RigidBodyInertia& base_inertia);
+  void build(const KDL::RigidBodyInertia& base_inertia, const std::vector<double>& armature);
   void validate();
   void checkComposites();
   void checkArmature() const;
+  std::vector<double> treeArmature() const;
 
   KDL::Tree tree_;
   std::vector<Body> bodies_;
@@ -142,6 +164,7 @@ class KDL_SPACE_EXPORT FloatingModel {
   std::vector<JointProperties> joint_properties_;
   std::vector<Diagnostic> diagnostics_;
   std::vector<FixedJoint> fixed_joints_;
+  std::vector<Mimic> mimic_;
   double total_mass_ = 0.0;
   std::shared_ptr<const detail::MotionTable> motions_;  ///< immutable: shared by copies
 };

@@ -9,7 +9,9 @@
 
 namespace kdl_space::detail {
 
-/// One body's joint motion, in its parent's frame: pose(q) = screw(q) * pose(0), the screw about
+/// One body's joint motion, in its parent's frame: pose(q) = screw(q) * pose(0), q its
+/// coordinate (for a mimic joint, its leader's: scale and axis carry the multiplier, pose(0) the
+/// offset), the screw about
 /// the joint's axis (revolute: rotation by t = scale q about the line through the axis point;
 /// prismatic: translation by scale q along `axis`). Revolute, by Rodrigues' formula
 /// Rot(a, t) = E + sin t a^ + (1 - cos t) a^ a^ folded into pose(0):

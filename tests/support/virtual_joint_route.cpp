@@ -14,6 +14,9 @@
 
 namespace kdl_space::test {
 
+/// The grounded tree's root: not "world", which real models name their base's root link.
+const char* const kVirtualRoot = "kdl_space_virtual_route_world";
+
 const char* const kVirtualJointNames[6] = {"virtual_tx", "virtual_ty", "virtual_tz",
                                            "virtual_rx", "virtual_ry", "virtual_rz"};
 
@@ -82,8 +85,8 @@ KDL::Tree buildVirtualTree(const FloatingModel& model, const KDL::Frame& world_T
   const std::string base_name = root->first;
   const KDL::Joint::JointType types[6] = {KDL::Joint::TransX, KDL::Joint::TransY, KDL::Joint::TransZ,
                                           KDL::Joint::RotX,   KDL::Joint::RotY,   KDL::Joint::RotZ};
-  KDL::Tree tree("world");
-  std::string parent = "world";
+  KDL::Tree tree(kVirtualRoot);
+  std::string parent = kVirtualRoot;
   for (int a = 0; a < 6; ++a) {
     const bool last = a == 5;
     const std::string name = last ? base_name : std::string(kVirtualJointNames[a]);
@@ -169,7 +172,7 @@ Eigen::MatrixXd VirtualJointTree::G_grounded(const LinkPoint& h) const { return 
 VirtualJointChain::VirtualJointChain(const FloatingModel& model, const State& state, const std::string& tip)
     : n_(static_cast<int>(model.nj())) {
   const KDL::Tree tree = buildVirtualTree(model, state.world_T_base);
-  if (!tree.getChain("world", tip, chain_)) throw std::invalid_argument("virtual route: no chain to " + tip);
+  if (!tree.getChain(kVirtualRoot, tip, chain_)) throw std::invalid_argument("virtual route: no chain to " + tip);
   std::map<std::string, int> by_name;
   int k = 0;
   for (unsigned int s = 0; s < chain_.getNrOfSegments(); ++s) {

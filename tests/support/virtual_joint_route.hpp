@@ -84,7 +84,7 @@ class VirtualJointTree {
 };
 
 /// \brief The same for a chain model, through KDL's chain solvers: the chain
-/// virtual_tree.getChain("world", tip); M_full from KDL::ChainDynParam::JntToMass, Jacobians
+/// virtual_tree.getChain(<root>, tip); M_full from KDL::ChainDynParam::JntToMass, Jacobians
 /// from KDL::ChainJntToJacSolver, poses from KDL::ChainFkSolverPos_recursive. Every real joint
 /// of the model must lie on the path to `tip` (throws std::invalid_argument otherwise).
 class VirtualJointChain {

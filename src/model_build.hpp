@@ -1,0 +1,18 @@
+// Between KDL's trees and the model's bodies: the inertia conversions and the traversal that
+// makes bodies and coordinates (mimic joints included) from a tree. Private to the library.
+#pragma once
+
+#include <kdl/rigidbodyinertia.hpp>
+
+#include "kdl_space/model.hpp"
+
+namespace kdl_space::detail {
+
+/// Mass, CoM and inertia about the CoM of a KDL inertia (KDL keeps the inertia about the
+/// reference frame's origin) into `body`.
+void splitInertia(const KDL::RigidBodyInertia& I, Body& body);
+
+/// The KDL inertia of a body's mass, CoM and inertia about the CoM.
+KDL::RigidBodyInertia kdlInertia(const Body& b);
+
+}  // namespace kdl_space::detail
