@@ -24,8 +24,23 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
+namespace {
+/// The model of a motion: not null, no mimic joints (the O(n) forward dynamics cannot couple them).
+std::shared_ptr<const FloatingModel> motionModel(std::shared_ptr<const FloatingModel> model) {
+  if (!model) throw ModelError("simulation: null model");
+  if (!model->mimic().empty()) {
+    std::string names;
+    for (const Mimic& m : model->mimic()) names += (names.empty() ? "'" : ", '") + m.joint + "'";
+    throw ModelError("simulation: the model has mimic joints (" + names +
+                     "): the motion of coupled joints is not supported yet (G*, the velocity jumps and the "
+                     "capture are); remove the <mimic> elements to simulate them as independent joints");
+  }
+  return model;
+}
+}  // namespace
+
 Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
-    : model_(model ? std::move(model) : throw ModelError("simulation: null model")),
+    : model_(motionModel(std::move(model))),
       kin_(*model_),
       momentum_(model_),
       dynamics_(model_),

@@ -1,0 +1,142 @@
+// Mimic joints (issue 12, item 5): a joint that follows another is not a coordinate; J*, H*, G*
+// and the velocity jump use the coupled coordinates (J T, T^T H T). Checked against the same
+// robot read without its <mimic> elements, with the coupling written out by hand.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <random>
+#include <string>
+
+#include "kdl_space/collision.hpp"
+#include "kdl_space/forward_dynamics.hpp"
+#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/recursive_ex_iit.hpp"
+#include "kdl_space/simulation.hpp"
+#include "kdl_space/urdf_loader.hpp"
+
+namespace kdl_space {
+namespace {
+
+std::string link(const std::string& name, double mass, double x) {
+  const std::string m = std::to_string(mass), c = std::to_string(x);
+  return R"(<link name=")" + name + R"("><inertial><origin xyz=")" + c + R"( 0.01 0" rpy="0.1 0.2 0.3"/><mass value=")" + m +
+         R"("/><inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0.001" ixz="0" iyz="0.002"/></inertial></link>)";
+}
+
+std::string joint(const std::string& name, const std::string& parent, const std::string& child, const std::string& xyz,
+                  const std::string& axis, const std::string& mimic = "") {
+  return R"(<joint name=")" + name + R"(" type="revolute"><parent link=")" + parent + R"("/><child link=")" + child +
+         R"("/><origin xyz=")" + xyz + R"(" rpy="0 0.3 0"/><axis xyz=")" + axis +
+         R"("/><limit lower="-2" upper="2" effort="10" velocity="1"/>)" + mimic + "</joint>";
+}
+
+/// A two-joint arm with a two-finger gripper; the right finger mimics the left (-1, +0.1), and
+/// the wrist camera's tilt mimics the elbow (0.5): two mimic joints on two branches.
+std::string gripper(bool with_mimic) {
+  const std::string right = with_mimic ? R"(<mimic joint="left_finger" multiplier="-1" offset="0.1"/>)" : "";
+  const std::string tilt = with_mimic ? R"(<mimic joint="elbow" multiplier="0.5"/>)" : "";
+  return R"(<?xml version="1.0"?><robot name="g">)" + link("base", 50.0, 0.0) +
+         joint("shoulder", "base", "upper", "0 0 0.5", "0 0 1") + link("upper", 3.0, 0.2) +
+         joint("elbow", "upper", "fore", "0.4 0 0", "0 1 0") + link("fore", 2.0, 0.2) +
+         joint("left_finger", "fore", "left", "0.4 0.05 0", "0 0 1") + link("left", 0.2, 0.05) +
+         joint("right_finger", "fore", "right", "0.4 -0.05 0", "0 0 1", right) + link("right", 0.2, 0.05) +
+         joint("camera_tilt", "upper", "camera", "0.1 0 0.1", "1 0 0", tilt) + link("camera", 0.5, 0.02) + "</robot>";
+}
+
+TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
+  ASSERT_EQ(coupled->jointNames(), (std::vector<std::string>{"shoulder", "elbow", "left_finger"}));
+  ASSERT_EQ(free->nj(), 5u);
+  // T: free joint value = T * coupled coordinates + o (written out from the <mimic> elements).
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(5, 3);
+  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
+  const auto at = [&](const std::string& name) { return free->jointIndex(name); };
+  T(at("shoulder"), 0) = 1.0;
+  T(at("elbow"), 1) = 1.0;
+  T(at("left_finger"), 2) = 1.0;
+  T(at("right_finger"), 2) = -1.0;
+  o(at("right_finger")) = 0.1;
+  T(at("camera_tilt"), 1) = 0.5;
+
+  FreeFloatingSolver a(coupled), b(free);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    State sa(*coupled), sb(*free);
+    sa.world_T_base = sb.world_T_base =
+        KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+    for (int j = 0; j < 3; ++j) sa.q(j) = u(rng);
+    sb.q.data = T * sa.q.data + o;
+    ASSERT_EQ(a.compute(sa), 0);
+    ASSERT_EQ(b.compute(sb), 0);
+    const Eigen::MatrixXd H_star = T.transpose() * b.H_star().data * T;
+    EXPECT_TRUE(a.H_star().data.isApprox(H_star, 1e-12)) << a.H_star().data << "\n\n" << H_star;
+    EXPECT_TRUE(a.H().data.isApprox(T.transpose() * b.H().data * T, 1e-12));
+    for (const std::string& tip : {"right", "camera", "fore"}) {
+      const Contact ha = coupled->contact(tip, KDL::Vector(0.03, 0.0, 0.01));
+      const Contact hb = free->contact(tip, KDL::Vector(0.03, 0.0, 0.01));
+      KDL::Jacobian Ja(3), Jb(5);
+      ASSERT_EQ(a.J_star(ha, Ja), 0);
+      ASSERT_EQ(b.J_star(hb, Jb), 0);
+      const Eigen::MatrixXd J_star = Jb.data * T;
+      EXPECT_TRUE(Ja.data.isApprox(J_star, 1e-12)) << tip;
+      // G* = J* H*^-1 J*^T + R_h M_a^-1 R_h^T (eq. 11) in the coupled coordinates.
+      Matrix6d G_locked, Ga;
+      ASSERT_EQ(b.G_locked(hb, G_locked), 0);
+      const Eigen::MatrixXd G = J_star * H_star.ldlt().solve(J_star.transpose()) + G_locked;
+      ASSERT_EQ(a.G_star(ha, Ga), 0);
+      EXPECT_TRUE(Ga.isApprox(G, 1e-10)) << tip << "\n" << Ga << "\n\n" << G;
+      // A capture side on the coupled model takes the dense route by itself, and its velocity
+      // jump is H*^-1 J*^T F in the coupled coordinates (eq. 18).
+      FloatingVelocity v{KDL::Twist::Zero(), KDL::JntArray(3)};
+      FloatingSide side(coupled, sa, ha, v);
+      EXPECT_TRUE(side.G().isApprox(G, 1e-10)) << tip;
+      const Vector6d F = (Vector6d() << 1.0, -2.0, 0.5, 0.1, 0.2, -0.3).finished();
+      ASSERT_EQ(side.applyImpulse(F), 0);
+      const Eigen::VectorXd dq = H_star.ldlt().solve(J_star.transpose() * F);
+      EXPECT_TRUE(side.after().qdot.data.isApprox(dq, 1e-10)) << tip;
+    }
+  }
+}
+
+TEST(Mimic, TheRecursionsRefuseACoupledModelByName) {
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  for (int which = 0; which < 2; ++which) {
+    try {
+      if (which == 0) RecursiveExIITSolver solver(coupled);
+      else ForwardDynamicsSolver solver(coupled);
+      ADD_FAILURE() << "a recursion accepted a model with mimic joints";
+    } catch (const ModelError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("'right_finger'"), std::string::npos) << what;
+      EXPECT_NE(what.find("'camera_tilt'"), std::string::npos) << what;
+    }
+  }
+  // The motion says what it cannot do yet, naming the joints.
+  try {
+    Simulator simulator(coupled);
+    ADD_FAILURE() << "a simulation of a model with mimic joints";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation: the model has mimic joints ('camera_tilt', 'right_finger')"),
+              std::string::npos) << e.what();
+  }
+  int notes = 0;
+  for (const Diagnostic& d : coupled->diagnostics()) notes += d.kind == "mimic_joint" || d.kind == "dense_route";
+  EXPECT_EQ(notes, 3);
+}
+
+TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
+  std::string xml = gripper(true);
+  xml.replace(xml.find(R"(mimic joint="elbow")"), 19, R"(mimic joint="elbo")");
+  try {
+    loadUrdfString(xml, "bad.urdf");
+    ADD_FAILURE() << "a mimic of an unknown joint loaded";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("joint 'camera_tilt': mimics 'elbo', which is no movable joint"),
+              std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace kdl_space
