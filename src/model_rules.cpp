@@ -25,6 +25,10 @@ Finding warning(std::string kind, ElementType type, std::string element, std::st
   return {Severity::Warning, std::move(kind), type, std::move(element), std::move(message)};
 }
 
+Finding note(std::string kind, ElementType type, std::string element, std::string message) {
+  return {Severity::Note, std::move(kind), type, std::move(element), std::move(message)};
+}
+
 InertiaVerdict judgeInertia(const Eigen::Matrix3d& I) {
   InertiaVerdict v;
   if (!I.allFinite()) {
@@ -57,34 +61,52 @@ void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I
                           "<inertial> if it only carries a frame"));
     return;
   }
-  InertiaVerdict v = judgeInertia(I_com);
+  const InertiaVerdict v = judgeInertia(I_com);
   const Eigen::Vector3d& l = v.moments;
   const std::string moments = number(l(0)) + ", " + number(l(1)) + ", " + number(l(2)) + " kg m^2";
-  if (v.kind == InertiaVerdict::NotPositiveDefinite) {
+  const double round_off = std::max(kRoundOffRelative * std::max(l(2), 0.0), mass * kRoundOffLength * kRoundOffLength);
+  if (l(0) < -round_off) {
     out.push_back(error("inertia_not_positive_definite", ElementType::Link, link,
                         "inertia is not positive definite (principal moments " + moments +
-                            "): a body with mass has three positive principal moments; check the "
-                            "signs, the products of inertia and the units"));
-  } else if (v.kind == InertiaVerdict::TriangleInequality) {
-    out.push_back(error("triangle_inequality", ElementType::Link, link,
-                        "principal moments " + moments +
-                            " break the triangle inequality I1 + I2 >= I3: no rigid body has this "
-                            "inertia; check the values and the units"));
+                            "): a body with mass has principal moments >= 0; check the signs, the "
+                            "products of inertia and the units"));
+    return;
+  }
+  if (I_com.isZero(0.0)) {
+    out.push_back(warning("point_mass", ElementType::Link, link,
+                          "a point mass (" + number(mass) + " kg, no rotational inertia): read as one; the "
+                          "body it belongs to needs its inertia from other links"));
+    return;
+  }
+  if (l(0) <= 0.0) {
+    out.push_back(warning("inertia_round_off", ElementType::Link, link,
+                          "principal moments " + moments + ": the smallest is " +
+                              (l(0) < 0.0 ? "negative" : "zero") + " within round-off (|I1| <= " +
+                              number(round_off) + " kg m^2), read as 0"));
+  }
+  const double I1 = std::max(l(0), 0.0), I2 = std::max(l(1), 0.0), I3 = l(2);
+  if (I1 + I2 < I3 * (1.0 - 1e-9)) {
+    const double short_by = I3 - I1 - I2;
+    out.push_back(warning("triangle_inequality", ElementType::Link, link,
+                          "principal moments " + moments + " break the triangle inequality I1 + I2 >= I3 by " +
+                              number(short_by) + " kg m^2 (" + number(100.0 * short_by / I3) +
+                              " % of I3): no rigid body has this inertia; read as written (the dynamics "
+                              "are defined while the bodies are positive definite)"));
   }
 }
 
-void checkBaseMass(const std::string& base, double mass, Findings& out) {
-  if (mass == 0.0)
-    out.push_back(error("base_without_mass", ElementType::Link, base,
-                        "the free-floating base has no mass: give this link an <inertial> with its mass "
-                        "and inertia (kdl_space reads the root link's <inertial>, which kdl_parser drops)"));
+Eigen::Matrix3d withoutNegativeMoments(const Eigen::Matrix3d& I) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (I + I.transpose()));
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(0) < 0.0)) return I;
+  const Eigen::Vector3d clamped = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
 }
 
 void checkRootInertia(const std::string& root, bool has_inertial, Findings& out) {
   if (has_inertial)
-    out.push_back(warning("root_inertia_dropped_by_kdl_parser", ElementType::Link, root,
-                          "root link inertia kept as the base body's inertia (kdl_parser drops it: "
-                          "tools built on kdl_parser alone see a massless base)"));
+    out.push_back(note("root_inertia_dropped_by_kdl_parser", ElementType::Link, root,
+                       "root link inertia kept as the base body's inertia (kdl_parser drops it: tools "
+                       "built on kdl_parser alone see a massless base)"));
 }
 
 bool dropsRootJoint(bool root_massless, std::size_t root_child_joints, const std::string& child_joint_type) {
@@ -128,6 +150,50 @@ void checkLimits(const std::string& joint, double lower, double upper, Findings&
                               "given a position: give q explicitly (kdl_space does not enforce limits)"));
 }
 
+void checkRevoluteWithoutLimit(const std::string& joint, Findings& out) {
+  out.push_back(warning("revolute_without_limit", ElementType::Joint, joint,
+                        "a revolute joint without <limit> (urdfdom refuses it): read as continuous, "
+                        "without position, effort or velocity limits"));
+}
+
+void checkMimic(const std::string& joint, const std::string& leader, Findings& out) {
+  out.push_back(warning("mimic_ignored", ElementType::Joint, joint,
+                        "mimics joint " + detail::quoted(leader) +
+                            ", but kdl_space does not couple joints yet: it is an independent coordinate "
+                            "(give it the leader's motion yourself)"));
+}
+
+std::vector<int> composite(const std::vector<MassNode>& nodes, int head) {
+  std::vector<int> members{head};
+  std::vector<bool> in(nodes.size(), false);
+  in[head] = true;
+  for (std::size_t i = head + 1; i < nodes.size(); ++i)  // parents precede children
+    if (nodes[i].parent >= 0 && in[nodes[i].parent] && !nodes[i].movable) {
+      in[i] = true;
+      members.push_back(static_cast<int>(i));
+    }
+  return members;
+}
+
+void checkBaseComposite(const std::vector<MassNode>& nodes, Findings& out) {
+  if (nodes.empty()) return;
+  double mass = 0.0;
+  std::vector<std::string> links;
+  for (const int i : composite(nodes, 0)) {
+    mass += nodes[i].mass;
+    links.push_back(detail::quoted(nodes[i].link));
+  }
+  if (mass != 0.0) return;  // massive, or unknown (NaN)
+  const std::string fix = "(kdl_space reads the root link's <inertial>, which kdl_parser drops)";
+  out.push_back(error("base_without_mass", ElementType::Link, nodes[0].link,
+                      links.size() == 1
+                          ? "the free-floating base has no mass: give this link an <inertial> with its mass and "
+                            "inertia " + fix
+                          : "the free-floating base has no mass: it is the links " + detail::listNames(links) +
+                                " (the root and the links fixed to it); give one of them an <inertial> with its "
+                                "mass and inertia " + fix));
+}
+
 void checkMassDistribution(const std::vector<MassNode>& nodes, Findings& out) {
   // Mass of each subtree, children first (parents precede children in `nodes`).
   std::vector<double> subtree(nodes.size(), 0.0);
@@ -136,17 +202,16 @@ void checkMassDistribution(const std::vector<MassNode>& nodes, Findings& out) {
     if (nodes[i].parent >= 0) subtree[nodes[i].parent] += subtree[i];
   for (std::size_t i = 1; i < nodes.size(); ++i) {
     const MassNode& n = nodes[i];
-    if (n.mass != 0.0) continue;  // massive, or unknown (NaN)
-    if (n.movable && subtree[i] == 0.0) {
-      out.push_back(error("non_positive_mass", ElementType::Link, n.link,
-                          "massless, and joint " + detail::quoted(n.joint) + " moves only massless links (" +
-                              detail::quoted(n.link) + " and below): that joint has no inertia and H* is "
-                              "singular; give the link its mass, or make the joint fixed"));
-    } else {
-      out.push_back(warning("massless_link", ElementType::Link, n.link,
-                            subtree[i] == 0.0 ? "massless link: it only carries a frame"
-                                              : "massless link: it carries no inertia of its own"));
+    if (n.movable && subtree[i] == 0.0 && !(n.armature > 0.0)) {
+      out.push_back(warning("joint_moves_no_mass", ElementType::Joint, n.joint,
+                            "moves only massless links (" + detail::quoted(n.link) +
+                                " and below): it has no inertia, so it is treated as fixed at q = 0 and is "
+                                "not a coordinate (give the links their mass, or the joint an armature)"));
     }
+    if (n.mass == 0.0)  // massive, or unknown (NaN): no note
+      out.push_back(note("massless_link", ElementType::Link, n.link,
+                         subtree[i] == 0.0 ? "massless link: it only carries a frame"
+                                           : "massless link: it carries no inertia of its own"));
   }
 }
 
@@ -155,6 +220,25 @@ void checkDepth(const std::string& link, int depth, Findings& out) {
     out.push_back(error("too_deep", ElementType::Link, link,
                         std::to_string(depth) + " joints below the base: kdl_space reads trees at most " +
                             std::to_string(kMaxTreeDepth) + " deep (kdl_parser recurses once per joint)"));
+}
+
+std::string xacroProblem(const std::string& xml) {
+  std::size_t at = std::string::npos;
+  std::string what;
+  // Not the xmlns:xacro attribute alone: xacro's output keeps it on <robot>.
+  const std::pair<const char*, const char*> marks[] = {{"<xacro:", "a <xacro:...> element"},
+                                                       {"$(arg ", "an $(arg ...)"},
+                                                       {"$(find ", "a $(find ...)"},
+                                                       {"${", "a ${...} expression"}};
+  for (const auto& [mark, name] : marks) {
+    const std::size_t found = xml.find(mark);
+    if (found < at) at = found, what = name;
+  }
+  if (at == std::string::npos) return "";
+  const long line = 1 + std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  return "an unexpanded xacro file (" + what + " at line " + std::to_string(line) +
+         "): expand it first, e.g. xacro FILE.urdf.xacro > FILE.urdf (Debian's ros-xacro, or ROS's xacro), "
+         "then give kdl_space the .urdf";
 }
 
 const Finding* firstError(const Findings& findings) {

@@ -15,6 +15,7 @@ using Findings = std::vector<Finding>;
 
 Finding error(std::string kind, ElementType type, std::string element, std::string message);
 Finding warning(std::string kind, ElementType type, std::string element, std::string message);
+Finding note(std::string kind, ElementType type, std::string element, std::string message);
 
 /// A number as the findings print it (the stream's default: 6 significant digits).
 std::string number(double v);
@@ -30,17 +31,26 @@ struct InertiaVerdict {
 /// relative slack of 1e-9.
 InertiaVerdict judgeInertia(const Eigen::Matrix3d& I);
 
+/// Round-off in an inertia: a principal moment within max(kRoundOffRelative * the largest,
+/// mass * kRoundOffLength^2) of zero is read as zero.
+constexpr double kRoundOffRelative = 1e-6;
+constexpr double kRoundOffLength = 1e-3;  ///< [m]
+
 /// \brief Inertial values of one link: mass [kg] and inertia about the CoM [kg m^2], any axes
 /// (only its principal moments matter). Errors: `not_finite`, `non_positive_mass` (negative, or
-/// zero with a rotational inertia), `inertia_not_positive_definite`, `triangle_inequality`.
+/// zero with a rotational inertia), `inertia_not_positive_definite` (a negative principal moment
+/// beyond round-off). Warnings, for what is read as it is written or within round-off:
+/// `point_mass` (no rotational inertia), `inertia_round_off` (a principal moment zero or
+/// negative within round-off: read as 0), `triangle_inequality` (I1 + I2 < I3, with the amount).
+/// The composite bodies are what must be positive definite, not every link.
 void checkInertia(const std::string& link, double mass, const Eigen::Matrix3d& I_com, Findings& out);
 
-/// \brief A free-floating base needs its mass: `base_without_mass` when `mass` is 0 (a negative
-/// mass is checkInertia's; NaN, an unreadable value, is reported where it was read).
-void checkBaseMass(const std::string& base, double mass, Findings& out);
+/// The inertia as the model reads it: negative principal moments (round-off, which checkInertia
+/// lets pass) set to zero; otherwise unchanged.
+Eigen::Matrix3d withoutNegativeMoments(const Eigen::Matrix3d& I);
 
-/// \brief Warning `root_inertia_dropped_by_kdl_parser` when the base is the URDF root link and
-/// has an <inertial>.
+/// \brief Note `root_inertia_dropped_by_kdl_parser` when the base is the URDF root link and has
+/// an <inertial> (kdl_space keeps it; tools built on kdl_parser alone would not).
 void checkRootInertia(const std::string& root, bool has_inertial, Findings& out);
 
 /// \brief True when the root's joint to its only child is dropped: a `floating` joint from a
@@ -61,18 +71,35 @@ void checkAxis(const std::string& joint, const Eigen::Vector3d& axis, Findings& 
 /// \brief Joint limits of a revolute or prismatic joint: `limits_exclude_zero` (warning).
 void checkLimits(const std::string& joint, double lower, double upper, Findings& out);
 
-/// One link of a tree for checkMassDistribution; node 0 is the base, parents precede children.
+/// \brief Warning `revolute_without_limit`: a revolute joint without <limit> (urdfdom refuses
+/// it) is read as continuous.
+void checkRevoluteWithoutLimit(const std::string& joint, Findings& out);
+
+/// \brief Warning `mimic_ignored`: a <mimic> joint is an independent coordinate (kdl_space does
+/// not couple joints yet).
+void checkMimic(const std::string& joint, const std::string& leader, Findings& out);
+
+/// One link of a tree for the mass rules below; node 0 is the base, parents precede children.
 struct MassNode {
   std::string link;
   int parent = -1;
   std::string joint;     ///< the joint from the parent
   bool movable = false;  ///< that joint moves
   double mass = 0.0;     ///< [kg]; NaN when unknown (not read), which no rule below reports
+  double armature = 0.0; ///< rotor inertia of that joint (a joint with one is a coordinate)
 };
 
-/// \brief Massless links: `non_positive_mass` for a massless link whose movable joint moves
-/// only massless links (its inertia is zero, H* singular); warning `massless_link` for the
-/// other massless links below the base.
+/// \brief The rigid bodies of the dynamics are composites: a link and every link joined to it
+/// by fixed joints. The nodes of the composite of node `head` (itself first), in node order.
+std::vector<int> composite(const std::vector<MassNode>& nodes, int head);
+
+/// \brief The base composite (the root and every link fixed to it) needs mass:
+/// `base_without_mass` naming its links when their masses add up to 0.
+void checkBaseComposite(const std::vector<MassNode>& nodes, Findings& out);
+
+/// \brief Massless links. Warning `joint_moves_no_mass` for each movable joint without
+/// armature that moves only massless links (no inertia: H* would be singular): the model treats
+/// it as fixed at q = 0. Note `massless_link` for the other massless links below the base.
 void checkMassDistribution(const std::vector<MassNode>& nodes, Findings& out);
 
 /// The deepest tree (joints from the base to a link) read safely: kdl_parser recurses once per
@@ -92,6 +119,11 @@ constexpr int kMaxXmlDepth = 2000;
 /// must then be well-formed and free of DOCTYPE and processing instructions (the constructs
 /// TinyXML reads differently from XML, where elements could hide from the measurement).
 std::string xmlDepthProblem(const std::string& xml);
+
+/// \brief Empty when `xml` is not an unexpanded xacro file; otherwise what gives it away (a
+/// <xacro:...> element, ${...}, $(arg ...) or $(find ...); not the xmlns:xacro attribute, which
+/// xacro's output keeps) and on which line.
+std::string xacroProblem(const std::string& xml);
 
 /// The first error of `findings`, or nullptr.
 const Finding* firstError(const Findings& findings);

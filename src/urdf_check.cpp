@@ -42,7 +42,10 @@ class Checker {
   UrdfReport run(const std::string& xml);
 
  private:
-  void add(Finding f) { (f.severity == Severity::Error ? report_.errors : report_.warnings).push_back(std::move(f)); }
+  void add(Finding f) {
+    (f.severity == Severity::Error ? report_.errors : f.severity == Severity::Warning ? report_.warnings : report_.notes)
+        .push_back(std::move(f));
+  }
   void addAll(const std::vector<Finding>& findings) {
     for (const Finding& f : findings) add(f);
   }
@@ -153,7 +156,6 @@ void Checker::checkTree() {
       rules::checkJointType(doc_.joints[j].name, doc_.joints[j].type, found);
   if (base_ >= 0) {
     const detail::XmlLink& base = doc_.links[base_];
-    rules::checkBaseMass(base.name, base.has_inertial ? base.mass : 0.0, found);
     if (base_ == root_) rules::checkRootInertia(base.name, base.has_inertial, found);
   }
   if (graph_ok_ && base_ >= 0) {
@@ -176,6 +178,7 @@ void Checker::checkTree() {
       nodes.push_back(node);
       moving.push_back(moves);
     }
+    rules::checkBaseComposite(nodes, found);
     rules::checkMassDistribution(nodes, found);
     if (const int deep = detail::firstDeeperThan(below, rules::kMaxTreeDepth); deep >= 0)  // the first is enough
       rules::checkDepth(nodes[deep].link, below.steps[deep].depth, found);

@@ -5,6 +5,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <sstream>
 
@@ -12,6 +13,7 @@
 #include "detail/text.hpp"
 #include "model_rules.hpp"
 #include "urdf_graph.hpp"
+#include "urdf_xml.hpp"
 
 namespace kdl_space {
 namespace {
@@ -79,12 +81,37 @@ std::string typeName(const urdf::Joint& j) {
   }
 }
 
+/// Limits, damping and friction of the movable joints, as urdfdom read them. An effort or velocity
+/// limit of 0 (files write it for "not given": no joint could move) is no limit.
+std::map<std::string, JointProperties> properties(const urdf::ModelInterface& model) {
+  std::map<std::string, JointProperties> by_name;
+  for (const auto& [name, joint] : model.joints_) {
+    if (!rules::isMovable(typeName(*joint))) continue;
+    JointProperties p;
+    if (const urdf::JointLimitsSharedPtr& l = joint->limits) {
+      if (joint->type != urdf::Joint::CONTINUOUS) p.lower = l->lower, p.upper = l->upper;
+      if (l->effort > 0.0) p.effort = l->effort;
+      if (l->velocity > 0.0) p.velocity = l->velocity;
+    }
+    if (const urdf::JointDynamicsSharedPtr& d = joint->dynamics) p.damping = d->damping, p.friction = d->friction;
+    by_name[name] = p;
+  }
+  return by_name;
+}
+
 }  // namespace
 
-FloatingModel loadUrdfString(const std::string& xml, const std::string& source) {
+FloatingModel loadUrdfString(const std::string& written, const std::string& source) {
   // Before TinyXML's recursive descent sees the text (parse, twice below).
-  if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty())
+  if (const std::string problem = rules::xmlDepthProblem(written); !problem.empty())
     throw ModelError(source + ": not XML that can be read safely: " + problem);
+  if (const std::string problem = rules::xacroProblem(written); !problem.empty())
+    throw ModelError(source + ": not a URDF yet: " + problem);
+  // Lenient readings of what urdfdom refuses, each a finding (the checker's too).
+  std::vector<Finding> findings;
+  std::vector<std::string> unlimited;
+  const std::string xml = detail::withUnlimitedRevolutesContinuous(written, unlimited);
+  for (const std::string& joint : unlimited) rules::checkRevoluteWithoutLimit(joint, findings);
   const urdf::ModelInterfaceSharedPtr model = parse(xml, source);
   std::vector<Diagnostic> diagnostics;
   auto fail = [&](const std::string& what) -> void { throw ModelError(source + ": " + what); };
@@ -107,16 +134,17 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
     diagnostics.push_back(
         {free_joint->name, "floating joint from the massless root " + detail::quoted(root->name) +
                                " dropped: link " + detail::quoted(free_joint->child_link_name) +
-                               " is the free-floating base"});
+                               " is the free-floating base",
+         "floating_root_joint_dropped", Severity::Note});
     base = model->getLink(free_joint->child_link_name);
   }
 
   // The shared rules (the same as checkUrdfFile's); the first error refuses the file.
-  std::vector<Finding> findings;
   for (const auto& [name, joint] : model->joints_) {
     if (name == dropped_joint) continue;
     const std::string type = typeName(*joint);
     rules::checkJointType(name, type, findings);
+    if (joint->mimic) rules::checkMimic(name, joint->mimic->joint_name, findings);
     if (rules::isMovable(type))
       rules::checkAxis(name, Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z), findings);
     if ((type == "revolute" || type == "prismatic") && joint->limits)
@@ -134,7 +162,7 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
   else if (deep >= 0)
     rules::checkDepth(graph.link(below.steps[deep].link), below.steps[deep].depth, findings);
   if (const Finding* e = rules::firstError(findings)) fail(describe(*e));
-  for (const Finding& f : findings) diagnostics.push_back({f.element, f.message});
+  for (const Finding& f : findings) diagnostics.push_back({f.element, f.message, f.kind, f.severity});
 
   // kdl_parser on a copy prepared so it has nothing to warn about (PITFALLS.md #2): no root
   // inertia, the dropped floating joint gone.
@@ -151,7 +179,7 @@ FloatingModel loadUrdfString(const std::string& xml, const std::string& source) 
            ": its joints form a loop (a URDF describes a tree)");
 
   try {
-    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics));
+    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics)).withJointProperties(properties(*model));
   } catch (const ModelError& e) {
     throw ModelError(source + ": " + e.what());
   }

@@ -19,6 +19,10 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
   try {
     const auto model = std::make_shared<const FloatingModel>(loadUrdfString(xml, report.source));
     summary.loaded = true;
+    // The model's own rule on its composite bodies (their poses are the model's to compose).
+    for (const Diagnostic& d : model->diagnostics())
+      if (d.kind == "singular_composite")
+        report.warnings.push_back(rules::warning(d.kind, ElementType::Link, d.element, d.message));
     summary.base = model->bodies()[0].name;
     summary.joint_names = model->jointNames();
     summary.total_mass = model->totalMass();

@@ -312,10 +312,12 @@ void Reader::readJoint(const TiXmlElement* e) {
     if (ok && limited) {
       rules::checkLimits(joint.name, lower, upper, findings_);
     }
+  } else if (joint.type == "revolute") {
+    rules::checkRevoluteWithoutLimit(joint.name, findings_);
   } else if (limited) {
     error("malformed", owner,
           "a " + joint.type + " joint needs <limit lower=... upper=... effort=... velocity=.../> (urdfdom "
-          "refuses it without)" + (joint.type == "revolute" ? "; for an unlimited rotation use a continuous joint" : ""));
+          "refuses it without)");
   }
   double unused = 0.0;
   if (const TiXmlElement* safety = e->FirstChildElement("safety_controller")) {
@@ -327,7 +329,7 @@ void Reader::readJoint(const TiXmlElement* e) {
   if (const TiXmlElement* calibration = e->FirstChildElement("calibration"))
     for (const char* a : {"rising", "falling"}) readOptional(calibration, a, owner, "<calibration", unused);
   if (const TiXmlElement* mimic = e->FirstChildElement("mimic")) {
-    readRequired(mimic, {"joint"}, owner, "<mimic");
+    if (readRequired(mimic, {"joint"}, owner, "<mimic")) rules::checkMimic(joint.name, mimic->Attribute("joint"), findings_);
     for (const char* a : {"multiplier", "offset"}) readOptional(mimic, a, owner, "<mimic", unused);
   }
   if (const TiXmlElement* dynamics = e->FirstChildElement("dynamics")) {
@@ -345,6 +347,10 @@ bool Reader::read(const std::string& xml) {
   }
   if (const std::string problem = rules::xmlDepthProblem(xml); !problem.empty()) {
     fileError("not_xml", "not XML that can be read safely: " + problem);
+    return false;
+  }
+  if (const std::string problem = rules::xacroProblem(xml); !problem.empty()) {
+    fileError("xacro", "not a URDF yet: " + problem);
     return false;
   }
   TiXmlDocument document;
@@ -386,6 +392,26 @@ bool Reader::read(const std::string& xml) {
 
 bool readUrdfXml(const std::string& xml, UrdfDocument& doc, std::vector<Finding>& findings) {
   return Reader(doc, findings).read(xml);
+}
+
+std::string withUnlimitedRevolutesContinuous(const std::string& xml, std::vector<std::string>& changed) {
+  TiXmlDocument document;
+  const std::string padded = xml + "    ";  // see urdf_loader.cpp
+  document.Parse(padded.c_str());
+  TiXmlElement* robot = document.Error() ? nullptr : document.FirstChildElement("robot");
+  if (!robot) return xml;  // urdfdom will say what is wrong
+  for (TiXmlElement* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
+    const char* type = e->Attribute("type");
+    const char* name = e->Attribute("name");
+    if (type && std::string(type) == "revolute" && !e->FirstChildElement("limit")) {
+      e->SetAttribute("type", "continuous");
+      changed.push_back(name ? name : "");
+    }
+  }
+  if (changed.empty()) return xml;
+  TiXmlPrinter printer;
+  document.Accept(&printer);
+  return printer.CStr();
 }
 
 LinkGraph linkGraph(const UrdfDocument& doc) {

@@ -46,6 +46,11 @@ struct UrdfDocument {
 /// as read. False when the text is not a URDF document at all (nothing was read).
 bool readUrdfXml(const std::string& xml, UrdfDocument& doc, std::vector<Finding>& findings);
 
+/// \brief The document as the loader hands it to urdfdom: every revolute joint without <limit>
+/// (which urdfdom refuses) made continuous, their names appended to `changed`; `xml` itself when
+/// there is none (or when it is not a URDF document: urdfdom says what is wrong).
+std::string withUnlimitedRevolutesContinuous(const std::string& xml, std::vector<std::string>& changed);
+
 /// The document's links and joints as a graph, in document order (the checker's view).
 LinkGraph linkGraph(const UrdfDocument& doc);
 

@@ -47,6 +47,7 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
     jt["base_twist_before"] = twist(other.before.base_twist);
     jt["base_twist_after"] = twist(other.after.base_twist);
     jt["joint_names"] = std::get<FloatingSystem>(p.target).model->jointNames();
+    jt["joints_treated_as_fixed"] = fixedJointsJson(*std::get<FloatingSystem>(p.target).model);
     jt["qdot_before"] = toJson(other.before.qdot.data);
     jt["qdot_after"] = toJson(other.after.qdot.data);
   }
@@ -55,6 +56,7 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
   j["robot"] = Json{{"base_twist_before", twist(r.robot.before.base_twist)},
                     {"base_twist_after", twist(r.robot.after.base_twist)},
                     {"joint_names", p.robot.model->jointNames()},
+                    {"joints_treated_as_fixed", fixedJointsJson(*p.robot.model)},
                     {"qdot_before", toJson(r.robot.before.qdot.data)},
                     {"qdot_after", toJson(r.robot.after.qdot.data)},
                     {"contact_twist_before", toJson(r.robot.contact_twist_before)},

@@ -58,7 +58,7 @@ CLI::App* addCheck(CLI::App& app, CheckOptions& o) {
   cmd->add_option("FILE", o.urdf, "URDF file; its root link is the free-floating base")->required();
   cmd->add_option("--tip", o.tips, "Contact link to check and to compute G* at (repeat for several)")
       ->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_flag("--json", o.json, "Print one JSON object: errors, warnings, model");
+  cmd->add_flag("--json", o.json, "Print one JSON object: errors, warnings, notes, model");
   cmd->add_flag("--strict", o.strict, "Exit with 3 on warnings too");
   return cmd;
 }
@@ -70,12 +70,14 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
     Json j;
     j["errors"] = findingsJson(report.errors);
     j["warnings"] = findingsJson(report.warnings);
+    j["notes"] = findingsJson(report.notes);
     j["model"] = summaryJson(report.model);
     // Names and values come from the file as written: replace what is not UTF-8.
     out << std::setprecision(17) << j.dump(2, ' ', false, Json::error_handler_t::replace) << "\n";
   } else {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";
+    for (const Finding& f : report.notes) out << report.source << ": note: " << describe(f) << "\n";
     if (report.model.loaded) out << report.source << ": note: " << modelNote(report.model) << "\n";
     out << plural(report.errors.size(), "error") << ", " << plural(report.warnings.size(), "warning");
     if (o.strict && !report.warnings.empty()) out << " (--strict: warnings fail the check)";

@@ -17,6 +17,12 @@
 
 namespace kdl_space::cli {
 
+Json fixedJointsJson(const FloatingModel& model) {
+  Json list = Json::array();
+  for (const FixedJoint& f : model.fixedJoints()) list.push_back(Json{{"joint", f.joint}, {"reason", f.reason}});
+  return list;
+}
+
 Json toJson(const Eigen::MatrixXd& m) {
   Json rows = Json::array();
   if (m.cols() == 1) {

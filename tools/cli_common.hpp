@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/model.hpp"
 #include "kdl_space/errors.hpp"
 #include "kdl_space/input_file.hpp"  // checkInputFile, parseFiniteNumber
 
@@ -32,6 +33,10 @@ using Json = nlohmann::ordered_json;
 
 /// A matrix as a JSON array of rows; a column vector as a flat array.
 Json toJson(const Eigen::MatrixXd& m);
+
+/// The joints of the description that are not coordinates: [{"joint", "reason"}] (JSON key
+/// `joints_treated_as_fixed` beside every `joint_names`).
+Json fixedJointsJson(const FloatingModel& model);
 
 /// Row labels of a twist or wrench: vx vy vz wx wy wz.
 const std::vector<std::string>& twistLabels();

@@ -180,6 +180,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     j["com"] = toJson(solver.r_g());
     j["I_g"] = toJson(solver.I_g());
     j["joint_names"] = joints;
+    j["joints_treated_as_fixed"] = fixedJointsJson(*model);
     j["H_star"] = n ? toJson(solver.H_star().data) : Json::array();
     j["contacts"] = json_contacts;
     j["G_star_all"] = toJson(G_all);

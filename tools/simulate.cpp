@@ -166,6 +166,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
                            {"rejected_steps", sim.stats().rejected_steps},
                            {"payload_attached", payload_attached},
                            {"joint_names", joints},
+                           {"joints_treated_as_fixed", fixedJointsJson(*model)},
                            {"final", final_state},
                            {"max_linear_momentum_change", dP},
                            {"max_angular_momentum_change", dL},

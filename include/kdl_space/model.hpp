@@ -7,7 +7,9 @@
 #include <kdl/chain.hpp>
 #include <kdl/rigidbodyinertia.hpp>
 #include <kdl/tree.hpp>
+#include <limits>
 #include <memory>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,24 @@ struct Body {
   Eigen::Matrix3d I_com = Eigen::Matrix3d::Zero();     ///< inertia about the CoM, body axes [kg m^2]
 };
 
+/// \brief What a description says of a joint beyond its motion (URDF <limit> and <dynamics>): read
+/// into the model, used by the simulation. Infinite where the description gives no limit (the
+/// URDF loader reads an effort or velocity limit of 0, which files write for "not given", as none).
+struct JointProperties {
+  double lower = -std::numeric_limits<double>::infinity();  ///< position limits [rad or m]
+  double upper = std::numeric_limits<double>::infinity();
+  double effort = std::numeric_limits<double>::infinity();    ///< [N m or N]
+  double velocity = std::numeric_limits<double>::infinity();  ///< [rad/s or m/s]
+  double damping = 0.0;   ///< viscous [N m s/rad or N s/m]
+  double friction = 0.0;  ///< Coulomb [N m or N]
+};
+
+/// A movable joint of the description that the model treats as fixed (at q = 0), and why.
+struct FixedJoint {
+  std::string joint;
+  std::string reason;
+};
+
 /// A contact point h: a body plus an offset in that body's frame (MATH.md conventions).
 struct Contact {
   int body = -1;                    ///< index into FloatingModel::bodies()
@@ -48,7 +68,13 @@ class KDL_SPACE_EXPORT FloatingModel {
  public:
   /// \brief Builds the model from a KDL tree whose root segment is the base, plus the base
   /// body's inertia (in the base frame, as KDL segments hold theirs).
-  /// \param armature optional rotor inertia per joint (model order), added to H's diagonal.
+  ///
+  /// The rigid bodies of the dynamics are composites (a link and every link fixed to it): the
+  /// base composite needs mass, links may be point masses or massless frames. A movable joint
+  /// that moves only massless links and has no armature is fixed at q = 0 (fixedJoints()); an
+  /// inertia negative within round-off is read with that moment 0. Each is a diagnostic.
+  /// \param armature optional rotor inertia per joint of `tree` (its q_nr order), added to H's
+  /// diagonal; kept for the joints that stay coordinates.
   /// \throws ModelError naming the link or joint when the model cannot be used.
   FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
                 std::vector<double> armature = {}, std::vector<Diagnostic> diagnostics = {});
@@ -65,10 +91,20 @@ class KDL_SPACE_EXPORT FloatingModel {
   const std::vector<std::string>& jointNames() const { return joint_names_; }
   /// Index of the body each joint moves (model order).
   const std::vector<int>& jointBody() const { return joint_body_; }
+  /// Limits, damping and friction per joint (model order; none unless given).
+  const std::vector<JointProperties>& jointProperties() const { return joint_properties_; }
+  /// \brief A copy of this model with the joints' limits, damping and friction, by joint name
+  /// (names of joints that are not coordinates are ignored: they are fixed).
+  /// \throws ModelError for a name that is no joint of the description's, or a property that
+  /// is NaN, a negative damping, friction, effort or velocity limit, or lower > upper.
+  FloatingModel withJointProperties(const std::map<std::string, JointProperties>& by_name) const;
   /// Rotor inertia per joint (zeros unless given).
   const std::vector<double>& armature() const { return armature_; }
-  /// Problems found that do not stop the computation.
+  /// Problems found that do not stop the computation, and what was assumed to read the tree.
   const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
+  /// The movable joints of the given tree that are not coordinates (they move no mass): fixed at
+  /// q = 0 in tree().
+  const std::vector<FixedJoint>& fixedJoints() const { return fixed_joints_; }
   /// The KDL tree (root segment = base; the base inertia is in `bodies()[0]`, not in the tree).
   const KDL::Tree& tree() const { return tree_; }
   /// Total mass w [kg].
@@ -93,7 +129,9 @@ class KDL_SPACE_EXPORT FloatingModel {
   FloatingModel withPayload(const std::string& link, const KDL::RigidBodyInertia& inertia) const;
 
  private:
+  void build(const KDL::RigidBodyInertia& base_inertia);
   void validate();
+  void checkComposites();
   void checkArmature() const;
 
   KDL::Tree tree_;
@@ -101,7 +139,9 @@ class KDL_SPACE_EXPORT FloatingModel {
   std::vector<std::string> joint_names_;
   std::vector<int> joint_body_;
   std::vector<double> armature_;
+  std::vector<JointProperties> joint_properties_;
   std::vector<Diagnostic> diagnostics_;
+  std::vector<FixedJoint> fixed_joints_;
   double total_mass_ = 0.0;
   std::shared_ptr<const detail::MotionTable> motions_;  ///< immutable: shared by copies
 };

@@ -33,6 +33,7 @@ struct UrdfReport {
   std::string source;             ///< file name (or the name given to checkUrdfString)
   std::vector<Finding> errors;    ///< the model cannot be used until these are fixed
   std::vector<Finding> warnings;  ///< the model loads; these deserve a look
+  std::vector<Finding> notes;     ///< what was read and how (not problems: --strict passes them)
   ModelSummary model;
 };
 

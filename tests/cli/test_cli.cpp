@@ -27,7 +27,7 @@ TEST(Cli, InspectJsonMatchesTheReferenceEngine) {
   for (const auto& item : j.items()) keys.push_back(item.key());
   // Exactly the contract's keys (a JSON object is unordered: compare sorted).
   EXPECT_EQ(keys, (std::vector<std::string>{"G_star_all", "H_star", "I_g", "com", "contacts", "diagnostics",
-                                            "joint_names", "mass"}));
+                                            "joint_names", "joints_treated_as_fixed", "mass"}));
   ASSERT_EQ(j.at("contacts").size(), 1u);
   const nlohmann::json& h = j.at("contacts")[0];
   std::vector<std::string> contact_keys;

@@ -42,7 +42,7 @@ TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
                                                "virtual_mass"}));
   EXPECT_EQ(keys(j.at("robot")), (std::vector<std::string>{"base_twist_after", "base_twist_before",
                                                            "contact_twist_after", "contact_twist_before",
-                                                           "joint_names", "qdot_after", "qdot_before"}));
+                                                           "joint_names", "joints_treated_as_fixed", "qdot_after", "qdot_before"}));
   EXPECT_EQ(keys(j.at("target")), (std::vector<std::string>{"twist_after", "twist_before"}));
 
   const nlohmann::json& robot = j.at("robot");

@@ -83,16 +83,51 @@ TEST(ModelErrors, PlanarJoint) {
                 {"case.urdf", "'slider'", "planar", "not supported"});
 }
 
-TEST(ModelErrors, MassButZeroInertia) {
-  expectRefused(robot(arm(inertial("2", "0", "0", "0"))), {"case.urdf", "'link1'", "not positive definite"});
+/// The diagnostics of `model` of `kind`.
+std::vector<Diagnostic> diagnosticsOf(const FloatingModel& model, const std::string& kind) {
+  std::vector<Diagnostic> found;
+  for (const Diagnostic& d : model.diagnostics())
+    if (d.kind == kind) found.push_back(d);
+  return found;
+}
+
+TEST(ModelErrors, MassButZeroInertiaIsAPointMass) {
+  // A point mass on j1's axis: j1 still moves link2's inertia, so the model is usable; the body
+  // of link1 alone is singular, which is said.
+  const FloatingModel model = loadUrdfString(robot(arm(inertial("2", "0", "0", "0"))), "case.urdf");
+  const std::vector<Diagnostic> point = diagnosticsOf(model, "point_mass");
+  ASSERT_EQ(point.size(), 1u);
+  EXPECT_EQ(point[0].element, "link1");
+  const std::vector<Diagnostic> singular = diagnosticsOf(model, "singular_composite");
+  ASSERT_EQ(singular.size(), 1u);
+  EXPECT_EQ(singular[0].element, "link1");
+  EXPECT_NE(singular[0].message.find("a point mass"), std::string::npos) << singular[0].message;
+  EXPECT_EQ(model.nj(), 2u);
 }
 
 TEST(ModelErrors, NegativeDefiniteInertia) {
   expectRefused(robot(arm(inertial("2", "-0.1", "-0.2", "-0.3"))), {"case.urdf", "'link1'", "not positive definite"});
 }
 
-TEST(ModelErrors, TriangleInequalityBroken) {
-  expectRefused(robot(arm(inertial("2", "0.1", "0.1", "0.3"))), {"case.urdf", "'link1'", "triangle inequality"});
+TEST(ModelErrors, TriangleInequalityBrokenIsAWarning) {
+  const FloatingModel model = loadUrdfString(robot(arm(inertial("2", "0.1", "0.1", "0.3"))), "case.urdf");
+  const std::vector<Diagnostic> found = diagnosticsOf(model, "triangle_inequality");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].element, "link1");
+  EXPECT_NE(found[0].message.find("by 0.1 kg m^2 (33.3333 % of I3)"), std::string::npos) << found[0].message;
+  EXPECT_EQ(found[0].severity, Severity::Warning);
+}
+
+TEST(ModelErrors, RoundOffBelowZeroIsReadAsZero) {
+  // 9e-8 beside -3.5e-8 on a 0.05 kg link: within m (1 mm)^2 = 5e-8 of zero.
+  const FloatingModel model =
+      loadUrdfString(robot(arm(inertial("0.05", "9e-8", "9e-8", "-3.5e-8"))), "case.urdf");
+  ASSERT_EQ(diagnosticsOf(model, "inertia_round_off").size(), 1u);
+  const Body& b = model.bodies()[static_cast<std::size_t>(model.bodyIndex("link1"))];
+  EXPECT_DOUBLE_EQ(b.I_com(2, 2), 0.0);  // diagonal: the negative moment is the zz one, now 0
+  EXPECT_DOUBLE_EQ(b.I_com(0, 0), 9e-8);
+  // Beyond round-off it is still refused.
+  expectRefused(robot(arm(inertial("0.05", "9e-8", "9e-8", "-1e-7"))), {"case.urdf", "'link1'", "not positive definite"});
 }
 
 TEST(ModelErrors, NanMass) {
@@ -113,9 +148,29 @@ TEST(ModelErrors, BaseWithoutInertial) {
                 {"case.urdf", "'base'", "no mass"});
 }
 
-TEST(ModelErrors, JointMovingOnlyMasslessLinks) {
-  expectRefused(robot(arm() + joint("idle", "revolute", "link2", "ghost") + link("ghost", "")),
-                {"case.urdf", "'idle'", "moves only massless links", "ghost"});
+TEST(ModelErrors, JointMovingOnlyMasslessLinksIsFixed) {
+  const FloatingModel model =
+      loadUrdfString(robot(arm() + joint("idle", "revolute", "link2", "ghost") + link("ghost", "")), "case.urdf");
+  EXPECT_EQ(model.jointNames(), (std::vector<std::string>{"j1", "j2"}));
+  ASSERT_EQ(model.fixedJoints().size(), 1u);
+  EXPECT_EQ(model.fixedJoints()[0].joint, "idle");
+  EXPECT_NE(model.fixedJoints()[0].reason.find("moves only massless links ('ghost' and below)"), std::string::npos);
+  ASSERT_EQ(diagnosticsOf(model, "joint_moves_no_mass").size(), 1u);
+  EXPECT_GE(model.bodyIndex("ghost"), 0);  // still a frame: a contact there works
+}
+
+TEST(ModelErrors, BaseCompositeWithoutMass) {
+  // A massless root with massless links fixed to it: the base has no mass; every link is named.
+  expectRefused(robot(link("world", "") + joint("mount", "fixed", "world", "plate") + link("plate", "") +
+                      joint("j1", "revolute", "plate", "link1") + link("link1")),
+                {"case.urdf", "no mass", "'world', 'plate'", "the root and the links fixed to it"});
+  // Mass fixed to a massless root makes the base: a UR5 on 'world' is a floating 4 kg base.
+  const FloatingModel model = loadUrdfString(
+      robot(link("world", "") + joint("mount", "fixed", "world", "base_link") + link("base_link", inertial("4")) +
+            joint("j1", "revolute", "base_link", "link1") + link("link1")),
+      "case.urdf");
+  EXPECT_EQ(model.bodies()[0].name, "world");
+  EXPECT_DOUBLE_EQ(model.totalMass(), 5.0);
 }
 
 TEST(ModelErrors, UnknownContactLinkAndUnknownJoint) {
