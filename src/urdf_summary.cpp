@@ -25,6 +25,8 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
         report.warnings.push_back(rules::warning(d.kind, ElementType::Link, d.element, d.message));
     summary.base = model->bodies()[0].name;
     summary.joint_names = model->jointNames();
+    summary.joint_properties = model->jointProperties();
+    summary.joints_treated_as_fixed = model->fixedJoints();
     summary.total_mass = model->totalMass();
     FreeFloatingSolver solver(model);
     const double inf = std::numeric_limits<double>::infinity();

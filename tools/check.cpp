@@ -1,5 +1,6 @@
 #include "check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -36,18 +37,69 @@ Json summaryJson(const ModelSummary& m) {
   Json g = Json::array();
   for (const auto& [link, condition] : m.condition_G_star) g.push_back(Json{{"link", link}, {"condition", jsonNumber(condition)}});
   j["condition_G_star"] = g;
+  Json props = Json::array();  // limits (null: none), damping, friction of each movable joint
+  for (std::size_t i = 0; i < m.joint_properties.size() && i < m.joint_names.size(); ++i) {
+    const JointProperties& p = m.joint_properties[i];
+    props.push_back(Json{{"joint", m.joint_names[i]}, {"lower", jsonNumber(p.lower)}, {"upper", jsonNumber(p.upper)},
+                         {"effort", jsonNumber(p.effort)}, {"velocity", jsonNumber(p.velocity)},
+                         {"damping", p.damping}, {"friction", p.friction}});
+  }
+  j["joint_properties"] = m.loaded ? props : Json(nullptr);
+  Json fixed = Json::array();
+  for (const FixedJoint& f : m.joints_treated_as_fixed) fixed.push_back(Json{{"joint", f.joint}, {"reason", f.reason}});
+  j["joints_treated_as_fixed"] = m.loaded ? fixed : Json(nullptr);
   return j;
 }
 
-/// One line about the model that loaded: what it is and how well conditioned at q = 0.
-std::string modelNote(const ModelSummary& m) {
+/// One line of what the joints' <limit> and <dynamics> gave (the values are in --json).
+std::string propertiesNote(const ModelSummary& m) {
+  std::size_t position = 0, effort = 0, velocity = 0, damping = 0, friction = 0;
+  for (const JointProperties& p : m.joint_properties) {
+    position += std::isfinite(p.lower) || std::isfinite(p.upper);
+    effort += std::isfinite(p.effort);
+    velocity += std::isfinite(p.velocity);
+    damping += p.damping > 0.0;
+    friction += p.friction > 0.0;
+  }
+  std::ostringstream s;
+  s << "of the " << plural(m.joint_properties.size(), "movable joint") << ": position limits on " << position
+    << ", effort limits on " << effort << ", velocity limits on " << velocity << ", damping on " << damping
+    << ", friction on " << friction << " (values in --json)";
+  return s.str();
+}
+
+/// Whether condition number `a` is worse than `b`: larger, infinite, or not a number at all.
+bool worse(double a, double b) {
+  const auto rank = [](double c) { return std::isnan(c) ? 2 : std::isinf(c) ? 1 : 0; };
+  return rank(a) != rank(b) ? rank(a) > rank(b) : rank(a) == 0 && a > b;
+}
+
+/// Leaves named in the note when no --tip was given; the JSON has them all.
+constexpr std::size_t kLeavesInNote = 3;
+
+/// One line about the model that loaded: what it is and how well conditioned at q = 0. cond(G*)
+/// at every requested tip, in their order; without --tip, at the kLeavesInNote worst leaves,
+/// worst first, and how many more the JSON holds.
+std::string modelNote(const ModelSummary& m, bool tips_requested) {
   std::ostringstream s;
   s << "base '" << m.base << "', " << plural(m.links, "link") << ", " << plural(m.joint_names.size(), "movable joint")
     << ", total mass " << m.total_mass << " kg";
   if (!m.joint_names.empty()) s << "; at q = 0: cond(H*) = " << m.condition_H_star;
-  for (std::size_t i = 0; i < m.condition_G_star.size(); ++i)
+  std::vector<std::pair<std::string, double>> shown = m.condition_G_star;
+  std::size_t more = 0;
+  if (!tips_requested) {
+    std::stable_sort(shown.begin(), shown.end(), [](const auto& a, const auto& b) { return worse(a.second, b.second); });
+    if (shown.size() > kLeavesInNote) {
+      more = shown.size() - kLeavesInNote;
+      shown.resize(kLeavesInNote);
+    }
+  }
+  for (std::size_t i = 0; i < shown.size(); ++i)
     s << (i == 0 ? (m.joint_names.empty() ? "; at q = 0: cond(G*) = " : ", cond(G*) = ") : ", ")
-      << m.condition_G_star[i].second << " at '" << m.condition_G_star[i].first << "'";
+      << shown[i].second << " at '" << shown[i].first << "'";
+  if (more)
+    s << " (the " << kLeavesInNote << " largest), and " << more << " more " << (more == 1 ? "leaf" : "leaves")
+      << " (all in --json)";
   return s.str();
 }
 
@@ -78,7 +130,11 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";
     for (const Finding& f : report.notes) out << report.source << ": note: " << describe(f) << "\n";
-    if (report.model.loaded) out << report.source << ": note: " << modelNote(report.model) << "\n";
+    if (report.model.loaded) {
+      if (!report.model.joint_properties.empty())
+        out << report.source << ": note: " << propertiesNote(report.model) << "\n";
+      out << report.source << ": note: " << modelNote(report.model, !o.tips.empty()) << "\n";
+    }
     out << plural(report.errors.size(), "error") << ", " << plural(report.warnings.size(), "warning");
     if (o.strict && !report.warnings.empty()) out << " (--strict: warnings fail the check)";
     out << "\n";

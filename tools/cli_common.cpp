@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <sstream>
 
 #include "detail/text.hpp"
 
@@ -37,29 +39,118 @@ Json toJson(const Eigen::MatrixXd& m) {
   return rows;
 }
 
+Json toJsonRows(const Eigen::MatrixXd& m) {
+  Json rows = Json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    Json row = Json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 const std::vector<std::string>& twistLabels() {
   static const std::vector<std::string> labels{"vx", "vy", "vz", "wx", "wy", "wz"};
   return labels;
 }
 
+std::size_t outputWidth() {
+  const char* columns = std::getenv("COLUMNS");
+  if (columns == nullptr || *columns == '\0') return kDefaultOutputWidth;
+  const std::string text(columns);
+  for (char c : text)
+    if (c < '0' || c > '9') return kDefaultOutputWidth;
+  // More digits than any terminal has columns: as wide as asked, without overflowing.
+  const std::size_t width = text.size() > 6 ? 999999 : std::stoul(text);
+  return std::max(width, kMinOutputWidth);
+}
+
+void printWrapped(std::ostream& os, const std::string& text, std::size_t width, const std::string& first_indent,
+                  const std::string& indent) {
+  std::istringstream paragraphs(text);
+  for (std::string paragraph; std::getline(paragraphs, paragraph);) {
+    // Words between single spaces (an empty one for each further space: a file name keeps its
+    // spaces); a line breaks at a space, which it drops.
+    std::string line = first_indent;
+    bool has_word = false;
+    std::istringstream words(paragraph);
+    for (std::string word; std::getline(words, word, ' ');) {
+      if (has_word && line.size() + 1 + word.size() > width) {
+        os << line << "\n";
+        line = indent;
+        has_word = false;
+      }
+      line += (has_word ? " " : "") + word;
+      has_word = true;
+    }
+    os << (has_word ? line : std::string()) << "\n";
+  }
+}
+
 void printMatrix(std::ostream& os, const std::string& title, const Eigen::MatrixXd& m,
-                 const std::vector<std::string>& row_labels, const std::vector<std::string>& col_labels) {
-  std::size_t width = 4;
-  for (const auto& l : row_labels) width = std::max(width, l.size());
-  os << title << "\n";
+                 const std::vector<std::string>& row_labels, const std::vector<std::string>& col_labels,
+                 std::size_t width) {
+  constexpr std::size_t kIndent = 2;         // before the row label
+  constexpr std::size_t kNumber = 13;        // -1.234567e+00
+  constexpr std::size_t kStep = kNumber + 1; // a space, then the number
+  width = std::max(width, kMinOutputWidth);
+  printWrapped(os, title, width, "", "  ");
   if (m.size() == 0) {
     os << "  (empty)\n";
     return;
   }
-  os << "  " << std::setw(static_cast<int>(width)) << "";
-  for (const auto& c : col_labels) os << " " << std::setw(13) << c.substr(0, 13);
-  os << "\n";
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
-    os << "  " << std::left << std::setw(static_cast<int>(width)) << row_labels.at(i) << std::right;
-    for (Eigen::Index j = 0; j < m.cols(); ++j)
-      os << " " << std::setw(13) << std::setprecision(6) << std::scientific << m(i, j);
-    os << std::defaultfloat << "\n";
+  std::size_t label_width = 4, longest_column = 0;
+  for (const auto& l : row_labels) label_width = std::max(label_width, l.size());
+  for (const auto& c : col_labels) longest_column = std::max(longest_column, c.size());
+  // A column label that does not fit over its number stands on a header line of its own, ending
+  // above its column: the first column's must fit after the row-label field.
+  if (longest_column > kNumber && longest_column > kIndent + kStep)
+    label_width = std::max(label_width, longest_column - kIndent - kStep);
+  const std::size_t fixed = kIndent + label_width;
+  const std::size_t n = static_cast<std::size_t>(m.cols());
+  std::size_t per_block = width > fixed + kStep ? (width - fixed) / kStep : 1;
+  const std::size_t blocks = (n + per_block - 1) / per_block;
+  per_block = (n + blocks - 1) / blocks;  // blocks of even size: 7 columns as 4 + 3, not 6 + 1
+
+  const std::ios::fmtflags flags = os.flags();
+  const std::streamsize precision = os.precision();
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t first = b * per_block, last = std::min(n, first + per_block);
+    if (blocks > 1) os << (b ? "\n" : "") << "  columns " << first + 1 << " to " << last << " of " << n << "\n";
+    bool short_labels = true;
+    for (std::size_t j = first; j < last; ++j) short_labels &= col_labels.at(j).size() <= kNumber;
+    if (short_labels) {
+      os << std::string(fixed, ' ');
+      for (std::size_t j = first; j < last; ++j) os << " " << std::setw(static_cast<int>(kNumber)) << col_labels[j];
+      os << "\n";
+    } else {
+      for (std::size_t j = first; j < last; ++j) {
+        const std::size_t end = fixed + (j - first + 1) * kStep;
+        const std::string& label = col_labels[j];
+        os << std::string(end > label.size() ? end - label.size() : 0, ' ') << label << "\n";
+      }
+    }
+    for (Eigen::Index i = 0; i < m.rows(); ++i) {
+      os << std::string(kIndent, ' ') << std::left << std::setw(static_cast<int>(label_width)) << row_labels.at(i)
+         << std::right << std::scientific << std::setprecision(6);
+      for (std::size_t j = first; j < last; ++j)
+        os << " " << std::setw(static_cast<int>(kNumber)) << m(i, static_cast<Eigen::Index>(j));
+      os.flags(flags);
+      os.precision(precision);
+      os << "\n";
+    }
   }
+}
+
+std::vector<Diagnostic> diagnosticsForGivenJoints(const std::vector<Diagnostic>& diagnostics,
+                                                  const std::vector<std::string>& given_joints) {
+  std::vector<Diagnostic> kept;
+  for (const Diagnostic& d : diagnostics) {
+    const bool given = std::find(given_joints.begin(), given_joints.end(), d.element) != given_joints.end();
+    if (given && d.kind == "limits_exclude_zero") continue;
+    kept.push_back(d);
+  }
+  return kept;
 }
 
 std::pair<std::string, double> parseAssignment(const std::string& text, const std::string& option) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kdl_space/model.hpp"
+#include "kdl_space/diagnostics.hpp"
 #include "kdl_space/errors.hpp"
 #include "kdl_space/input_file.hpp"  // checkInputFile, parseFiniteNumber
 
@@ -37,13 +38,46 @@ Json toJson(const Eigen::MatrixXd& m);
 /// The joints of the description that are not coordinates: [{"joint", "reason"}] (JSON key
 /// `joints_treated_as_fixed` beside every `joint_names`).
 Json fixedJointsJson(const FloatingModel& model);
+/// A matrix as a JSON array of rows, always: an r x c matrix is r arrays of c numbers, a column
+/// (c = 1) included (for matrices whose column count is the number of joints: J*, H*).
+Json toJsonRows(const Eigen::MatrixXd& m);
 
 /// Row labels of a twist or wrench: vx vy vz wx wy wz.
 const std::vector<std::string>& twistLabels();
 
-/// Prints `title`, then one row per matrix row with its label, columns headed by `col_labels`.
+/// Smallest output width the text reports are laid out for.
+constexpr std::size_t kMinOutputWidth = 40;
+/// Width used when COLUMNS is not set or not a number.
+constexpr std::size_t kDefaultOutputWidth = 100;
+
+/// The width, in characters, the text reports fit: the COLUMNS environment variable when it is
+/// set and a decimal number (at least kMinOutputWidth), else kDefaultOutputWidth.
+std::size_t outputWidth();
+
+/// \brief Prints `text` word-wrapped to `width` characters, breaking only at spaces: each line
+/// of `text` after `first_indent`, its continuation lines after `indent`. A word longer than a
+/// line is never cut (its line is longer than `width`).
+void printWrapped(std::ostream& os, const std::string& text, std::size_t width, const std::string& first_indent = "",
+                  const std::string& indent = "    ");
+
+/// \brief Prints `title`, then one row per matrix row with its label, columns headed by
+/// `col_labels`, every line at most `width` characters.
+///
+/// A matrix wider than `width` is printed in blocks of columns, each headed by the full labels
+/// of its columns ("columns i to j of n" before each block); rows keep their labels in every
+/// block. Labels are never cut: when a column label is longer than a number (13 characters),
+/// each column's label gets a header line of its own, ending above its column (the row-label
+/// field widens so that the first column's label fits). Only a label longer than the whole
+/// width makes a line longer than `width`.
 void printMatrix(std::ostream& os, const std::string& title, const Eigen::MatrixXd& m,
-                 const std::vector<std::string>& row_labels, const std::vector<std::string>& col_labels);
+                 const std::vector<std::string>& row_labels, const std::vector<std::string>& col_labels,
+                 std::size_t width = outputWidth());
+
+/// \brief The model's diagnostics the user still needs: without the "limits exclude 0" warning
+/// (finding `limits_exclude_zero`) of a joint in `given_joints`, whose position the user gave
+/// (that warning is about joints left at 0).
+std::vector<Diagnostic> diagnosticsForGivenJoints(const std::vector<Diagnostic>& diagnostics,
+                                                  const std::vector<std::string>& given_joints);
 
 /// Parses "NAME=VALUE"; throws UsageError naming `option` if malformed.
 std::pair<std::string, double> parseAssignment(const std::string& text, const std::string& option);

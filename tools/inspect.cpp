@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "detail/text.hpp"
 #include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/urdf_check.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 namespace kdl_space::cli {
@@ -89,7 +90,11 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   try {
     model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
   } catch (const ModelError& e) {
-    throw InputError(e.what());
+    // In check's words (one set of rules): every error of the file, not only the loader's first.
+    const UrdfReport report = checkUrdfFile(o.urdf);
+    std::string all;
+    for (const Finding& f : report.errors) all += (all.empty() ? "" : "\n") + report.source + ": error: " + describe(f);
+    throw InputError(all.empty() ? e.what() : all);
   }
   for (const auto& [name, value] : q_by_name)
     if (model->jointIndex(name) < 0)
@@ -118,10 +123,14 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
                      "--base-rpy): " + strError(rc));
 
+  // The model's warnings, less "limits exclude 0" for a joint given by --q: it is not at 0.
+  std::vector<std::string> given;
+  for (const auto& entry : q_by_name) given.push_back(entry.first);
   std::vector<std::string> diagnostics;
-  for (const Diagnostic& d : model->diagnostics()) diagnostics.push_back(describe(d));
+  for (const Diagnostic& d : diagnosticsForGivenJoints(model->diagnostics(), given)) diagnostics.push_back(describe(d));
   const std::vector<std::string>& joints = model->jointNames();
   const unsigned int n = model->nj();
+  const std::size_t width = outputWidth();
 
   Json json_contacts = Json::array();
   std::ostringstream report;
@@ -154,20 +163,24 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     json_contacts.push_back(Json{{"link", link},
                                  {"offset", toJson(toEigen(h.offset))},
                                  {"point", toJson(p_h)},
-                                 {"J_star", toJson(J_star.data)},
+                                 {"J_star", toJsonRows(J_star.data)},  // 6 x n, even for n = 1
                                  {"G_star", toJson(G_star)},
                                  {"G_grounded", grounded ? toJson(G_grounded) : Json(nullptr)},
                                  {"G_locked", toJson(G_locked)}});
     if (!o.json) {
-      report << "\nContact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", "
-             << h.offset.y() << ", " << h.offset.z() << ") m, at (" << p_h.x() << ", " << p_h.y() << ", "
-             << p_h.z() << ") m in the world\n";
-      printMatrix(report, "J* (generalized Jacobian, eq. 4), one row per joint: twist (v; w) per unit rate",
-                  J_star.data.transpose(), joints, twistLabels());
-      printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", G_star, twistLabels(), twistLabels());
+      std::ostringstream where;
+      where << "Contact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", "
+            << h.offset.y() << ", " << h.offset.z() << ") m, at (" << p_h.x() << ", " << p_h.y() << ", "
+            << p_h.z() << ") m in the world";
+      report << "\n";
+      printWrapped(report, where.str(), width);
+      // Transposed, so that each joint's row carries its name; the JSON's J_star is J* (6 x n).
+      printMatrix(report, "J*^T (J* of eq. 4, transposed: n x 6, one row per joint; columns the twist (v; w) per "
+                  "unit rate)", J_star.data.transpose(), joints, twistLabels(), width);
+      printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", G_star, twistLabels(), twistLabels(), width);
       if (grounded)
-        printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels());
-      printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels());
+        printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels(), width);
+      printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels(), width);
     }
   }
   Eigen::MatrixXd G_all(6 * contacts.size(), 6 * contacts.size());
@@ -181,30 +194,31 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     j["I_g"] = toJson(solver.I_g());
     j["joint_names"] = joints;
     j["joints_treated_as_fixed"] = fixedJointsJson(*model);
-    j["H_star"] = n ? toJson(solver.H_star().data) : Json::array();
+    j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
     j["contacts"] = json_contacts;
     j["G_star_all"] = toJson(G_all);
     j["diagnostics"] = diagnostics;
     out << std::setprecision(17) << j.dump(2) << "\n";
     return;
   }
-  out << "Free-floating model " << o.urdf << ": base '" << model->bodies()[0].name << "', "
-      << model->bodies().size() << " links, " << n << " movable joints\n";
-  out << "Total mass w = " << solver.w() << " kg\n";
-  out << "System CoM r_g = (" << solver.r_g().x() << ", " << solver.r_g().y() << ", " << solver.r_g().z()
-      << ") m\n";
+  std::ostringstream what;
+  what << "Free-floating model " << o.urdf << ": base '" << model->bodies()[0].name << "', "
+       << model->bodies().size() << " links, " << n << " movable joints";
+  what << "\nTotal mass w = " << solver.w() << " kg\nSystem CoM r_g = (" << solver.r_g().x() << ", "
+       << solver.r_g().y() << ", " << solver.r_g().z() << ") m";
+  printWrapped(out, what.str(), width);
   printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
-              {"x", "y", "z"});
-  printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints);
+              {"x", "y", "z"}, width);
+  printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints, width);
   out << report.str();
   if (contacts.size() > 1) {
     std::vector<std::string> labels;
     for (const ContactRequest& r : requests)
       for (const std::string& l : twistLabels()) labels.push_back(r.link + ":" + l);
-    printMatrix(out, "\nG* over all contact points (with cross-coupling blocks)", G_all, labels, labels);
+    printMatrix(out, "\nG* over all contact points (with cross-coupling blocks)", G_all, labels, labels, width);
   }
   out << "\nDiagnostics:" << (diagnostics.empty() ? " none" : "") << "\n";
-  for (const std::string& d : diagnostics) out << "  - " << d << "\n";
+  for (const std::string& d : diagnostics) printWrapped(out, d, width, "  - ", "    ");
 }
 
 }  // namespace kdl_space::cli

@@ -7,6 +7,7 @@
 
 #include "kdl_space/diagnostics.hpp"
 #include "kdl_space/export.hpp"
+#include "kdl_space/model.hpp"
 
 namespace kdl_space {
 
@@ -19,6 +20,8 @@ struct ModelSummary {
   /// True when the loader built the model (no errors); the fields below are set only then.
   bool loaded = false;
   std::vector<std::string> joint_names;  ///< movable joints, model order
+  std::vector<JointProperties> joint_properties;  ///< their limits, damping, friction (model order)
+  std::vector<FixedJoint> joints_treated_as_fixed;  ///< movable joints of the file that are not coordinates
   double total_mass = 0.0;               ///< [kg]
   /// Condition number (largest / smallest eigenvalue) of H* at q = 0, base at the origin;
   /// NaN without movable joints, +inf when singular.

@@ -172,6 +172,10 @@ TEST_P(CheckTool, ReportsEachProblemWithItsLineAndExitCode) {
     ASSERT_FALSE(got.empty());
     EXPECT_EQ(got.back().rfind(path + ": note: base 'base', ", 0), 0u) << got.back();
     got.pop_back();
+    // What the joints' <limit> and <dynamics> gave: every file here limits all its joints.
+    ASSERT_FALSE(got.empty());
+    EXPECT_EQ(got.back().rfind(path + ": note: of the ", 0), 0u) << got.back();
+    got.pop_back();
   }
   EXPECT_EQ(got, expected);
 }
@@ -194,6 +198,17 @@ TEST_P(CheckTool, JsonHasTheSameEntries) {
   EXPECT_EQ(j.at("warnings"), entries(c.warnings));
   EXPECT_EQ(j.at("notes"), entries(c.notes));
   EXPECT_EQ(j.at("model").at("loaded").get<bool>(), c.errors.empty());
+}
+
+TEST_P(CheckTool, InspectOfAFileThatDoesNotLoadSaysWhatCheckSays) {
+  const Case& c = GetParam();
+  if (c.errors.empty() || !c.args.empty()) return;  // it loads (an unknown --tip is check's own)
+  const std::string path = kBroken + c.file + ".urdf";
+  const ToolRun r = kdlSpace("inspect --urdf " + path + " --tip base");
+  EXPECT_EQ(r.rc, 3);
+  std::string expected;
+  for (const Expected& e : c.errors) expected += (expected.empty() ? "" : "\n") + path + ": error: " + e.text();
+  EXPECT_EQ(r.err, "kdl_space: " + expected + "\n");
 }
 
 INSTANTIATE_TEST_SUITE_P(BrokenUrdf, CheckTool, ::testing::ValuesIn(cases()));

@@ -309,7 +309,7 @@ TEST_F(HostileFiles, DeeplyNestedUrdfIsRefusedByEveryCommand) {
   const std::string why = ": not XML that can be read safely: elements nested more than 2000 deep (a URDF nests 4 or 5)\n";
   const ToolRun inspect = kdlSpace("inspect --urdf " + urdf + " --tip hand");
   EXPECT_EQ(inspect.rc, 3);
-  EXPECT_EQ(inspect.err, "kdl_space: " + urdf + why);
+  EXPECT_EQ(inspect.err, "kdl_space: " + urdf + ": error" + why);  // in check's words
   expectCleanFailure(inspect, "inspect");
   std::ifstream in(kCorpus + "/broken_urdf.yaml");
   std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
