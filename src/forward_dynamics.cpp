@@ -27,15 +27,6 @@ struct ForwardDynamicsSolver::BodyData {
 
 namespace {
 
-/// Spatial cross product of motions, V x U, (linear; angular) order.
-inline Vector6d crossMotion(const Vector6d& V, const Vector6d& U) {
-  Vector6d r;
-  const Vector3d w = V.tail<3>();
-  r.head<3>() = w.cross(U.head<3>()) + V.head<3>().cross(U.tail<3>());
-  r.tail<3>() = w.cross(U.tail<3>());
-  return r;
-}
-
 /// I x of a rigid body of mass m, CoM at c relative to the reference point, inertia I_c about
 /// the CoM (world axes), without forming I: (m (x_v + x_w x c); I_c x_w + c x m (x_v + x_w x c)).
 inline Vector6d rigidTimes(double m, const Vector3d& c, const Matrix3d& I_c, const Vector6d& x) {

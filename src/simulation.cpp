@@ -25,25 +25,20 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 namespace {
-/// The model of a motion: not null, no mimic joints (the O(n) forward dynamics cannot couple them).
-std::shared_ptr<const FloatingModel> motionModel(std::shared_ptr<const FloatingModel> model) {
-  if (!model) throw ModelError("simulation: null model");
-  if (!model->mimic().empty()) {
-    std::string names;
-    for (const Mimic& m : model->mimic()) names += (names.empty() ? "'" : ", '") + m.joint + "'";
-    throw ModelError("simulation: the model has mimic joints (" + names +
-                     "): the motion of coupled joints is not supported yet (G*, the velocity jumps and the "
-                     "capture are); remove the <mimic> elements to simulate them as independent joints");
-  }
-  return model;
+/// The forward dynamics of a motion: the O(n) recursion, or the dense route when joints are
+/// coupled (mimic), which the recursion cannot carry.
+std::variant<ForwardDynamicsSolver, DenseForwardDynamics> dynamicsFor(const std::shared_ptr<const FloatingModel>& model) {
+  if (!model->mimic().empty()) return std::variant<ForwardDynamicsSolver, DenseForwardDynamics>(
+      std::in_place_type<DenseForwardDynamics>, model);
+  return std::variant<ForwardDynamicsSolver, DenseForwardDynamics>(std::in_place_type<ForwardDynamicsSolver>, model);
 }
 }  // namespace
 
 Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
-    : model_(motionModel(std::move(model))),
+    : model_(model ? std::move(model) : throw ModelError("simulation: null model")),
       kin_(*model_),
       momentum_(model_),
-      dynamics_(model_),
+      dynamics_(dynamicsFor(model_)),
       options_(options) {
   const unsigned int n = this->model().nj();
   controls_.assign(n, JointControl{});
@@ -63,7 +58,7 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
     throw ModelError("simulation: step, rtol, atol, max_step and max_steps must be finite and > 0");
   if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54)
     throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54");
-  if (dynamics_.setGravity(options_.gravity) != E_NOERROR)
+  if (std::visit([&](auto& d) { return d.setGravity(options_.gravity); }, dynamics_) != E_NOERROR)
     throw ModelError("simulation: gravity must be finite");
 }
 
@@ -80,7 +75,7 @@ void Simulator::setJointControl(unsigned int joint, const JointControl& control)
   controls_[joint] = control;
   std::vector<bool> locked(controls_.size());
   for (std::size_t j = 0; j < controls_.size(); ++j) locked[j] = controls_[j].mode == JointControl::Mode::Locked;
-  dynamics_.setLocked(locked);
+  std::visit([&](auto& d) { d.setLocked(locked); }, dynamics_);
 }
 
 int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
@@ -176,7 +171,9 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
     }
     tau_.data += tau_extra_.data;
   }
-  if (const int rc = dynamics_.CartToJnt(kin_, scratch_.velocity, tau_, {}, acc_)) return rc;
+  static const std::vector<KDL::Wrench> none;
+  if (const int rc = std::visit([&](auto& d) { return d.CartToJnt(kin_, scratch_.velocity, tau_, none, acc_); }, dynamics_))
+    return rc;
   const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
   const Eigen::Vector4d quat = x.segment<4>(3);
   dx.head<3>() = toEigen(scratch_.velocity.base_twist.vel);

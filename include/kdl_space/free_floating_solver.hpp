@@ -75,6 +75,9 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
   /// Unit twist of joint j (model order), world frame, at the point r_g.
   const Vector6d& S(int j) const { return S_[j]; }
+  /// The twist of body i's joint per unit rate of its coordinate (a mimic joint's multiplier
+  /// included; zero for a fixed joint and the base), world frame, at r_g.
+  const Vector6d& bodyJointTwist(int i) const { return Sb_[i]; }
   /// Spatial inertia of body i alone, world frame, about the point r_g.
   const Matrix6d& bodyInertia(int i) const { return I_body_[i]; }
   /// Whether H is positive definite (false: the grounded G is unavailable).

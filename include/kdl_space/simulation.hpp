@@ -4,9 +4,11 @@
 
 #include <functional>
 #include <memory>
+#include <variant>
 #include <vector>
 
 #include "kdl_space/export.hpp"
+#include "kdl_space/dense_forward_dynamics.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/kinematics.hpp"
 #include "kdl_space/momentum.hpp"
@@ -72,7 +74,7 @@ class KDL_SPACE_EXPORT Simulator {
   /// gravity finite and the integrator an enumerator.
   explicit Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options = {});
 
-  const FloatingModel& model() const { return dynamics_.model(); }
+  const FloatingModel& model() const { return *model_; }
   const SimulationOptions& options() const { return options_; }
   /// \throws ModelError (a set-up call) for a joint index out of range, a mode that is no
   /// enumerator, or a gain or set point that is negative or not finite.
@@ -120,7 +122,8 @@ class KDL_SPACE_EXPORT Simulator {
   std::shared_ptr<const FloatingModel> model_;
   Kinematics kin_;             ///< the state of the last unpack() / energyAndMomentum()
   MomentumSolver momentum_;
-  ForwardDynamicsSolver dynamics_;
+  /// The articulated-body recursion; the dense route for a model with mimic joints.
+  std::variant<ForwardDynamicsSolver, DenseForwardDynamics> dynamics_;
   SimulationOptions options_;
   std::vector<JointControl> controls_;
   TorqueCallback callback_;

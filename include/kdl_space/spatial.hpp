@@ -42,6 +42,23 @@ void symmetrize(Eigen::MatrixBase<Derived>& A) {
 }
 
 /// True when every number of the frame (vector, twist) is finite.
+/// Spatial cross product of motions, V x U, (linear; angular) order (Featherstone's crm).
+inline Vector6d crossMotion(const Vector6d& V, const Vector6d& U) {
+  Vector6d r;
+  const Vector3d w = V.tail<3>();
+  r.head<3>() = w.cross(U.head<3>()) + V.head<3>().cross(U.tail<3>());
+  r.tail<3>() = w.cross(U.tail<3>());
+  return r;
+}
+
+/// Spatial cross product of a motion and a force, V x* F, (f; n) order (Featherstone's crf).
+inline Vector6d crossForce(const Vector6d& V, const Vector6d& F) {
+  Vector6d r;
+  r.head<3>() = V.tail<3>().cross(F.head<3>());
+  r.tail<3>() = V.tail<3>().cross(F.tail<3>()) + V.head<3>().cross(F.head<3>());
+  return r;
+}
+
 KDL_SPACE_EXPORT bool allFinite(const KDL::Frame& f);
 KDL_SPACE_EXPORT bool allFinite(const KDL::Vector& v);
 KDL_SPACE_EXPORT bool allFinite(const KDL::Twist& t);

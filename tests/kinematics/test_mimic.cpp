@@ -8,6 +8,7 @@
 #include <string>
 
 #include "kdl_space/collision.hpp"
+#include "kdl_space/dense_forward_dynamics.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
@@ -102,7 +103,7 @@ TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
 
 TEST(Mimic, TheRecursionsRefuseACoupledModelByName) {
   const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
-  for (int which = 0; which < 2; ++which) {
+  for (int which = 0; which < 2; ++which) {  // the recursions; the simulation takes the dense route
     try {
       if (which == 0) RecursiveExIITSolver solver(coupled);
       else ForwardDynamicsSolver solver(coupled);
@@ -113,17 +114,84 @@ TEST(Mimic, TheRecursionsRefuseACoupledModelByName) {
       EXPECT_NE(what.find("'camera_tilt'"), std::string::npos) << what;
     }
   }
-  // The motion says what it cannot do yet, naming the joints.
-  try {
-    Simulator simulator(coupled);
-    ADD_FAILURE() << "a simulation of a model with mimic joints";
-  } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find("simulation: the model has mimic joints ('camera_tilt', 'right_finger')"),
-              std::string::npos) << e.what();
-  }
   int notes = 0;
   for (const Diagnostic& d : coupled->diagnostics()) notes += d.kind == "mimic_joint" || d.kind == "dense_route";
   EXPECT_EQ(notes, 3);
+}
+
+TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
+  // M_c a_c + c_c = (0; tau_c) with M_c = T^T M T, c_c = T^T c (M, c: the robot without <mimic>,
+  // at the coupled state: q = T q_c + o, qdot = T qdot_c), T = diag(E_6, T_joints).
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(11, 9);
+  T.topLeftCorner<6, 6>().setIdentity();
+  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
+  const auto at = [&](const std::string& name) { return 6 + free->jointIndex(name); };
+  T(at("shoulder"), 6) = 1.0;
+  T(at("elbow"), 7) = 1.0;
+  T(at("left_finger"), 8) = 1.0;
+  T(at("right_finger"), 8) = -1.0;
+  o(at("right_finger") - 6) = 0.1;
+  T(at("camera_tilt"), 7) = 0.5;
+  DenseForwardDynamics a(coupled), b(free);
+  ASSERT_EQ(a.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
+  ASSERT_EQ(b.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    State sa(*coupled), sb(*free);
+    sa.world_T_base = sb.world_T_base =
+        KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+    for (int j = 0; j < 3; ++j) sa.q(j) = u(rng);
+    sb.q.data = T.bottomRightCorner(5, 3) * sa.q.data + o;
+    FloatingVelocity va{KDL::Twist(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng))),
+                        KDL::JntArray(3)};
+    for (int j = 0; j < 3; ++j) va.qdot(j) = u(rng);
+    FloatingVelocity vb{va.base_twist, KDL::JntArray(5)};
+    vb.qdot.data = T.bottomRightCorner(5, 3) * va.qdot.data;
+    KDL::JntArray tau(3), tau_free(5);
+    for (int j = 0; j < 3; ++j) tau(j) = u(rng);
+    FloatingAcceleration acc_a{Vector6d::Zero(), KDL::JntArray(3)}, acc_b{Vector6d::Zero(), KDL::JntArray(5)};
+    ASSERT_EQ(a.CartToJnt(sa, va, tau, {}, acc_a), 0);
+    ASSERT_EQ(b.CartToJnt(sb, vb, tau_free, {}, acc_b), 0);  // for M and c of the free robot
+    FreeFloatingSolver& k = b.kinematics();
+    Eigen::MatrixXd M(11, 11);
+    M << k.M_a(), k.A_m(), k.A_m().transpose(), k.H().data;
+    const Eigen::MatrixXd M_c = T.transpose() * M * T;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(9);
+    rhs.tail(3) = tau.data;
+    const Eigen::VectorXd a_c = M_c.ldlt().solve(rhs - T.transpose() * b.bias());
+    EXPECT_TRUE(acc_a.qddot.data.isApprox(a_c.tail(3), 1e-10)) << acc_a.qddot.data.transpose() << " vs "
+                                                               << a_c.tail(3).transpose();
+    // The base's acceleration at its origin from a_g at the CoM (the same kinematic identity).
+    const Vector3d P = k.r_g(), p_b = toEigen(sa.world_T_base.p);
+    const Vector3d w = toEigen(va.base_twist.rot), v_b = toEigen(va.base_twist.vel);
+    Vector6d base;
+    base << a_c.head<3>() + Vector3d(a_c.segment<3>(3)).cross(p_b - P) + w.cross(v_b), a_c.segment<3>(3);
+    EXPECT_TRUE(acc_a.base.isApprox(base, 1e-10)) << acc_a.base.transpose() << " vs " << base.transpose();
+  }
+}
+
+TEST(Mimic, TheMotionOfACoupledRobotKeepsItsEnergyAndMomentum) {
+  // In orbit, no torques: the coupled motion conserves energy and momentum (the simulation
+  // takes the dense route by itself).
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  Simulator simulator(coupled);
+  SimulationState s{0.0, State(*coupled), FloatingVelocity{KDL::Twist(KDL::Vector(0.01, 0.0, -0.02),
+                                                                      KDL::Vector(0.02, -0.01, 0.03)),
+                                                           KDL::JntArray(3)}};
+  s.velocity.qdot(0) = 0.4;
+  s.velocity.qdot(1) = -0.3;
+  s.velocity.qdot(2) = 0.8;
+  double T0 = 0.0, T1 = 0.0;
+  Vector6d h0, h1;
+  ASSERT_EQ(simulator.energyAndMomentum(s, T0, h0), 0);
+  ASSERT_EQ(simulator.run(s, 2.0, 0.5, [](const SimulationState&) {}), 0);
+  ASSERT_EQ(simulator.energyAndMomentum(s, T1, h1), 0);
+  EXPECT_NEAR(T1, T0, 1e-8 * T0);
+  EXPECT_LT((h1 - h0).norm(), 1e-8 * h0.norm());
+  EXPECT_GT((s.state.q.data).norm(), 0.1);  // it moved
 }
 
 TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {

@@ -1,53 +1,27 @@
-// The composite-rigid-body route of free-floating forward dynamics: the tests' (and the
-// benchmark's) second route beside the library's articulated-body algorithm. It is the dense
-// route the library used before (docs/DYNAMICS.md, "The second route"): about the system's CoM
-// r_g at this instant,
-//   [[M_a, A_m], [A_m^T, H]] [a_g; qddot] = [-c_0; tau - c_q],
-// M_a, A_m, H from FreeFloatingSolver (a composite-rigid-body pass, eq. 12 and the fixed-base
-// H), c = (c_0; c_q) the bias of a recursive Newton-Euler pass with zero accelerations (velocity
-// products, gravity as an acceleration -g of the frame, external wrenches), and the (6+n)^2
-// system solved by a Cholesky factorisation; locked joints: rows and columns replaced by the
-// identity, qddot = 0. It shares only FreeFloatingSolver (and through it forwardKinematics) with
-// the articulated-body route.
+// The composite-rigid-body route of free-floating forward dynamics, the tests' (and the
+// benchmark's) second route beside the library's articulated-body algorithm: the library's
+// DenseForwardDynamics (include/kdl_space/dense_forward_dynamics.hpp; the route the simulation
+// takes for coupled joints), which shares only FreeFloatingSolver (and through it
+// forwardKinematics) with the articulated-body route.
 //
 // CrbSimulator: the Simulator's integration loop (same state, tableau, error norm and step
 // control) on this route, as the library ran it before: per derivative, FreeFloatingSolver's
-// compute and baseTwist for the base twist, then CrbForwardDynamics (which computes again).
+// compute and baseTwist for the base twist, then the dense forward dynamics (which computes again).
 #pragma once
 
 #include <memory>
 #include <vector>
 
+#include "kdl_space/dense_forward_dynamics.hpp"
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/simulation.hpp"
 
 namespace kdl_space::test {
 
-/// Dense forward dynamics; the same contract and codes as ForwardDynamicsSolver::CartToJnt(State).
-class CrbForwardDynamics {
- public:
-  explicit CrbForwardDynamics(std::shared_ptr<const FloatingModel> model);
-
-  const FloatingModel& model() const { return kinematics_.model(); }
-  int setGravity(const Vector3d& g);
-  int setLocked(const std::vector<bool>& locked);
-  int CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
-                const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
-  /// The dense solver at the state of the last CartToJnt.
-  FreeFloatingSolver& kinematics() { return kinematics_; }
-  /// Bias (c_0 at the CoM; c_q) of the last CartToJnt. Size 6 + nj().
-  const Eigen::VectorXd& bias() const { return c_; }
-
- private:
-  FreeFloatingSolver kinematics_;
-  Vector3d gravity_ = Vector3d::Zero();
-  std::vector<bool> locked_;
-  std::vector<Vector6d> V_, A_, F_;  ///< per body: twist, spatial acceleration, force, at r_g
-  Eigen::VectorXd c_, rhs_;
-  Eigen::MatrixXd M_;
-  Eigen::LLT<Eigen::MatrixXd> M_llt_;
-};
+/// The dense route, the library's (DenseForwardDynamics): the tests' second route beside the
+/// articulated-body algorithm.
+using CrbForwardDynamics = DenseForwardDynamics;
 
 /// \brief Simulator::run's loop on the dense route (free, locked and PD joints; no callback, no
 /// observer, no brakes): for the benchmark and for a cross-check of the Simulator.
