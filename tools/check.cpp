@@ -103,6 +103,28 @@ std::string modelNote(const ModelSummary& m, bool tips_requested) {
   return s.str();
 }
 
+/// The notes, one line each; a kind with more than kNotesOfAKind of them (massless frames of a
+/// large robot) in one line that names the first few (--json lists each).
+void printNotes(std::ostream& out, const UrdfReport& report) {
+  constexpr std::size_t kNotesOfAKind = 3;
+  std::vector<std::string> done;
+  for (const Finding& f : report.notes) {
+    std::vector<const Finding*> same;
+    for (const Finding& g : report.notes)
+      if (g.kind == f.kind) same.push_back(&g);
+    if (same.size() <= kNotesOfAKind) {
+      out << report.source << ": note: " << describe(f) << "\n";
+      continue;
+    }
+    if (std::find(done.begin(), done.end(), f.kind) != done.end()) continue;
+    done.push_back(f.kind);
+    std::ostringstream names;
+    for (std::size_t i = 0; i < same.size() && i < kNotesOfAKind; ++i) names << (i ? ", '" : "'") << same[i]->element << "'";
+    out << report.source << ": note: " << same.size() << " notes " << f.kind << " (" << names.str() << " and "
+        << same.size() - kNotesOfAKind << " more; each in --json), e.g. " << describe(f) << "\n";
+  }
+}
+
 }  // namespace
 
 CLI::App* addCheck(CLI::App& app, CheckOptions& o) {
@@ -129,7 +151,7 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
   } else {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";
-    for (const Finding& f : report.notes) out << report.source << ": note: " << describe(f) << "\n";
+    printNotes(out, report);
     if (report.model.loaded) {
       if (!report.model.joint_properties.empty())
         out << report.source << ": note: " << propertiesNote(report.model) << "\n";

@@ -373,3 +373,30 @@ TEST(CheckTool, NeverCrashesOnWhatIsNotAUrdf) {
 
 }  // namespace
 }  // namespace kdl_space::test
+
+namespace kdl_space::test {
+namespace {
+
+TEST(CheckTool, ManyNotesOfAKindAreOneLine) {
+  // A humanoid's massless frames: one line that counts them; --json lists each.
+  const std::string path = dataDir() + "/real_patterns/humanoid44.urdf";
+  const ToolRun json = kdlSpace("check " + path + " --json");
+  ASSERT_EQ(json.rc, 0) << json.err;
+  std::size_t massless = 0;
+  const nlohmann::json report = nlohmann::json::parse(json.out);
+  for (const auto& n : report.at("notes")) massless += n.at("kind") == "massless_link";
+  ASSERT_GT(massless, 3u);
+  const ToolRun text = kdlSpace("check " + path);
+  std::size_t lines_about_it = 0;
+  std::istringstream in(text.out);
+  for (std::string line; std::getline(in, line);)
+    if (line.find("massless_link") != std::string::npos || line.find("massless link") != std::string::npos) {
+      ++lines_about_it;
+      EXPECT_NE(line.find(std::to_string(massless) + " notes massless_link ("), std::string::npos) << line;
+      EXPECT_NE(line.find("and " + std::to_string(massless - 3) + " more; each in --json"), std::string::npos) << line;
+    }
+  EXPECT_EQ(lines_about_it, 1u) << text.out;
+}
+
+}  // namespace
+}  // namespace kdl_space::test
