@@ -139,7 +139,6 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   validate();
 }
 
-
 namespace {
 KDL::Tree chainAsTree(const KDL::Chain& chain, const std::string& base_name) {
   KDL::Tree tree(base_name);

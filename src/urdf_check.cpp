@@ -63,6 +63,7 @@ class Checker {
   int base_ = -1;            ///< the free-floating base link
   int dropped_joint_ = -1;   ///< the floating joint from a massless root, dropped
   int lightest_ = -1;        ///< the lightest moving link with mass (for the mass ratio)
+  bool lightest_fixed_ = false;  ///< it hangs on a fixed joint (below a moving one)
 };
 
 /// Links and joints as a graph: missing links, roots, loops; the base.
@@ -191,8 +192,10 @@ void Checker::checkTree() {
       rules::checkDepth(nodes[deep].link, below.steps[deep].depth, found);
     for (std::size_t i = 1; i < nodes.size(); ++i)
       if (moving[i] && nodes[i].mass > 0.0 && std::isfinite(nodes[i].mass) &&
-          (lightest_ < 0 || nodes[i].mass < doc_.links[lightest_].mass))
+          (lightest_ < 0 || nodes[i].mass < doc_.links[lightest_].mass)) {
         lightest_ = below.steps[i].link;
+        lightest_fixed_ = !nodes[i].movable;
+      }
   }
   addAll(found);
 }
@@ -212,10 +215,11 @@ void Checker::checkMassRatio(const std::string& conditions) {
   if (lightest_ < 0 || base_ < 0 || !(doc_.links[base_].mass > 0.0)) return;
   const double base = doc_.links[base_].mass, lightest = doc_.links[lightest_].mass;
   const double ratio = base / lightest;
+  const std::string which = lightest_fixed_ ? "this link on a fixed joint (it moves with its parent)" : "this moving link";
   if (ratio > kMassRatioLimit)
     add(rules::warning("mass_ratio", ElementType::Link, doc_.links[lightest_].name,
                        "the base " + detail::quoted(doc_.links[base_].name) + " (" + rules::number(base) + " kg) is " +
-                           rules::number(ratio) + " times heavier than this moving link (" + rules::number(lightest) +
+                           rules::number(ratio) + " times heavier than " + which + " (" + rules::number(lightest) +
                            " kg), above " + rules::number(kMassRatioLimit) + ": H* and G* may be ill-conditioned (" +
                            conditions + ")"));
 }

@@ -44,31 +44,46 @@ std::string gripper(bool with_mimic) {
          joint("camera_tilt", "upper", "camera", "0.1 0 0.1", "1 0 0", tilt) + link("camera", 0.5, 0.02) + "</robot>";
 }
 
+/// The coupling written out by hand from gripper()'s <mimic> elements: the free robot's joint
+/// values are T q + o of the coupled coordinates (shoulder, elbow, left_finger).
+struct Coupling {
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(5, 3);
+  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
+};
+
+Coupling handCoupling(const FloatingModel& free) {
+  Coupling c;
+  const auto at = [&](const std::string& name) { return free.jointIndex(name); };
+  c.T(at("shoulder"), 0) = 1.0;
+  c.T(at("elbow"), 1) = 1.0;
+  c.T(at("left_finger"), 2) = 1.0;
+  c.T(at("right_finger"), 2) = -1.0;
+  c.o(at("right_finger")) = 0.1;
+  c.T(at("camera_tilt"), 1) = 0.5;
+  return c;
+}
+
+/// A random state of the coupled robot and the same state of the free one.
+void randomStates(std::mt19937& rng, const Coupling& c, State& coupled, State& free) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  coupled.world_T_base = free.world_T_base =
+      KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+  for (int j = 0; j < 3; ++j) coupled.q(j) = u(rng);
+  free.q.data = c.T * coupled.q.data + c.o;
+}
+
 TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
   const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
   const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
   ASSERT_EQ(coupled->jointNames(), (std::vector<std::string>{"shoulder", "elbow", "left_finger"}));
   ASSERT_EQ(free->nj(), 5u);
-  // T: free joint value = T * coupled coordinates + o (written out from the <mimic> elements).
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(5, 3);
-  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
-  const auto at = [&](const std::string& name) { return free->jointIndex(name); };
-  T(at("shoulder"), 0) = 1.0;
-  T(at("elbow"), 1) = 1.0;
-  T(at("left_finger"), 2) = 1.0;
-  T(at("right_finger"), 2) = -1.0;
-  o(at("right_finger")) = 0.1;
-  T(at("camera_tilt"), 1) = 0.5;
-
+  const Coupling c = handCoupling(*free);
+  const Eigen::MatrixXd& T = c.T;
   FreeFloatingSolver a(coupled), b(free);
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 5; ++trial) {
     State sa(*coupled), sb(*free);
-    sa.world_T_base = sb.world_T_base =
-        KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
-    for (int j = 0; j < 3; ++j) sa.q(j) = u(rng);
-    sb.q.data = T * sa.q.data + o;
+    randomStates(rng, c, sa, sb);
     ASSERT_EQ(a.compute(sa), 0);
     ASSERT_EQ(b.compute(sb), 0);
     const Eigen::MatrixXd H_star = T.transpose() * b.H_star().data * T;
@@ -124,16 +139,10 @@ TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
   // at the coupled state: q = T q_c + o, qdot = T qdot_c), T = diag(E_6, T_joints).
   const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
   const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(11, 9);
+  const Coupling c = handCoupling(*free);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(11, 9);  // the base's six coordinates, then the joints'
   T.topLeftCorner<6, 6>().setIdentity();
-  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
-  const auto at = [&](const std::string& name) { return 6 + free->jointIndex(name); };
-  T(at("shoulder"), 6) = 1.0;
-  T(at("elbow"), 7) = 1.0;
-  T(at("left_finger"), 8) = 1.0;
-  T(at("right_finger"), 8) = -1.0;
-  o(at("right_finger") - 6) = 0.1;
-  T(at("camera_tilt"), 7) = 0.5;
+  T.bottomRightCorner(5, 3) = c.T;
   DenseForwardDynamics a(coupled), b(free);
   ASSERT_EQ(a.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
   ASSERT_EQ(b.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
@@ -141,10 +150,7 @@ TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 5; ++trial) {
     State sa(*coupled), sb(*free);
-    sa.world_T_base = sb.world_T_base =
-        KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
-    for (int j = 0; j < 3; ++j) sa.q(j) = u(rng);
-    sb.q.data = T.bottomRightCorner(5, 3) * sa.q.data + o;
+    randomStates(rng, c, sa, sb);
     FloatingVelocity va{KDL::Twist(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng))),
                         KDL::JntArray(3)};
     for (int j = 0; j < 3; ++j) va.qdot(j) = u(rng);

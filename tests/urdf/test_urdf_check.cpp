@@ -268,3 +268,39 @@ TEST(UrdfCheck, AgreesWithTheLoaderOnRandomDamage) {
 
 }  // namespace
 }  // namespace kdl_space::test
+
+namespace kdl_space {
+namespace {
+
+TEST(UrdfCheckMassRatio, SaysWhenTheLightLinkHangsOnAFixedJoint) {
+  // A 1e7 kg station, a 2 kg arm link, a 1 g sensor fixed to it: the lightest link that moves
+  // is the sensor, on a fixed joint; the words say so. Without the sensor: the arm link, moving.
+  const auto robot = [](bool sensor) {
+    const auto inertial = [](const std::string& m, const std::string& i) {
+      return "<inertial><mass value=\"" + m + "\"/><inertia ixx=\"" + i + "\" iyy=\"" + i + "\" izz=\"" + i +
+             "\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+    };
+    std::string xml = "<robot name=\"r\"><link name=\"station\">" + inertial("1e7", "1e8") +
+                      "</link><joint name=\"j\" type=\"continuous\"><parent link=\"station\"/><child link=\"arm\"/>"
+                      "<axis xyz=\"0 0 1\"/></joint><link name=\"arm\">" + inertial("2", "0.1") + "</link>";
+    if (sensor)
+      xml += "<joint name=\"mount\" type=\"fixed\"><parent link=\"arm\"/><child link=\"sensor\"/></joint>"
+             "<link name=\"sensor\">" + inertial("0.001", "1e-7") + "</link>";
+    return xml + "</robot>";
+  };
+  const auto ratioWarning = [](const UrdfReport& r) {
+    for (const Finding& f : r.warnings)
+      if (f.kind == "mass_ratio") return f;
+    return Finding{};
+  };
+  const Finding with = ratioWarning(checkUrdfString(robot(true)));
+  EXPECT_EQ(with.element, "sensor");
+  EXPECT_NE(with.message.find("times heavier than this link on a fixed joint (it moves with its parent) (0.001 kg)"),
+            std::string::npos) << with.message;
+  const Finding without = ratioWarning(checkUrdfString(robot(false)));
+  EXPECT_EQ(without.element, "arm");
+  EXPECT_NE(without.message.find("times heavier than this moving link (2 kg)"), std::string::npos) << without.message;
+}
+
+}  // namespace
+}  // namespace kdl_space
