@@ -112,7 +112,9 @@ void checkRootInertia(const std::string& root, bool has_inertial, Findings& out)
 }
 
 bool dropsRootJoint(bool root_massless, std::size_t root_child_joints, const std::string& child_joint_type) {
-  return root_massless && root_child_joints == 1 && child_joint_type == "floating";
+  // A mobile base's planar joint from the world is dropped as a floating one: in orbit the base
+  // floats in all six directions.
+  return root_massless && root_child_joints == 1 && (child_joint_type == "floating" || child_joint_type == "planar");
 }
 
 void checkJointType(const std::string& joint, const std::string& type, Findings& out) {
@@ -123,6 +125,9 @@ void checkJointType(const std::string& joint, const std::string& type, Findings&
   if (type == "floating")
     message += "; a floating joint is accepted only from a massless root link (such as 'world') to "
                "its only child, the base";
+  else
+    message += "; a planar joint is accepted only from a massless root link (such as 'world') to its only "
+               "child, the base, which then floats";
   out.push_back(error("free_joint_inside", ElementType::Joint, joint, message));
 }
 

@@ -53,8 +53,9 @@ Eigen::Matrix3d withoutNegativeMoments(const Eigen::Matrix3d& I);
 /// an <inertial> (kdl_space keeps it; tools built on kdl_parser alone would not).
 void checkRootInertia(const std::string& root, bool has_inertial, Findings& out);
 
-/// \brief True when the root's joint to its only child is dropped: a `floating` joint from a
-/// massless root (such as "world"), whose child then is the free-floating base.
+/// \brief True when the root's joint to its only child is dropped: a `floating` or `planar`
+/// joint (a mobile base's) from a massless root (such as "world"), whose child then is the
+/// free-floating base.
 bool dropsRootJoint(bool root_massless, std::size_t root_child_joints, const std::string& child_joint_type);
 
 /// \brief Joint types (URDF names): `free_joint_inside` for a floating or planar joint (other

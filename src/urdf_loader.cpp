@@ -132,7 +132,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
     const urdf::JointSharedPtr& free_joint = root->child_joints[0];
     dropped_joint = free_joint->name;
     diagnostics.push_back(
-        {free_joint->name, "floating joint from the massless root " + detail::quoted(root->name) +
+        {free_joint->name, typeName(*free_joint) + " joint from the massless root " + detail::quoted(root->name) +
                                " dropped: link " + detail::quoted(free_joint->child_link_name) +
                                " is the free-floating base",
          "floating_root_joint_dropped", Severity::Note});

@@ -140,7 +140,8 @@ const std::vector<Case>& cases() {
          "child link 'camera' does not exist: add <link name=\"camera\"/>, or correct the name"},
         {"free_joint_inside", "joint", "slider",
          "a planar joint inside the tree is not supported (only the base floats; use revolute, continuous, "
-         "prismatic or fixed joints)"}},
+         "prismatic or fixed joints); a planar joint is accepted only from a massless root link (such as "
+         "'world') to its only child, the base, which then floats"}},
        {{"axis_not_unit", "joint", "elbow", "axis (0 2 0) is not unit length (norm 2): it is normalised"},
         {"triangle_inequality", "link", "forearm", kTriangle},
         {"limits_exclude_zero", "joint", "wrist",

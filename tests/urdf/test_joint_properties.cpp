@@ -113,5 +113,22 @@ TEST(JointProperties, UnexpandedXacroIsNamedAsSuch) {
   EXPECT_NO_THROW(loadUrdfString(expanded));
 }
 
+TEST(JointProperties, AMobileBasesPlanarJointFromTheWorldIsDropped) {
+  // A mobile manipulator's description: world -planar-> base_footprint. In orbit its base floats.
+  std::string xml = arm("", "continuous", "");
+  xml.replace(xml.find("<link name=\"base\">"), 0,
+              R"(<link name="world"/><joint name="world_to_base" type="planar"><parent link="world"/>)"
+              R"(<child link="base"/><axis xyz="0 0 1"/></joint>)");
+  const FloatingModel model = loadUrdfString(xml, "mobile.urdf");
+  EXPECT_EQ(model.bodies()[0].name, "base");
+  EXPECT_EQ(model.nj(), 2u);
+  bool said = false;
+  for (const Diagnostic& d : model.diagnostics())
+    said |= d.element == "world_to_base" && d.message.rfind("planar joint from the massless root 'world' dropped", 0) == 0;
+  EXPECT_TRUE(said);
+  EXPECT_TRUE(checkUrdfString(xml, "mobile.urdf").errors.empty());
+  EXPECT_EQ(checkUrdfString(xml, "mobile.urdf").model.base, "base");
+}
+
 }  // namespace
 }  // namespace kdl_space
