@@ -6,7 +6,6 @@
 #include "kdl_space/errors.hpp"
 #include "kdl_space/spatial.hpp"
 #include "detail/text.hpp"
-#include "model_build.hpp"
 
 namespace kdl_space {
 namespace detail {
@@ -34,10 +33,9 @@ namespace {
 [[noreturn]] void fail(const std::string& what, const std::string& name, const std::string& message) {
   throw ModelError(what + " " + detail::quoted(name) + ": " + message);
 }
-}  // namespace
 
-namespace {
-std::string tree_joint_name(const std::map<std::string, unsigned int>& q_nr, unsigned int t) {
+/// The name of the tree's joint number t.
+std::string treeJointName(const std::map<std::string, unsigned int>& q_nr, unsigned int t) {
   for (const auto& [name, nr] : q_nr)
     if (nr == t) return name;
   return "?";
@@ -79,7 +77,7 @@ void FloatingModel::build(const KDL::RigidBodyInertia& base_inertia, const std::
   for (unsigned int t = 0; t < n_tree; ++t) {
     Follow f{static_cast<int>(t), 1.0, 0.0};
     for (unsigned int steps = 0; follow[f.leader].leader >= 0; ++steps) {
-      if (steps > n_tree) fail("joint", tree_joint_name(q_nr, t), "its <mimic> joints form a cycle: none is a coordinate");
+      if (steps > n_tree) fail("joint", treeJointName(q_nr, t), "its <mimic> joints form a cycle: none is a coordinate");
       const Follow& next = follow[f.leader];
       f = {next.leader, f.multiplier * next.multiplier, f.multiplier * next.offset + f.offset};
     }

@@ -200,6 +200,19 @@ TEST(Mimic, TheMotionOfACoupledRobotKeepsItsEnergyAndMomentum) {
   EXPECT_GT((s.state.q.data).norm(), 0.1);  // it moved
 }
 
+TEST(Mimic, JointsThatFollowEachOtherAreRefused) {
+  // left_finger follows right_finger, which follows left_finger: no coordinate moves them.
+  std::string xml = gripper(true);
+  const std::string left = R"(<joint name="left_finger" type="revolute">)";
+  xml.insert(xml.find("</joint>", xml.find(left)), R"(<mimic joint="right_finger"/>)");
+  try {
+    loadUrdfString(xml, "cycle.urdf");
+    ADD_FAILURE() << "a cycle of mimic joints loaded";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("its <mimic> joints form a cycle"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
   std::string xml = gripper(true);
   xml.replace(xml.find(R"(mimic joint="elbow")"), 19, R"(mimic joint="elbo")");
