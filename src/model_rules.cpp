@@ -182,6 +182,26 @@ void checkMimic(const std::string& joint, const std::string& leader, bool leader
                          "): not a coordinate"));
 }
 
+void checkMimicCycles(const std::vector<std::pair<std::string, std::string>>& follows, Findings& out) {
+  const auto leaderOf = [&follows](const std::string& joint) -> const std::string* {
+    for (const auto& [follower, leader] : follows)
+      if (follower == joint) return &leader;
+    return nullptr;
+  };
+  for (const auto& [joint, first] : follows) {
+    const std::string* at = &first;
+    for (std::size_t steps = 0; at && steps <= follows.size(); ++steps) {
+      if (*at == joint) {
+        out.push_back(error("bad_mimic", ElementType::Joint, joint,
+                            "its <mimic> joints form a cycle: none is a coordinate; let one of them "
+                            "follow no other"));
+        break;
+      }
+      at = leaderOf(*at);
+    }
+  }
+}
+
 std::vector<int> composite(const std::vector<MassNode>& nodes, int head) {
   std::vector<int> members{head};
   std::vector<bool> in(nodes.size(), false);

@@ -82,6 +82,10 @@ void checkRevoluteWithoutLimit(const std::string& joint, Findings& out);
 void checkMimic(const std::string& joint, const std::string& leader, bool leader_movable, double multiplier,
                 double offset, Findings& out);
 
+/// \brief Error `bad_mimic` on a joint whose <mimic> chain (joint -> leader -> its leader ...)
+/// comes back to itself: none of them is a coordinate. `follows` maps a mimic joint to its leader.
+void checkMimicCycles(const std::vector<std::pair<std::string, std::string>>& follows, Findings& out);
+
 /// One link of a tree for the mass rules below; node 0 is the base, parents precede children.
 struct MassNode {
   std::string link;

@@ -162,6 +162,10 @@ void Checker::checkTree() {
       leader_movable |= other.name == joint.mimic_leader && other.known_type && rules::isMovable(other.type);
     rules::checkMimic(joint.name, joint.mimic_leader, leader_movable, joint.mimic_multiplier, joint.mimic_offset, found);
   }
+  std::vector<std::pair<std::string, std::string>> follows;
+  for (const detail::XmlJoint& joint : doc_.joints)
+    if (joint.has_mimic) follows.emplace_back(joint.name, joint.mimic_leader);
+  rules::checkMimicCycles(follows, found);
   if (base_ >= 0) {
     const detail::XmlLink& base = doc_.links[base_];
     if (base_ == root_) rules::checkRootInertia(base.name, base.has_inertial, found);

@@ -156,6 +156,9 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
     if ((type == "revolute" || type == "prismatic") && joint->limits)
       rules::checkLimits(name, joint->limits->lower, joint->limits->upper, findings);
   }
+  std::vector<std::pair<std::string, std::string>> follows;
+  for (const Mimic& m : mimic) follows.emplace_back(m.joint, m.leader);
+  rules::checkMimicCycles(follows, findings);
   if (base == root) rules::checkRootInertia(root->name, root->inertial != nullptr, findings);
   // Below the base, breadth first: the problem nearest the base, a link reached twice (its joints
   // close a loop) or the first link too deep.

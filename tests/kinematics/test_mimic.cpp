@@ -13,6 +13,7 @@
 #include "kdl_space/free_floating_solver.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
+#include "kdl_space/urdf_check.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 namespace kdl_space {
@@ -211,6 +212,15 @@ TEST(Mimic, JointsThatFollowEachOtherAreRefused) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("its <mimic> joints form a cycle"), std::string::npos) << e.what();
   }
+  // check says so too, for each joint of the cycle (one set of rules).
+  const UrdfReport report = checkUrdfString(xml, "cycle.urdf");
+  ASSERT_EQ(report.errors.size(), 2u);
+  for (const Finding& f : report.errors) EXPECT_EQ(f.kind, "bad_mimic");
+  try {
+    loadUrdfString(xml, "cycle.urdf");
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), "cycle.urdf: " + describe(report.errors[0]));
+  }
 }
 
 TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
@@ -222,6 +232,10 @@ TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("joint 'camera_tilt': mimics 'elbo', which is no movable joint"),
               std::string::npos) << e.what();
+    const UrdfReport report = checkUrdfString(xml, "bad.urdf");
+    ASSERT_EQ(report.errors.size(), 1u);
+    EXPECT_EQ(report.errors[0].kind, "bad_mimic");
+    EXPECT_EQ(std::string(e.what()), "bad.urdf: " + describe(report.errors[0]));
   }
 }
 
