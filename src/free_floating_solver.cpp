@@ -13,7 +13,6 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   state_ = State(*model_);
   I_c_.resize(nb);
   I_body_.resize(nb);
-  S_.resize(n);
   Sb_.assign(nb, Vector6d::Zero());
   A_m_.setZero(6, n);
   Am_work_.setZero(6, n);
@@ -59,7 +58,6 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
   // coordinate that moves several joints (mimic) sums their terms (H = T^T H_joints T).
   for (std::size_t b = 1; b < bodies.size(); ++b)
     if (bodies[b].joint >= 0) Sb_[b] = shiftTwist(kin.S[b], r_g_ - kin.p_b);
-  for (unsigned int j = 0; j < n; ++j) S_[j] = Sb_[model_->jointBody()[j]];
   A_m_.setZero();
   for (std::size_t b = 1; b < bodies.size(); ++b) {
     const int j = bodies[b].joint;

@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <map>
+#include <set>
 #include <cmath>
 
 #include "kdl_space/errors.hpp"
@@ -22,9 +23,7 @@ struct ReadLink {
   rules::MassNode node;
 };
 
-[[noreturn]] void fail(const std::string& what, const std::string& name, const std::string& message) {
-  throw ModelError(what + " " + detail::quoted(name) + ": " + message);
-}
+using detail::fail;
 
 std::vector<ReadLink> readLinks(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
                                 const std::vector<double>& armature) {
@@ -94,13 +93,15 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   rules::checkMassDistribution(nodes, findings);
   if (const Finding* e = rules::firstError(findings)) throw ModelError(describe(*e));
   // What the dynamics read: a joint that moves no mass is fixed, round-off below zero is zero.
+  std::set<std::string> moves_no_mass;
+  for (const Finding& f : findings)
+    if (f.kind == "joint_moves_no_mass") {
+      moves_no_mass.insert(f.element);
+      fixed_joints_.push_back({f.element, f.message});
+    }
   std::vector<bool> fixed(links.size(), false), corrected(links.size(), false);
   for (std::size_t i = 0; i < links.size(); ++i) {
-    for (const Finding& f : findings)
-      if (f.kind == "joint_moves_no_mass" && i > 0 && f.element == links[i].node.joint && links[i].node.movable) {
-        fixed[i] = true;
-        fixed_joints_.push_back({f.element, f.message});
-      }
+    fixed[i] = links[i].node.movable && moves_no_mass.count(links[i].node.joint) > 0;
     const Matrix3d I = rules::withoutNegativeMoments(links[i].body.I_com);
     corrected[i] = I != links[i].body.I_com;
     links[i].body.I_com = I;
@@ -109,17 +110,11 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   const bool rebuild = std::find(fixed.begin(), fixed.end(), true) != fixed.end() ||
                        std::find(corrected.begin() + 1, corrected.end(), true) != corrected.end();
   tree_ = rebuild ? rebuiltTree(links, fixed, corrected) : tree;
-  if (rebuild && !armature.empty()) {  // the coordinates' armature, by joint name
-    std::vector<double> kept;
-    for (std::size_t i = 1; i < links.size(); ++i)
-      if (links[i].node.movable && !fixed[i]) kept.push_back(links[i].node.armature);
+  if (rebuild && !armature.empty()) {  // the coordinates' armature, by joint name (the numbering changed)
     armature.assign(tree_.getNrOfJoints(), 0.0);
-    std::size_t k = 0;
     for (std::size_t i = 1; i < links.size(); ++i)
-      if (links[i].node.movable && !fixed[i]) {
-        const KDL::SegmentMap::const_iterator e = tree_.getSegment(links[i].body.name);
-        armature[GetTreeElementQNr(e->second)] = kept[k++];
-      }
+      if (links[i].node.movable && !fixed[i])
+        armature[GetTreeElementQNr(tree_.getSegment(links[i].body.name)->second)] = links[i].node.armature;
   }
   // A mimic joint made fixed (it moves no mass) follows nothing.
   mimic_.erase(std::remove_if(mimic_.begin(), mimic_.end(),

@@ -27,12 +27,14 @@ KDL::RigidBodyInertia kdlInertia(const Body& b) {
                                KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
 }
 
+void fail(const std::string& what, const std::string& name, const std::string& message) {
+  throw ModelError(what + " " + quoted(name) + ": " + message);
+}
+
 }  // namespace detail
 
 namespace {
-[[noreturn]] void fail(const std::string& what, const std::string& name, const std::string& message) {
-  throw ModelError(what + " " + detail::quoted(name) + ": " + message);
-}
+using detail::fail;
 
 /// The name of the tree's joint number t.
 std::string treeJointName(const std::map<std::string, unsigned int>& q_nr, unsigned int t) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <iomanip>
 #include <sstream>
 
@@ -107,21 +108,18 @@ std::string modelNote(const ModelSummary& m, bool tips_requested) {
 /// large robot) in one line that names the first few (--json lists each).
 void printNotes(std::ostream& out, const UrdfReport& report) {
   constexpr std::size_t kNotesOfAKind = 3;
-  std::vector<std::string> done;
+  std::map<std::string, std::vector<const Finding*>> by_kind;
+  for (const Finding& f : report.notes) by_kind[f.kind].push_back(&f);
   for (const Finding& f : report.notes) {
-    std::vector<const Finding*> same;
-    for (const Finding& g : report.notes)
-      if (g.kind == f.kind) same.push_back(&g);
+    const std::vector<const Finding*>& same = by_kind[f.kind];
     if (same.size() <= kNotesOfAKind) {
       out << report.source << ": note: " << describe(f) << "\n";
-      continue;
+    } else if (same.front() == &f) {  // the kind's line, where its first note stands
+      std::ostringstream names;
+      for (std::size_t k = 0; k < kNotesOfAKind; ++k) names << (k ? ", '" : "'") << same[k]->element << "'";
+      out << report.source << ": note: " << same.size() << " notes " << f.kind << " (" << names.str() << " and "
+          << same.size() - kNotesOfAKind << " more; each in --json), e.g. " << describe(f) << "\n";
     }
-    if (std::find(done.begin(), done.end(), f.kind) != done.end()) continue;
-    done.push_back(f.kind);
-    std::ostringstream names;
-    for (std::size_t i = 0; i < same.size() && i < kNotesOfAKind; ++i) names << (i ? ", '" : "'") << same[i]->element << "'";
-    out << report.source << ": note: " << same.size() << " notes " << f.kind << " (" << names.str() << " and "
-        << same.size() - kNotesOfAKind << " more; each in --json), e.g. " << describe(f) << "\n";
   }
 }
 

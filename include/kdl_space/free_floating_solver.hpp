@@ -74,7 +74,7 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   /// World pose of body i (model().bodies() order).
   const KDL::Frame& bodyPose(int i) const { return world_T_body_[i]; }
   /// Unit twist of joint j (model order), world frame, at the point r_g.
-  const Vector6d& S(int j) const { return S_[j]; }
+  const Vector6d& S(int j) const { return Sb_[model_->jointBody()[j]]; }
   /// The twist of body i's joint per unit rate of its coordinate (a mimic joint's multiplier
   /// included; zero for a fixed joint and the base), world frame, at r_g.
   const Vector6d& bodyJointTwist(int i) const { return Sb_[i]; }
@@ -149,7 +149,6 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   KDL::Frame world_T_base_;
   State state_;                           ///< copy of the last computed state
   std::vector<KDL::Frame> world_T_body_;  ///< per body
-  std::vector<Vector6d> S_;               ///< per joint: unit joint twist at r_g, world (its leader body's)
   std::vector<Vector6d> Sb_;              ///< per body: its joint's twist per coordinate rate at r_g
   std::vector<Matrix6d> I_body_;          ///< per body: its spatial inertia about r_g
   std::vector<Matrix6d> I_c_;             ///< per body: composite spatial inertia about r_g
