@@ -210,18 +210,10 @@ std::shared_ptr<const FloatingModel> loadTwin(const LoadCase& c) {
 
 // --- The independent route ---------------------------------------------------------------------
 
-/// Copies the segments below `from` (of any tree) below `hook` in `target`, as they are.
-void copySubtree(KDL::SegmentMap::const_iterator from, const std::string& hook, KDL::Tree& target) {
-  for (const auto& child : GetTreeElementChildren(from->second)) {
-    ASSERT_TRUE(target.addSegment(GetTreeElementSegment(child->second), hook)) << child->first;
-    copySubtree(child, child->first, target);
-  }
-}
-
 /// \brief The independent route (virtual_joint_route.hpp) for one model, at one state at a time,
 /// by link name. The route reads the model's KDL tree; what it cannot take as it is is handed to
 /// it rewritten as the same robot: joints the model does not move but its tree still does (fixed
-/// at 0), and a base link named "world", the name of the route's own root segment (renamed).
+/// at 0). (A base link named "world" needs nothing: the route's root has a name of its own.)
 class Route {
  public:
   explicit Route(const std::shared_ptr<const FloatingModel>& model) : model_(model), route_model_(model) {
@@ -231,15 +223,6 @@ class Route {
       std::map<std::string, double> at_zero;
       for (const FixedJoint& f : model->fixedJoints()) at_zero[f.joint] = 0.0;
       tree = lockJoints(tree, at_zero);
-      rewritten = true;
-    }
-    const std::string root = tree.getRootSegment()->first;
-    if (root == "world") {
-      renamed_from_ = root;
-      renamed_to_ = "world_as_the_models_base";
-      KDL::Tree renamed(renamed_to_);
-      copySubtree(tree.getRootSegment(), renamed_to_, renamed);
-      tree = renamed;
       rewritten = true;
     }
     if (rewritten) route_model_ = std::make_shared<const FloatingModel>(tree, baseInertia(*model));
@@ -257,14 +240,12 @@ class Route {
       s.q(j) = state.q(model_->jointIndex(route_model_->jointNames()[j]));
     tree_ = std::make_unique<VirtualJointTree>(*route_model_, s);
   }
-  Eigen::MatrixXd G(const LinkPoint& p) const { return tree_->G(LinkPoint{link(p.link), p.offset}); }
-  KDL::Frame pose(const std::string& name) const { return tree_->pose(link(name)); }
+  Eigen::MatrixXd G(const LinkPoint& p) const { return tree_->G(p); }
+  KDL::Frame pose(const std::string& name) const { return tree_->pose(name); }
 
  private:
-  std::string link(const std::string& name) const { return name == renamed_from_ ? renamed_to_ : name; }
 
   std::shared_ptr<const FloatingModel> model_, route_model_;
-  std::string renamed_from_, renamed_to_;
   std::unique_ptr<VirtualJointTree> tree_;
 };
 
