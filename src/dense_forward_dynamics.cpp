@@ -64,6 +64,7 @@ int DenseForwardDynamics::solve(const Vector3d& p_b, const FloatingVelocity& vel
   const unsigned int n = model().nj();
   const FreeFloatingSolver& k = solver_;
   const Vector3d& P = k.r_g();  // the fixed point of this instant
+  if (grounded_ && toEigen(velocity.base_twist) != Vector6d::Zero()) return E_BAD_ARGUMENT;
 
   // Newton-Euler with zero accelerations: velocity products, gravity, external wrenches.
   for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -103,13 +104,16 @@ int DenseForwardDynamics::solve(const Vector3d& p_b, const FloatingVelocity& vel
   M_.bottomRightCorner(n, n) = k.H().data;
   rhs_.head<6>() = -c_.head<6>();
   rhs_.tail(n) = tau.data - c_.tail(n);
-  for (unsigned int j = 0; j < n; ++j) {
-    if (!locked_[j]) continue;
-    M_.row(6 + j).setZero();
-    M_.col(6 + j).setZero();
-    M_(6 + j, 6 + j) = 1.0;
-    rhs_(6 + j) = 0.0;
-  }
+  const auto hold = [&](Eigen::Index k) {
+    M_.row(k).setZero();
+    M_.col(k).setZero();
+    M_(k, k) = 1.0;
+    rhs_(k) = 0.0;
+  };
+  for (unsigned int j = 0; j < n; ++j)
+    if (locked_[j]) hold(6 + j);
+  if (grounded_)  // the base's true acceleration is zero (gravity is in the bias)
+    for (Eigen::Index k = 0; k < 6; ++k) hold(k);
   M_llt_.compute(M_);
   if (M_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
   M_llt_.solveInPlace(rhs_);

@@ -84,6 +84,7 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
     return E_SIZE_MISMATCH;
   if (!kin.valid) return E_NOT_COMPUTED;
   if (!velocity.qdot.data.allFinite() || !tau.data.allFinite() || !allFinite(velocity.base_twist)) return E_NOT_FINITE;
+  if (grounded_ && toEigen(velocity.base_twist) != Vector6d::Zero()) return E_BAD_ARGUMENT;
   for (const KDL::Wrench& f : f_ext)
     if (!allFinite(f.force) || !allFinite(f.torque)) return E_NOT_FINITE;
   const Vector3d& p_b = kin.p_b;  // the reference point of every spatial quantity
@@ -148,10 +149,11 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
     parent.pA += b.pA + b.U * (b.u * b.D_inv);
   }
 
-  // 3. Outward: the base's acceleration I^A_0 A_0 = -p^A_0 (the floating base, ch. 9), then the
-  // joints'.
+  // 3. Outward: the base's acceleration I^A_0 A_0 = -p^A_0 (the floating base, ch. 9; a grounded
+  // base's is that of the frame, -g), then the joints'.
   Vector6d A0;
-  if (!data_[0].IA.solve(-data_[0].pA, A0)) return E_NOT_POSITIVE_DEFINITE;
+  if (grounded_) A0 << -gravity_, Vector3d::Zero();
+  else if (!data_[0].IA.solve(-data_[0].pA, A0)) return E_NOT_POSITIVE_DEFINITE;
   data_[0].a = A0;
   for (std::size_t i = 1; i < nb; ++i) {
     BodyData& b = data_[i];

@@ -29,6 +29,9 @@ class KDL_SPACE_EXPORT DenseForwardDynamics {
   const FloatingModel& model() const { return solver_.model(); }
   int setGravity(const Vector3d& g);
   int setLocked(const std::vector<bool>& locked);
+  /// A grounded base: the base rows and columns replaced by the identity, its acceleration zero
+  /// (as ForwardDynamicsSolver::setGrounded).
+  void setGrounded(bool grounded) { grounded_ = grounded; }
   int CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
   int CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
@@ -45,6 +48,7 @@ class KDL_SPACE_EXPORT DenseForwardDynamics {
   FreeFloatingSolver solver_;
   Vector3d gravity_ = Vector3d::Zero();
   std::vector<bool> locked_;
+  bool grounded_ = false;
   std::vector<Vector6d> V_, A_, F_;  ///< per body: twist, spatial acceleration, force, at r_g
   Eigen::VectorXd c_, rhs_;
   Eigen::MatrixXd M_;

@@ -59,6 +59,11 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   /// Joints whose brakes are on (model order, size nj()). \return E_SIZE_MISMATCH or 0.
   int setLocked(const std::vector<bool>& locked);
   const std::vector<bool>& locked() const { return locked_; }
+  /// \brief A grounded base (held still, as on a test bed or a fixed-base arm): its acceleration
+  /// is zero and the joints follow the fixed-base dynamics H qddot = tau - c (eq. 22's H). The
+  /// base twist given to CartToJnt must then be zero (else E_BAD_ARGUMENT).
+  void setGrounded(bool grounded) { grounded_ = grounded; }
+  bool grounded() const { return grounded_; }
 
   /// \brief Accelerations at the state of `kin` (forwardKinematics of this model) from the
   /// velocity, joint torques tau (model order) and external wrenches f_ext (one per body in
@@ -66,8 +71,9 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   /// No reference to `kin` is kept.
   /// \return 0, E_SIZE_MISMATCH (kin of another model, qdot, tau, acceleration.qddot, a non-empty
   /// f_ext of another size than bodies()), E_NOT_COMPUTED (kin not valid), E_NOT_FINITE (an
-  /// input, or accelerations that overflow) or E_NOT_POSITIVE_DEFINITE (an articulated inertia
-  /// that is not); `acceleration` is untouched on an error.
+  /// input, or accelerations that overflow), E_NOT_POSITIVE_DEFINITE (an articulated inertia
+  /// that is not) or E_BAD_ARGUMENT (a grounded base given a twist); `acceleration` is untouched
+  /// on an error.
   int CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration);
   /// \brief The same from a state: forwardKinematics into the solver's own Kinematics, then the
@@ -83,6 +89,7 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   std::shared_ptr<const FloatingModel> model_;
   Vector3d gravity_ = Vector3d::Zero();
   std::vector<bool> locked_;
+  bool grounded_ = false;
   Kinematics own_;                 ///< for CartToJnt(State) only
   std::vector<BodyData> data_;     ///< per body
   Eigen::VectorXd qddot_;          ///< joint accelerations before they are returned (n)

@@ -1,0 +1,24 @@
+// Private to the simulator: where each part of the integrated state lies in its vector, and the
+// forward dynamics it runs.
+#pragma once
+
+#include <variant>
+
+#include "kdl_space/dense_forward_dynamics.hpp"
+#include "kdl_space/forward_dynamics.hpp"
+
+namespace kdl_space::detail {
+
+/// x = (p_b (3), quaternion x y z w (4), q (n), h_O = (P; L about the origin) (6), qdot (n),
+/// work (6: EnergySplit's order), external impulse (6)).
+struct StateLayout {
+  explicit StateLayout(unsigned int joints)
+      : n(static_cast<int>(joints)), q(7), h(7 + n), qdot(13 + n), work(13 + 2 * n), impulse(19 + 2 * n),
+        size(25 + 2 * n) {}
+  int n, q, h, qdot, work, impulse, size;
+};
+
+/// The articulated-body recursion; the dense route for a model with mimic joints.
+using Dynamics = std::variant<ForwardDynamicsSolver, DenseForwardDynamics>;
+
+}  // namespace kdl_space::detail
