@@ -8,6 +8,7 @@
 #include "kdl_space/urdf_loader.hpp"
 #include "model_rules.hpp"
 #include "scenario_fields.hpp"
+#include "scenario_sections.hpp"
 
 namespace kdl_space {
 namespace {
@@ -149,69 +150,6 @@ ImpactLaw law(const Field& f, bool& has_normal) {
   return l;
 }
 
-/// One joint's control in the simulation section: free, locked or {pd: {kp, kd, set_point}}.
-JointControl jointControl(const Field& j) {
-  JointControl c;
-  if (j.isScalar()) {
-    const std::string mode = j.text();
-    if (mode == "free") c.mode = JointControl::Mode::Free;
-    else if (mode == "locked") c.mode = JointControl::Mode::Locked;
-    else j.fail(echo(mode) + " is not one of free, locked, {pd: {kp, kd, set_point}}");
-    return c;
-  }
-  j.onlyKeys({"pd"});
-  const Field pd = j.at("pd");
-  pd.onlyKeys({"kp", "kd", "set_point"});
-  c.mode = JointControl::Mode::PD;
-  c.kp = pd.at("kp").number();
-  c.kd = pd.at("kd").number();
-  c.set_point = pd.at("set_point").number();
-  if (c.kp < 0.0) pd.at("kp").fail("must be >= 0, got " + number(c.kp));
-  if (c.kd < 0.0) pd.at("kd").fail("must be >= 0, got " + number(c.kd));
-  return c;
-}
-
-SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
-  f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "max_steps", "gravity",
-              "joints"});
-  SimulationSpec s;
-  const auto positive = [&](const char* key, double& value) {
-    if (!f.has(key)) return;
-    value = f.at(key).number();
-    if (!(value > 0.0)) f.at(key).fail("must be > 0, got " + number(value));
-  };
-  positive("duration", s.duration);
-  positive("output_step", s.output_step);
-  positive("step", s.options.step);
-  positive("rtol", s.options.rtol);
-  positive("atol", s.options.atol);
-  positive("max_step", s.options.max_step);
-  if (f.has("max_steps")) {
-    const double budget = f.at("max_steps").number();
-    if (!(budget >= 1.0) || budget != std::floor(budget) || budget > 1e12)
-      f.at("max_steps").fail("must be a whole number of steps from 1 to 1e12, got " + number(budget));
-    s.options.max_steps = static_cast<long>(budget);
-  }
-  if (f.has("integrator")) {
-    const std::string name = f.at("integrator").text();
-    if (name == "rk4") s.options.integrator = Integrator::RK4;
-    else if (name == "dopri5") s.options.integrator = Integrator::DormandPrince54;
-    else f.at("integrator").fail(echo(name) + " is not one of rk4, dopri5");
-  }
-  if (f.has("gravity")) s.options.gravity = f.at("gravity").vector(3);
-  if (f.has("joints")) {
-    const Field joints = f.at("joints");
-    for (const std::string& name : joints.keys()) {
-      const Field j = joints.at(name);
-      const int index = robot.jointIndex(name);
-      if (index < 0)
-        j.fail("the robot has no movable joint " + echo(name) + " (its movable joints: " + listNames(robot.jointNames()) + ")");
-      s.joints.emplace_back(static_cast<unsigned int>(index), jointControl(j));
-    }
-  }
-  return s;
-}
-
 /// The file's YAML (or JSON, which YAML reads), or an InputError saying why not.
 YAML::Node parse(const std::string& file) {
   checkInputFile(file, "scenario file (YAML or JSON)");
@@ -235,16 +173,24 @@ Scenario loadScenario(const std::string& path) {
   s.file = path;
   const YAML::Node root = parse(path);
   const Field top(root, "", &s.file);
-  if (root.IsNull()) throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law");
-  if (!root.IsMap()) top.fail("a scenario is a mapping with robot, target and law, not " + fields::kindOf(root));
+  if (root.IsNull())
+    throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law (or robot and simulation)");
+  if (!root.IsMap())
+    top.fail("a scenario is a mapping with robot, target and law (or robot and simulation), not " + fields::kindOf(root));
   top.onlyKeys({"robot", "target", "law", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
   s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
-  const Field target = top.at("target");
-  if (target.has("urdf")) s.capture.target = system(target, folder, s.target_urdf);
-  else s.capture.target = rigidTarget(target);
-  s.capture.law = law(top.at("law"), s.capture.has_normal);
-  if (top.has("simulation")) s.simulation = simulation(top.at("simulation"), *s.capture.robot.model);
+  // A plain motion has neither target nor law; an impact needs both.
+  s.impact = top.has("target") || top.has("law");
+  if (s.impact) {
+    const Field target = top.at("target");
+    if (target.has("urdf")) s.capture.target = system(target, folder, s.target_urdf);
+    else s.capture.target = rigidTarget(target);
+    s.capture.law = law(top.at("law"), s.capture.has_normal);
+  } else if (!top.has("simulation")) {
+    top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
+  }
+  if (top.has("simulation")) s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model);
   return s;
 }
 

@@ -114,4 +114,23 @@ std::map<std::string, double> Field::namedNumbers() const {
   return values;
 }
 
+std::vector<Field> Field::items() const {
+  if (!node_.IsSequence()) fail("expected a list, got " + kindOf(node_));
+  std::vector<Field> items;
+  for (std::size_t i = 0; i < node_.size(); ++i) items.push_back(child(node_[i], path_ + "[" + std::to_string(i) + "]"));
+  return items;
+}
+
+bool Field::flag() const {
+  const std::string t = text();
+  if (t == "true") return true;
+  if (t == "false") return false;
+  fail(echo(t) + " is not one of true, false");
+}
+
+Eigen::Vector3d Field::perAxis() const {
+  if (node_.IsSequence()) return vector(3);
+  return Eigen::Vector3d::Constant(number());
+}
+
 }  // namespace kdl_space::fields

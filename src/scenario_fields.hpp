@@ -46,9 +46,16 @@ class Field {
   Eigen::Matrix3d matrix3() const;
   /// A mapping NAME: finite number.
   std::map<std::string, double> namedNumbers() const;
+  /// The elements of a list (paths "PATH[i]").
+  std::vector<Field> items() const;
+  /// true or false.
+  bool flag() const;
+  /// A number, or a list of 3 (one value for three axes).
+  Eigen::Vector3d perAxis() const;
 
   const std::string& path() const { return path_; }
   bool isScalar() const { return node_.IsScalar(); }
+  bool isSequence() const { return node_.IsSequence(); }
 
  private:
   Field child(const YAML::Node& node, const std::string& path) const { return Field(node, path, file_); }

@@ -3,6 +3,7 @@
 // `kdl_space capture` and `simulate` read; a library user can build the same types in code.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,12 +14,20 @@
 
 namespace kdl_space {
 
-/// The `simulation` section: what happens after the impact.
+/// The `simulation` section: the motion (after the impact, or from the robot's initial state).
 struct SimulationSpec {
   double duration = 20.0;     ///< [s] (the tool's --duration overrides it)
   double output_step = 0.05;  ///< output row spacing [s]
-  SimulationOptions options;
-  std::vector<std::pair<unsigned int, JointControl>> joints;  ///< by joint index of the robot
+  SimulationOptions options;  ///< options.grounded: see `base`
+  /// `base: free | grounded`; unset: the robot's mode holds (grounded if it was grounded).
+  std::optional<bool> grounded;
+  /// By joint index of the robot, resolved from names and patterns ("*", "wrist_*"): exact names
+  /// win over patterns, later patterns over earlier ones, "*" is the default. Joints not listed
+  /// keep the mode of the robot (locked for `mode: locked` and `robot.locked`, else free).
+  std::vector<std::pair<unsigned int, JointControl>> joints;
+  std::vector<std::pair<unsigned int, LimitMode>> limits;  ///< resolved as `joints`; default warn
+  BaseControl base_control;
+  std::vector<ScheduledWrench> wrenches;
 };
 
 /// A scenario file, read and checked.
@@ -26,6 +35,8 @@ struct Scenario {
   std::string file;         ///< the path it was read from
   std::string robot_urdf;   ///< the robot's URDF (resolved path)
   std::string target_urdf;  ///< a free-floating target's URDF (resolved path); empty for a rigid target
+  /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot.
+  bool impact = true;
   CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
   SimulationSpec simulation;
 };

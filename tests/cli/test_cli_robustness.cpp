@@ -80,8 +80,8 @@ const std::vector<Broken>& corpus() {
       // Not a scenario at all.
       {"not_yaml.yaml", "{f}:3: not valid YAML or JSON: end of sequence flow not found", false},
       {"empty.yaml", "{f}: the file is empty; expected a scenario file (YAML or JSON)", false},
-      {"comments_only.yaml", "{f}: holds no data; a scenario is a mapping with robot, target and law", false},
-      {"top_level_list.yaml", "{f}:2: a scenario is a mapping with robot, target and law, not a list of 3", false},
+      {"comments_only.yaml", "{f}: holds no data; a scenario is a mapping with robot, target and law (or robot and simulation)", false},
+      {"top_level_list.yaml", "{f}:2: a scenario is a mapping with robot, target and law (or robot and simulation), not a list of 3", false},
       // Fields: missing, unknown, twice, without a value, of the wrong type.
       {"missing_robot.yaml", "{f}:2: robot: missing (a required field)", false},
       {"missing_target_mass.yaml", "{f}:10: target.mass: missing (a required field)", false},
@@ -243,7 +243,7 @@ TEST_F(HostileFiles, ScenarioFilesThatAreNoScenario) {
     std::string args, err;
   } cases[] = {
       {"capture " + bytes, "kdl_space: " + bytes +
-                               ":1: a scenario is a mapping with robot, target and law, not "
+                               ":1: a scenario is a mapping with robot, target and law (or robot and simulation), not "
                                "'????????????????????????????????????????...'\n"},
       {"simulate " + folder, "kdl_space: " + folder + ": is a folder, not a scenario file (YAML or JSON)\n"},
       {"capture /nonexistent/scenario.yaml", "kdl_space: /nonexistent/scenario.yaml: no such file\n"},
