@@ -60,7 +60,8 @@ class RosenbrockStepper {
   /// Evaluations of f since construction (n + 4 per complete step).
   long rhsEvaluations() const { return rhs_evaluations_; }
 
-  /// The Jacobian df/dx of the last step that reached it (zero before).
+  /// The Jacobian df/dx at the last step's (t, x) (zero before the first step; partly updated if f
+  /// failed while it was computed).
   const Eigen::MatrixXd& jacobian() const { return J_; }
 
   /// An estimate of the spectral radius of jacobian() (the rate of the fastest mode, 1/s) by a few
