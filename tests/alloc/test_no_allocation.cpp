@@ -20,6 +20,7 @@
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
 #include "kdl_space/urdf_loader.hpp"
+#include "detail/rosenbrock.hpp"
 #include "generated_chain.hpp"
 #include "test_util.hpp"
 
@@ -129,6 +130,36 @@ TEST(NoAllocation, TheCounterSeesAllocations) {
   EXPECT_GE(allocationsDuring([] { delete new int(3); }), 1);
   EXPECT_GE(allocationsDuring([] { KDL::JntArray q(7); }), 1);
   EXPECT_GE(allocationsDuring([] { void* volatile p = std::malloc(16); std::free(p); }), 1);
+}
+
+TEST(NoAllocation, RosenbrockStep) {
+  // The stiff integrator's step (Jacobian, LU of the iteration matrix, four stages) and its
+  // spectral radius estimate, at sizes below and above Eigen's blocked LU (a simulator state of a
+  // 7-joint arm has 27 numbers, of a 50-link chain 113).
+  for (int n : {1, 27, 113}) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n) - 5.0 * Eigen::MatrixXd::Identity(n, n);
+    // A nonlinear, non-autonomous f written without temporaries: dx = A x - x^3 / 10 + sin t.
+    const detail::RosenbrockStepper::Rhs f = [&A](double t, const Eigen::VectorXd& x, Eigen::VectorXd& dx) {
+      dx.noalias() = A * x;
+      dx.array() -= 0.1 * x.array().cube();
+      dx.array() += std::sin(t);
+      return 0;
+    };
+    detail::RosenbrockStepper stepper(n);
+    Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(n, -1.0, 1.0), x_new(n);
+    double error = 0.0, radius = 0.0;
+    ASSERT_EQ(stepper.step(f, 0.0, 0.01, x, x_new, error, 1e-6, 1e-9), E_NOERROR);  // warm-up
+    EXPECT_EQ(allocationsDuring([&] {
+                for (int k = 0; k < 3; ++k) {
+                  EXPECT_EQ(stepper.step(f, 0.01 * k, 0.01, x, x_new, error, 1e-6, 1e-9), E_NOERROR);
+                  x = x_new;  // same size: a copy, no allocation
+                }
+                radius = stepper.spectralRadiusEstimate();
+              }),
+              0)
+        << "n = " << n;
+    EXPECT_GT(radius, 0.0);
+  }
 }
 
 class EveryComputeCall : public ::testing::TestWithParam<std::string> {};
