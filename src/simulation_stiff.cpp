@@ -1,14 +1,26 @@
-// The simulator's stiff (Rosenbrock) step.
+// The simulator's stiff step: RODAS3 (detail/rosenbrock.hpp) on the same derivative as the
+// explicit methods.
+#include "detail/rosenbrock.hpp"
 #include "kdl_space/simulation.hpp"
+#include "simulation_layout.hpp"
 
 namespace kdl_space {
-namespace detail {
-class RosenbrockStepper {};
-}  // namespace detail
 
 void Simulator::StiffDeleter::operator()(detail::RosenbrockStepper* p) const { delete p; }
-void Simulator::makeStiffStepper() { throw ModelError("simulation: the Rosenbrock integrator is not built yet"); }
-double Simulator::stiffErrorExponent() const { return -1.0 / 3.0; }
-int Simulator::stepRosenbrock(double, double, const Vector&, double&, bool&) { return E_BAD_ARGUMENT; }
+
+void Simulator::makeStiffStepper() {
+  stiff_.reset(new detail::RosenbrockStepper(detail::StateLayout(model().nj()).size));
+}
+
+double Simulator::stiffErrorExponent() const { return -1.0 / (detail::RosenbrockStepper::embedded_order + 1); }
+
+int Simulator::stepRosenbrock(double t, double h, const Vector& x, double& error, bool& trial_failed) {
+  // A lambda holding only `this` is stored inside std::function: no allocation.
+  const int rc = stiff_->step([this](double s, const Vector& y, Vector& dy) { return derivative(s, y, dy); }, t, h, x,
+                              x_new_, error, options_.rtol, options_.atol);
+  // A stage (or a Jacobian column) where the dynamics are undefined: a smaller step may avoid it.
+  trial_failed = rc == E_NOT_FINITE || rc == E_NOT_POSITIVE_DEFINITE;
+  return rc;
+}
 
 }  // namespace kdl_space

@@ -119,6 +119,8 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
 
 void runCapture(const CaptureOptions& o, std::ostream& out) {
   const Scenario sc = loadScenario(o.scenario);
+  if (!sc.impact)
+    throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
   const CaptureResult result = inScenario(sc, [&] { return solveCapture(sc.capture); });
   if (o.json)
     out << captureJson(sc, result).dump(2) << "\n";

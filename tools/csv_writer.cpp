@@ -4,14 +4,18 @@
 
 namespace kdl_space::cli {
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints) : file_(path, "--csv") {
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control)
+    : file_(path, "--csv"), base_control_(base_control) {
   out_.open(file_.tmp());
   if (!out_) throw InputError("--csv " + path + ": cannot write in its folder");
   out_ << std::setprecision(17);
   out_ << "t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx,base_vy,base_vz,base_wx,base_wy,base_wz";
   for (const auto& j : joints) out_ << ",q_" << j;
   for (const auto& j : joints) out_ << ",qdot_" << j;
-  out_ << ",P_x,P_y,P_z,L_x,L_y,L_z,kinetic_energy\n";
+  out_ << ",P_x,P_y,P_z,L_x,L_y,L_z,kinetic_energy";
+  for (const auto& j : joints) out_ << ",tau_" << j;
+  if (base_control_) out_ << ",base_control_fx,base_control_fy,base_control_fz,base_control_nx,base_control_ny,base_control_nz";
+  out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity\n";
 }
 
 void CsvWriter::write(const Sample& s) {
@@ -22,7 +26,12 @@ void CsvWriter::write(const Sample& s) {
   for (Eigen::Index i = 0; i < s.q.size(); ++i) out_ << ',' << s.q(i);
   for (Eigen::Index i = 0; i < s.qd.size(); ++i) out_ << ',' << s.qd(i);
   for (int i = 0; i < 6; ++i) out_ << ',' << s.h(i);
-  out_ << ',' << s.T << '\n';
+  out_ << ',' << s.T;
+  for (Eigen::Index i = 0; i < s.tau.size(); ++i) out_ << ',' << s.tau(i);
+  if (base_control_)
+    for (int i = 0; i < 6; ++i) out_ << ',' << s.base_wrench(i);
+  for (int i = 0; i < 6; ++i) out_ << ',' << s.work(i);
+  out_ << '\n';
 }
 
 void CsvWriter::close() {

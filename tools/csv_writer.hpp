@@ -14,7 +14,8 @@ namespace kdl_space::cli {
 class CsvWriter {
  public:
   /// Opens the temporary file and writes the header; throws InputError if it cannot.
-  CsvWriter(const std::string& path, const std::vector<std::string>& joints);
+  /// `base_control`: the base control's wrench columns are written.
+  CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control);
   void write(const Sample& s);
   /// Flushes and closes the temporary file; throws InputError if a write failed.
   void close();
@@ -24,6 +25,7 @@ class CsvWriter {
  private:
   AtomicFile file_;
   std::ofstream out_;
+  bool base_control_;
 };
 
 }  // namespace kdl_space::cli

@@ -1,5 +1,6 @@
 #include "plot_writer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -47,19 +48,22 @@ std::string label(const std::string& text) {
 }  // namespace
 
 /// The gnuplot terminal for a plot file name; throws UsageError for another extension.
-std::string plotTerminal(const std::string& path) {
+std::string plotTerminal(const std::string& path, std::size_t panels) {
   const std::string ext = fs::path(path).extension().string();
-  if (ext == ".svg") return "svg size 1000,1100 dynamic font 'sans,11'";
-  if (ext == ".png") return "pngcairo size 1000,1100 font 'sans,10'";
+  const std::string height = std::to_string(std::max<std::size_t>(1100, 340 * panels));
+  if (ext == ".svg") return "svg size 1000," + height + " dynamic font 'sans,11'";
+  if (ext == ".png") return "pngcairo size 1000," + height + " font 'sans,10'";
   throw UsageError("--plot " + path + ": the file name must end in .svg or .png");
 }
 
 /// Base attitude, joint angles, momentum and energy error over time, drawn by gnuplot into
 /// out.tmp() (the caller commits it).
 void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
-               const std::string& title) {
+               const std::string& title, bool torques) {
   const std::string& path = out.path();
-  const std::string terminal = plotTerminal(path);
+  const std::size_t groups = std::max<std::size_t>(1, (joints.size() + kJointsPerPanel - 1) / kJointsPerPanel);
+  const std::size_t panels = 2 + groups * (torques ? 2 : 1);
+  const std::string terminal = plotTerminal(path, panels);
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp"), log(out.tmp() + ".log");
   {
     std::ofstream d(data.path());
@@ -69,12 +73,14 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     for (const Sample& s : samples) {
       double roll, pitch, yaw;
       KDL::Rotation::Quaternion(s.quat(0), s.quat(1), s.quat(2), s.quat(3)).GetRPY(roll, pitch, yaw);
-      const double dh = (s.h - s0.h).norm(), dT = std::abs(s.T - s0.T);
+      const double dh = (s.h - s0.h - s.impulse).norm(), dT = std::abs(s.T - s0.T - s.work.sum());
       d << s.t << ' ' << roll * 180 / M_PI << ' ' << pitch * 180 / M_PI << ' ' << yaw * 180 / M_PI;
       for (Eigen::Index j = 0; j < s.q.size(); ++j) d << ' ' << s.q(j);
       // Relative errors (absolute when the initial value is zero), floored for the log axis.
       d << ' ' << std::max(s0.h.norm() > 0 ? dh / h_scale : dh, 1e-17) << ' '
-        << std::max(s0.T > 0 ? dT / s0.T : dT, 1e-17) << '\n';
+        << std::max(s0.T > 0 ? dT / s0.T : dT, 1e-17);
+      for (Eigen::Index j = 0; j < s.tau.size(); ++j) d << ' ' << s.tau(j);
+      d << '\n';
     }
     d.close();
     if (!d) throw InputError("--plot " + path + ": cannot write the plot's data next to it");
@@ -82,20 +88,29 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
   {
     std::ofstream g(script.path());
     g << "set terminal " << terminal << "\nset output " << quotedPath(out.tmp()) << "\n"
-      << "set multiplot layout 3,1 title " << label(title) << "\n"
+      << "set multiplot layout " << panels << ",1 title " << label(title) << "\n"
       << "set grid\nset key outside right\nset xlabel 'time [s]'\n"
       << "set ylabel 'base attitude [deg]'\n"
       << "plot " << quotedPath(data.path()) << " using 1:2 with lines title 'roll', '' using 1:3 with lines title 'pitch', "
-      << "'' using 1:4 with lines title 'yaw'\n"
-      << "set ylabel 'joint position [rad or m]'\nplot ";
-    for (std::size_t j = 0; j < joints.size(); ++j)
-      g << (j ? ", " : "") << (j ? "''" : quotedPath(data.path())) << " using 1:" << 5 + j << " with lines title "
-        << label(joints[j]);
-    if (joints.empty()) g << "0 title 'no joints'";
+      << "'' using 1:4 with lines title 'yaw'\n";
+    // One panel per group of joints, columns from `first` on.
+    const auto jointPanels = [&](const std::string& ylabel, std::size_t first) {
+      for (std::size_t group = 0; group < groups; ++group) {
+        g << "set ylabel '" << ylabel << "'\nplot ";
+        const std::size_t begin = group * kJointsPerPanel, end = std::min(joints.size(), begin + kJointsPerPanel);
+        for (std::size_t j = begin; j < end; ++j)
+          g << (j > begin ? ", " : "") << quotedPath(data.path()) << " using 1:" << first + j << " with lines title "
+            << label(joints[j]);
+        if (joints.empty()) g << "0 title 'no joints'";
+        g << "\n";
+      }
+    };
+    jointPanels("joint position [rad or m]", 5);
     const std::size_t c = 5 + joints.size();
-    g << "\nset ylabel 'change since t = 0 (relative)'\nset logscale y\nset format y '10^{%L}'\n"
-      << "plot " << quotedPath(data.path()) << " using 1:" << c << " with lines title 'momentum |h - h_0|', '' using 1:"
-      << c + 1 << " with lines title 'kinetic energy |T - T_0|'\n"
+    if (torques) jointPanels("joint torque [N m or N]", c + 2);
+    g << "set ylabel 'change since t = 0 (relative)'\nset logscale y\nset format y '10^{%L}'\n"
+      << "plot " << quotedPath(data.path()) << " using 1:" << c << " with lines title 'momentum |h - h_0 - impulse|', '' using 1:"
+      << c + 1 << " with lines title 'energy |T - T_0 - work|'\n"
       << "unset multiplot\n";
     g.close();
     if (!g) throw InputError("--plot " + path + ": cannot write the plot's script next to it");

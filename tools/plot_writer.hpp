@@ -1,5 +1,7 @@
 // The plot of `kdl_space simulate --plot FILE` (.svg or .png), drawn by gnuplot: base attitude,
-// joint positions, and the change of momentum and energy since the start.
+// joint positions, the change of momentum and energy since the start, and the joint torques when a
+// controller runs. Many joints are drawn in several panels (at most kJointsPerPanel each), so
+// that a legend never squeezes a panel.
 #pragma once
 
 #include <string>
@@ -10,12 +12,16 @@
 
 namespace kdl_space::cli {
 
-/// The gnuplot terminal for a plot file name; throws UsageError for another extension.
-std::string plotTerminal(const std::string& path);
+constexpr std::size_t kJointsPerPanel = 10;
+
+/// The gnuplot terminal for a plot file name and its number of panels; throws UsageError for
+/// another extension.
+std::string plotTerminal(const std::string& path, std::size_t panels = 3);
 
 /// \brief Draws the samples into out.tmp() with gnuplot (the caller commits it); throws
 /// InputError if gnuplot fails or its scratch files cannot be written.
+/// `torques`: draw the joint torques too.
 void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
-               const std::string& title);
+               const std::string& title, bool torques);
 
 }  // namespace kdl_space::cli

@@ -13,6 +13,11 @@ struct Sample {
   Eigen::VectorXd q, qd;                       ///< joint positions and rates
   Eigen::Matrix<double, 6, 1> h;               ///< total momentum (P; L about the world origin)
   double T = 0.0;                              ///< kinetic energy [J]
+  Eigen::VectorXd tau;                         ///< joint torques applied (controls + friction)
+  Eigen::Matrix<double, 6, 1> base_wrench = Eigen::Matrix<double, 6, 1>::Zero();  ///< base control (f; n)
+  /// Work since the start: controller, friction, limits, base control, wrenches, gravity [J].
+  Eigen::Matrix<double, 6, 1> work = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> impulse = Eigen::Matrix<double, 6, 1>::Zero();  ///< external, since the start
 };
 
 }  // namespace kdl_space::cli

@@ -11,6 +11,8 @@
 #include "capture.hpp"
 #include "cli_common.hpp"
 #include "csv_writer.hpp"
+#include "detail/text.hpp"
+#include "motion_report.hpp"
 #include "plot_writer.hpp"
 
 namespace kdl_space::cli {
@@ -18,27 +20,75 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Why a simulation stopped, in the scenario's terms.
-std::string simulationFailure(int rc, const SimulationSpec& spec) {
+/// Why a simulation stopped, in the scenario's terms: what grew, when, and what to try. `s` is
+/// the last accepted state.
+std::string simulationFailure(int rc, const SimulationSpec& spec, const MotionRecord& r, const SimulationState& s) {
+  const std::string advice = stiffnessAdvice(r);
   switch (rc) {
     case E_MAX_STEPS:
       return "the step budget simulation.max_steps = " + std::to_string(spec.options.max_steps) +
-             " is spent (an unstable controller? raise max_steps, or loosen rtol and atol)";
+             " is spent (an unstable controller? raise max_steps, or loosen rtol and atol" +
+             (advice.empty() ? std::string() : "; " + advice) + ")";
     case E_STEP_UNDERFLOW:
       return std::string(strError(rc)) + " (loosen simulation.rtol and atol)";
-    case E_NOT_FINITE:
-      return "the motion blew up to NaN or infinite values (unstable PD gains, or too large an rk4 step?)";
+    case E_NOT_FINITE: {
+      std::ostringstream why;
+      why << std::setprecision(3) << "the motion blew up to NaN or infinite values (unstable PD gains, or too large an "
+          << "rk4 step?)";
+      const std::vector<std::string>& joints = r.sim.model().jointNames();
+      Eigen::Index j = 0;
+      if (s.velocity.qdot.rows() > 0 && s.velocity.qdot.data.allFinite()) {
+        const double fastest = s.velocity.qdot.data.cwiseAbs().maxCoeff(&j);
+        why << ": by t = " << s.t << " s joint '" << joints[j] << "' moved at " << fastest
+            << " rad/s (or m/s), the base at " << toEigen(s.velocity.base_twist.rot).norm() << " rad/s";
+      }
+      const Stiffness& st = r.stiffness;
+      if (st.fastest_joint >= 0)
+        why << "; the servo of joint '" << joints[st.fastest_joint] << "' (closed-loop rate " << st.fastest_rate
+            << " 1/s) needs explicit steps below " << st.explicit_step
+            << " s: lower simulation.step or the gains, or use integrator: rosenbrock";
+      return why.str();
+    }
     default:
       return strError(rc);
   }
 }
 
-const char* integratorName(Integrator i) { return i == Integrator::RK4 ? "rk4" : "dopri5"; }
+const char* integratorName(Integrator i) {
+  return i == Integrator::RK4 ? "rk4" : i == Integrator::Rosenbrock ? "rosenbrock" : "dopri5";
+}
+
+/// A name of the robot's model resolved in `model` (the same model, or the robot with a payload).
+unsigned int jointIn(const FloatingModel& model, const FloatingModel& robot, unsigned int j) {
+  return static_cast<unsigned int>(model.jointIndex(robot.jointNames()[j]));
+}
+
+/// The simulator as the scenario says: the robot's mode holds through the motion (a grounded base
+/// stays grounded, braked joints stay braked) unless the simulation section changes it.
+std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model) {
+  const SimulationSpec& spec = sc.simulation;
+  const FloatingSystem& robot = sc.capture.robot;
+  SimulationOptions options = spec.options;
+  options.grounded = spec.grounded.value_or(robot.response == Response::Grounded);
+  auto sim = std::make_unique<Simulator>(model, options);
+  JointControl locked;
+  locked.mode = JointControl::Mode::Locked;
+  for (unsigned int j = 0; j < robot.model->nj(); ++j)
+    if (robot.response == Response::JointsLocked) sim->setJointControl(jointIn(*model, *robot.model, j), locked);
+  for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(*model, *robot.model, joint), control);
+  for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(*model, *robot.model, joint), mode);
+  sim->setBaseControl(spec.base_control);
+  for (ScheduledWrench w : spec.wrenches) {
+    w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
+    sim->addWrench(w);
+  }
+  return sim;
+}
 
 }  // namespace
 
 CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
-  CLI::App* cmd = app.add_subcommand("simulate", "Solve the scenario's impact, then integrate the motion after it");
+  CLI::App* cmd = app.add_subcommand("simulate", "Solve the scenario's impact, then integrate the motion after it (or the robot's plain motion)");
   cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON), as for capture")->required();
   cmd->add_option("--duration", o.duration, "Seconds to simulate after the impact (default: the scenario's, else 20)")
       ->check(positiveNumber());
@@ -46,7 +96,7 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
       [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "");
   cmd->add_option("--csv", o.csv, "Write the time history as CSV (one row per output step)")
       ->type_name("FILE")->check(file_name);
-  cmd->add_option("--plot", o.plot, "Draw base attitude, joint angles and momentum/energy drift (.svg or .png)")
+  cmd->add_option("--plot", o.plot, "Draw base attitude, joint angles (and torques), momentum and energy balance (.svg or .png)")
       ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   return cmd;
@@ -84,28 +134,39 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     }
   }
   const CaptureProblem& problem = sc.capture;
-  const CaptureResult capture = inScenario(sc, [&] { return solveCapture(problem); });
-  const std::shared_ptr<const FloatingModel> model = inScenario(sc, [&] { return attachTarget(problem, capture); });
+  std::optional<CaptureResult> capture;
+  std::shared_ptr<const FloatingModel> model = problem.robot.model;
+  if (sc.impact) {
+    capture = inScenario(sc, [&] { return solveCapture(problem); });
+    model = inScenario(sc, [&] { return attachTarget(problem, *capture); });
+  }
   const bool payload_attached = model != problem.robot.model;
 
   std::unique_ptr<Simulator> simulator;
   try {
-    simulator = std::make_unique<Simulator>(model, spec.options);
-    for (const auto& [joint, control] : spec.joints) simulator->setJointControl(joint, control);
+    simulator = makeSimulator(sc, model);
   } catch (const ModelError& e) {
     throw InputError(sc.file + ": " + e.what());
   }
   Simulator& sim = *simulator;
   SimulationState s;
   s.state = problem.robot.state;
-  s.velocity = capture.robot.after;
+  s.velocity = capture ? capture->robot.after : problem.robot.velocity;
+  if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
+    std::ostringstream why;
+    why << sc.file << ": simulation: the base is grounded (held still), but its twist at the start of the motion is ("
+        << toEigen(s.velocity.base_twist).transpose() << "): give robot.base.twist zero, or simulation.base: free";
+    throw InputError(why.str());
+  }
   if (const int rc = sim.engageBrakes(s)) throw InputError(sc.file + ": simulation: cannot engage the brakes: " + strError(rc));
+  Stiffness stiffness;
+  if (const int rc = sim.stiffness(s, stiffness)) throw InputError(sc.file + ": simulation: " + strError(rc));
 
   const std::vector<std::string>& joints = model->jointNames();
   std::vector<Sample> samples;
   std::optional<CsvWriter> csv;
   std::unique_ptr<AtomicFile> plot_file;
-  if (!o.csv.empty()) csv.emplace(o.csv, joints);
+  if (!o.csv.empty()) csv.emplace(o.csv, joints, spec.base_control.on());
   int observer_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x) {
     Sample smp;
@@ -115,21 +176,28 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     smp.twist = toEigen(x.velocity.base_twist);
     smp.q = x.state.q.data;
     smp.qd = x.velocity.qdot.data;
+    smp.tau = x.tau.data;
+    smp.base_wrench = x.base_wrench;
+    smp.work << x.work.controller, x.work.friction, x.work.limits, x.work.base_control, x.work.wrenches, x.work.gravity;
+    smp.impulse = x.impulse;
     if (const int rc = sim.energyAndMomentum(x, smp.T, smp.h)) observer_rc = rc;
     if (csv) csv->write(smp);
     samples.push_back(std::move(smp));
   };
   const int rc = sim.run(s, duration, spec.output_step, observer);
+  const MotionRecord record{sim, samples, stiffness, spec.output_step};
   if (rc || observer_rc) {
     std::ostringstream why;
     why << sc.file << ": simulation failed at t = " << s.t << " s of " << duration << " s: "
-        << simulationFailure(rc ? rc : observer_rc, spec);
+        << simulationFailure(rc ? rc : observer_rc, spec, record, s);
     throw InputError(why.str());  // the temporaries are removed: no file is left
   }
   if (csv) csv->close();
+  bool torques = false;  // a controller runs: something drives the joints
+  for (const Sample& x : samples) torques = torques || x.tau.cwiseAbs().maxCoeff() > 0.0;
   if (!o.plot.empty()) {
     plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
-    writePlot(*plot_file, samples, joints, "kdl_space simulate " + fs::path(sc.file).filename().string());
+    writePlot(*plot_file, samples, joints, "kdl_space simulate " + fs::path(sc.file).filename().string(), torques);
   }
   // Every output is complete: give them their names (a failed rename takes the other back).
   if (csv) csv->file().commit();
@@ -151,15 +219,19 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     dT = std::max(dT, std::abs(x.T - first.T));
   }
   const Sample& last = samples.back();
+  std::vector<std::string> locked_joints;
+  for (unsigned int j = 0; j < model->nj(); ++j)
+    if (sim.jointControls()[j].mode == JointControl::Mode::Locked) locked_joints.push_back(joints[j]);
   if (o.json) {
     Json j;
-    j["capture"] = captureJson(sc, capture);
+    j["capture"] = capture ? captureJson(sc, *capture) : Json(nullptr);
     Json final_state{{"t", last.t},
                      {"base_position", toJson(last.p)},
                      {"base_quaternion", toJson(last.quat)},
                      {"base_twist", toJson(last.twist)},
                      {"q", toJson(last.q)},
                      {"qdot", toJson(last.qd)}};
+    const auto [balance_P, balance_L] = momentumBalance(samples);
     j["simulation"] = Json{{"duration", duration},
                            {"integrator", integratorName(spec.options.integrator)},
                            {"accepted_steps", sim.stats().accepted_steps},
@@ -173,16 +245,32 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
                            {"max_energy_change", dT},
                            {"energy", first.T},
                            {"csv", o.csv.empty() ? Json(nullptr) : Json(o.csv)},
-                           {"plot", o.plot.empty() ? Json(nullptr) : Json(o.plot)}};
+                           {"plot", o.plot.empty() ? Json(nullptr) : Json(o.plot)},
+                           {"base", sim.options().grounded ? "grounded" : "free"},
+                           {"locked_joints", locked_joints},
+                           {"momentum_balance_error", sim.options().grounded
+                                                          ? Json(nullptr)
+                                                          : Json{{"linear", balance_P}, {"angular", balance_L}}},
+                           {"limit_violations", limitViolationsJson(record)},
+                           {"saturation", saturationJson(record)},
+                           {"energy_split", energySplitJson(record)},
+                           {"base_control", baseControlJson(record)},
+                           {"stiffness", stiffnessJson(record)}};
     out << j.dump(2) << "\n";
     return;
   }
-  printCaptureSummary(out, sc, capture);
-  const std::string& contact_link = problem.robot.model->bodies()[problem.robot.contact.body].name;
-  out << "\nAfter the impact: " << (payload_attached ? "the target is attached to link '" + contact_link + "'"
-                                                  : std::string("the target separates; the robot alone"))
-      << ", " << duration << " s with " << integratorName(spec.options.integrator) << " ("
-      << sim.stats().accepted_steps << " steps, " << sim.stats().rejected_steps << " rejected)\n";
+  if (capture) {
+    printCaptureSummary(out, sc, *capture);
+    const std::string& contact_link = problem.robot.model->bodies()[problem.robot.contact.body].name;
+    out << "\nAfter the impact: " << (payload_attached ? "the target is attached to link '" + contact_link + "'"
+                                                      : std::string("the target separates; the robot alone"));
+  } else {
+    out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
+  }
+  out << ", " << duration << " s with " << integratorName(spec.options.integrator) << " ("
+      << sim.stats().accepted_steps << " steps, " << sim.stats().rejected_steps << " rejected)"
+      << (sim.options().grounded ? ", base grounded" : "") << "\n";
+  if (!locked_joints.empty()) out << "Braked joints: " << locked_joints.size() << " (" << detail::listNames(locked_joints) << ")\n";
   double roll, pitch, yaw;
   KDL::Rotation::Quaternion(last.quat(0), last.quat(1), last.quat(2), last.quat(3)).GetRPY(roll, pitch, yaw);
   out << "Final base position [m]: " << last.p.transpose() << "\n"
@@ -193,6 +281,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
               {"position", "rate"});
   out << "Largest change over the run: linear momentum " << dP << " N s, angular momentum " << dL
       << " N m s, kinetic energy " << dT << " J (of " << first.T << " J)\n";
+  printMotionReport(out, record);
   if (!o.csv.empty()) out << "CSV: " << o.csv << "\n";
   if (!o.plot.empty()) out << "Plot: " << o.plot << "\n";
 }
