@@ -44,6 +44,7 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   at_stop_.assign(n, false);
   locked_now_.assign(n, false);
   saturated_.assign(n, false);
+  friction_velocity_.assign(n, options_.friction_velocity);
   stats_.joints.assign(n, JointRecord{});
   scratch_.state = State(this->model());
   scratch_.velocity.qdot = KDL::JntArray(n);
@@ -62,8 +63,9 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   x_event_.setZero(size);
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   if (!positive(options_.step) || !positive(options_.rtol) || !positive(options_.atol) ||
-      !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity))
-    throw ModelError("simulation: step, rtol, atol, max_step, max_steps and friction_velocity must be finite and > 0");
+      !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity) || !positive(options_.friction_rate))
+    throw ModelError(
+        "simulation: step, rtol, atol, max_step, max_steps, friction_velocity and friction_rate must be finite and > 0");
   if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54 &&
       options_.integrator != Integrator::Rosenbrock)
     throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54, Rosenbrock");

@@ -47,7 +47,7 @@ int Simulator::actuate(double t) {
     saturated_[j] = options_.effort_limits && std::isfinite(effort) && effort > 0.0 && std::abs(u) > effort;
     if (saturated_[j]) u = std::copysign(effort, u);
     tau_friction_(j) = options_.joint_friction ? frictionTorque(qdot(j), props[j].damping, props[j].friction,
-                                                                options_.friction_velocity)
+                                                                friction_velocity_[j])
                                                : 0.0;
     scratch_.tau(j) = u + tau_friction_(j);
   }
@@ -165,6 +165,20 @@ int Simulator::startRun(SimulationState& s) {
     if (controls_[j].mode == JointControl::Mode::PD && controls_[j].hold) controls_[j].set_point = s.state.q(j);
   std::fill(at_stop_.begin(), at_stop_.end(), false);
   applyLocks();
+  // The Coulomb regularisation of each joint, from its apparent inertia here.
+  std::fill(friction_velocity_.begin(), friction_velocity_.end(), options_.friction_velocity);
+  bool any_friction = false;
+  for (const JointProperties& p : model().jointProperties()) any_friction = any_friction || p.friction > 0.0;
+  if (options_.joint_friction && any_friction) {
+    if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+    for (unsigned int j = 0; j < n; ++j) {
+      const double f = model().jointProperties()[j].friction;
+      double m = 0.0;
+      if (f <= 0.0 || locked_now_[j]) continue;
+      if (const int rc = apparentInertia(j, m)) return rc;
+      friction_velocity_[j] = std::max(options_.friction_velocity, f / (m * options_.friction_rate));
+    }
+  }
   std::vector<unsigned int> stop;
   for (unsigned int j = 0; j < n; ++j) {
     if (limit_modes_[j] != LimitMode::Stop || controls_[j].mode == JointControl::Mode::Locked) continue;
@@ -302,18 +316,25 @@ int Simulator::retake(double t, double h, const Vector& x, Vector& result) {
   return E_NOERROR;
 }
 
-int Simulator::stiffness(const SimulationState& s, Stiffness& result) {
-  const unsigned int n = model().nj();
-  if (s.state.q.rows() != n) return E_SIZE_MISMATCH;
-  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+int Simulator::apparentInertia(unsigned int j, double& m) {
   static const std::vector<KDL::Wrench> none;
-  const FloatingVelocity rest(*model_);
-  KDL::JntArray unit(n);
-  FloatingAcceleration base_line{Vector6d::Zero(), KDL::JntArray(n)}, acc{Vector6d::Zero(), KDL::JntArray(n)};
+  const FloatingVelocity rest(*model_);  // set-up calls only: allocates
+  KDL::JntArray unit(model().nj());
+  FloatingAcceleration base_line{Vector6d::Zero(), KDL::JntArray(model().nj())}, acc = base_line;
   const auto solve = [&](FloatingAcceleration& a) {
     return std::visit([&](auto& d) { return d.CartToJnt(kin_, rest, unit, none, a); }, dynamics_);
   };
   if (const int rc = solve(base_line)) return rc;  // gravity alone: subtracted below
+  unit(j) = 1.0;
+  if (const int rc = solve(acc)) return rc;
+  m = 1.0 / (acc.qddot(j) - base_line.qddot(j));
+  return std::isfinite(m) && m > 0.0 ? E_NOERROR : E_NOT_POSITIVE_DEFINITE;
+}
+
+int Simulator::stiffness(const SimulationState& s, Stiffness& result) {
+  const unsigned int n = model().nj();
+  if (s.state.q.rows() != n) return E_SIZE_MISMATCH;
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
   Stiffness out;
   const std::vector<JointProperties>& props = model().jointProperties();
   for (unsigned int j = 0; j < n; ++j) {
@@ -321,14 +342,11 @@ int Simulator::stiffness(const SimulationState& s, Stiffness& result) {
     const JointControl& c = controls_[j];
     const double kp = c.mode == JointControl::Mode::PD ? c.kp : 0.0;
     double kd = (c.mode == JointControl::Mode::PD ? c.kd : 0.0);
-    if (options_.joint_friction) kd += props[j].damping + props[j].friction / options_.friction_velocity;
+    if (options_.joint_friction) kd += props[j].damping + props[j].friction / friction_velocity_[j];
     if (kp == 0.0 && kd == 0.0) continue;
-    unit(j) = 1.0;
-    const int rc = solve(acc);
-    unit(j) = 0.0;
-    if (rc) return rc;
-    const double m = 1.0 / (acc.qddot(j) - base_line.qddot(j));  // the joint's apparent inertia
-    const double disc = kd * kd - 4.0 * m * kp;                  // roots of m s^2 + kd s + kp
+    double m = 0.0;  // the joint's apparent inertia
+    if (const int rc = apparentInertia(j, m)) return rc;
+    const double disc = kd * kd - 4.0 * m * kp;  // roots of m s^2 + kd s + kp
     const double rate = disc >= 0.0 ? (kd + std::sqrt(disc)) / (2.0 * m) : std::sqrt(kp / m);
     if (rate > out.fastest_rate) {
       out.fastest_rate = rate;

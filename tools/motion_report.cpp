@@ -133,6 +133,20 @@ Json stiffnessJson(const MotionRecord& r) {
               {"advice", advice.empty() ? Json(nullptr) : Json(advice)}};
 }
 
+Json frictionJson(const MotionRecord& r) {
+  const FloatingModel& m = r.sim.model();
+  Json joints = Json::array();
+  for (std::size_t j = 0; j < m.nj(); ++j) {
+    const JointProperties& p = m.jointProperties()[j];
+    if (p.damping == 0.0 && p.friction == 0.0) continue;
+    joints.push_back(Json{{"joint", m.jointNames()[j]},
+                          {"damping", p.damping},
+                          {"friction", p.friction},
+                          {"regularisation_velocity", r.sim.frictionVelocities()[j]}});
+  }
+  return Json{{"on", r.sim.options().joint_friction}, {"joints", joints}};
+}
+
 void printMotionReport(std::ostream& out, const MotionRecord& r) {
   const FloatingModel& m = r.sim.model();
   for (std::size_t j = 0; j < m.nj(); ++j) {

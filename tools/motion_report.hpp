@@ -31,6 +31,8 @@ Json energySplitJson(const MotionRecord& r);
 /// null without a base control; else its set points, final errors and the momentum balance.
 Json baseControlJson(const MotionRecord& r);
 Json stiffnessJson(const MotionRecord& r);
+/// The joints with damping or Coulomb friction: their values and the regularisation v_s used.
+Json frictionJson(const MotionRecord& r);
 /// Largest |h - h_0 - impulse| over the samples (P and L parts); the momentum balance.
 std::pair<double, double> momentumBalance(const std::vector<Sample>& samples);
 

@@ -159,8 +159,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw InputError(why.str());
   }
   if (const int rc = sim.engageBrakes(s)) throw InputError(sc.file + ": simulation: cannot engage the brakes: " + strError(rc));
+  const SimulationState start = s;
   Stiffness stiffness;
-  if (const int rc = sim.stiffness(s, stiffness)) throw InputError(sc.file + ": simulation: " + strError(rc));
 
   const std::vector<std::string>& joints = model->jointNames();
   std::vector<Sample> samples;
@@ -185,6 +185,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     samples.push_back(std::move(smp));
   };
   const int rc = sim.run(s, duration, spec.output_step, observer);
+  // The servos' stiffness at the start, with the friction's regularisation of the run.
+  if (const int src = sim.stiffness(start, stiffness))
+    throw InputError(sc.file + ": simulation: " + strError(src));
   const MotionRecord record{sim, samples, stiffness, spec.output_step};
   if (rc || observer_rc) {
     std::ostringstream why;
@@ -255,7 +258,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
                            {"saturation", saturationJson(record)},
                            {"energy_split", energySplitJson(record)},
                            {"base_control", baseControlJson(record)},
-                           {"stiffness", stiffnessJson(record)}};
+                           {"stiffness", stiffnessJson(record)},
+                           {"friction", frictionJson(record)}};
     out << j.dump(2) << "\n";
     return;
   }

@@ -45,7 +45,12 @@ struct SimulationOptions {
   bool effort_limits = true;
   /// The model's joint damping and Coulomb friction act (frictionTorque).
   bool joint_friction = true;
-  double friction_velocity = 1e-3;  ///< v_s of frictionTorque's regularisation [rad/s or m/s]
+  /// Coulomb friction's regularisation (frictionTorque): near rest it is a damping of slope
+  /// friction / v_s, which on a light joint would make the motion stiff. So each joint's v_s is
+  /// max(friction_velocity, friction / (m_j friction_rate)), m_j its apparent inertia at the start
+  /// of the run: the Coulomb term's rate stays below friction_rate (Simulator::frictionVelocities).
+  double friction_velocity = 1e-3;  ///< the smallest v_s [rad/s or m/s]
+  double friction_rate = 1e3;       ///< the largest rate of the regularised Coulomb term [1/s]
 };
 
 /// Work done on the system since the start of the run, by what did it [J]. The kinetic energy
@@ -125,7 +130,8 @@ struct Stiffness {
 /// limit. Scheduled wrenches start and end exactly on a step.
 class KDL_SPACE_EXPORT Simulator {
  public:
-  /// \throws ModelError unless step, rtol, atol, max_step, friction_velocity are finite and > 0,
+  /// \throws ModelError unless step, rtol, atol, max_step, friction_velocity, friction_rate are
+  /// finite and > 0,
   /// max_steps > 0, gravity finite and the integrator an enumerator.
   explicit Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options = {});
   ~Simulator();
@@ -169,7 +175,8 @@ class KDL_SPACE_EXPORT Simulator {
   /// E_STEP_UNDERFLOW when the adaptive step falls to round-off, or a code of the dynamics. On an
   /// error found before the first step s is untouched; later, s is left at the last accepted step
   /// whose state can be evaluated (s.t tells how far the run got). A run allocates nothing
-  /// unless a hard stop with several joints at once is met.
+  /// unless a joint has Coulomb friction (its regularisation is set at the start) or a hard stop
+  /// is met.
   int run(SimulationState& s, double t_end, double output_dt,
           const std::function<void(const SimulationState&)>& observer);
 
@@ -182,8 +189,13 @@ class KDL_SPACE_EXPORT Simulator {
   int stiffness(const SimulationState& s, Stiffness& result);
 
   const SimulationStats& stats() const { return stats_; }
+  /// Each joint's v_s of the last run (model order; see SimulationOptions::friction_rate).
+  const std::vector<double>& frictionVelocities() const { return friction_velocity_; }
 
  private:
+  /// 1 / (M^-1)_jj at the state of kin_: the inertia joint j's torque meets (the acceleration of a
+  /// unit torque from rest), with the dynamics' locks.
+  int apparentInertia(unsigned int j, double& m);
   using Vector = Eigen::VectorXd;
   void pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const;
   int unpack(const Vector& x, double t, SimulationState& s);
@@ -230,6 +242,7 @@ class KDL_SPACE_EXPORT Simulator {
   std::vector<LimitMode> limit_modes_;
   std::vector<bool> at_stop_;  ///< joints held at a hard stop now
   std::vector<bool> locked_now_;  ///< braked or at a stop: what the dynamics hold
+  std::vector<double> friction_velocity_;  ///< v_s per joint
   BaseControl base_control_;
   std::vector<ScheduledWrench> wrenches_;
   TorqueCallback callback_;
