@@ -14,8 +14,7 @@ const char* integratorName(Integrator i) {
 
 double meanStep(const MotionRecord& r) {
   const long steps = r.sim.stats().accepted_steps;
-  if (steps == 0 || r.samples.empty()) return 0.0;
-  return (r.samples.back().t - r.samples.front().t) / static_cast<double>(steps);
+  return steps == 0 ? 0.0 : (r.t_reached - r.t_start) / static_cast<double>(steps);
 }
 
 }  // namespace
@@ -33,10 +32,11 @@ std::string stiffnessAdvice(const MotionRecord& r) {
         << " 1/s): lower the step or the gains, or use integrator: rosenbrock";
     return why.str();
   }
-  // An explicit adaptive run whose steps are held near the stability bound, far below the output.
+  // An explicit adaptive run whose steps are far below the output step, with a servo fast enough
+  // to hold them there.
   const double mean = meanStep(r);
   if (o.integrator == Integrator::DormandPrince54 && mean > 0.0 && mean < 0.01 * r.output_step &&
-      st.explicit_step < 10.0 * mean) {
+      st.explicit_step < 0.01 * r.output_step) {
     why << "stiff: the servo of joint " << joint << " (closed-loop rate " << st.fastest_rate
         << " 1/s) holds dopri5's step near " << mean << " s (" << r.sim.stats().accepted_steps
         << " steps): try integrator: rosenbrock (an rtol of 1e-6 or looser suits it)";

@@ -19,6 +19,7 @@ struct MotionRecord {
   const std::vector<Sample>& samples;
   const Stiffness& stiffness;
   double output_step;
+  double t_start, t_reached;  ///< the run's start, and how far it got [s]
 };
 
 /// Whether the run was held back by a stiff servo, and what to try (empty: it was not).

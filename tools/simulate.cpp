@@ -27,8 +27,8 @@ std::string simulationFailure(int rc, const SimulationSpec& spec, const MotionRe
   switch (rc) {
     case E_MAX_STEPS:
       return "the step budget simulation.max_steps = " + std::to_string(spec.options.max_steps) +
-             " is spent (an unstable controller? raise max_steps, or loosen rtol and atol" +
-             (advice.empty() ? std::string() : "; " + advice) + ")";
+             " is spent (an unstable controller? raise max_steps, or loosen rtol and atol)" +
+             (advice.empty() ? std::string() : "; " + advice);
     case E_STEP_UNDERFLOW:
       return std::string(strError(rc)) + " (loosen simulation.rtol and atol)";
     case E_NOT_FINITE: {
@@ -149,20 +149,31 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw InputError(sc.file + ": " + e.what());
   }
   Simulator& sim = *simulator;
+  const std::vector<std::string>& joints = model->jointNames();
   SimulationState s;
   s.state = problem.robot.state;
   s.velocity = capture ? capture->robot.after : problem.robot.velocity;
   if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
     std::ostringstream why;
-    why << sc.file << ": simulation: the base is grounded (held still), but its twist at the start of the motion is ("
-        << toEigen(s.velocity.base_twist).transpose() << "): give robot.base.twist zero, or simulation.base: free";
+    why << sc.file << ": simulation: the base is grounded (held still), but its twist at the start of the motion is "
+        << toEigen(s.velocity.base_twist).transpose().format(Eigen::IOFormat(6, Eigen::DontAlignCols, ", ", ", ", "", "", "[", "]"))
+        << ": give robot.base.twist zero, or simulation.base: free";
     throw InputError(why.str());
+  }
+  for (unsigned int j = 0; j < model->nj(); ++j) {  // a hard stop holds a joint inside its limits only
+    const JointProperties& p = model->jointProperties()[j];
+    const double q = s.state.q(j);
+    if (sim.limitModes()[j] == LimitMode::Stop && (q > p.upper || q < p.lower)) {
+      std::ostringstream why;
+      why << sc.file << ": simulation.limits: joint '" << joints[j] << "' starts at " << q << ", outside its limits ["
+          << p.lower << ", " << p.upper << "] (a hard stop keeps it inside them): start it inside, or let its limits warn";
+      throw InputError(why.str());
+    }
   }
   if (const int rc = sim.engageBrakes(s)) throw InputError(sc.file + ": simulation: cannot engage the brakes: " + strError(rc));
   const SimulationState start = s;
   Stiffness stiffness;
 
-  const std::vector<std::string>& joints = model->jointNames();
   std::vector<Sample> samples;
   std::optional<CsvWriter> csv;
   std::unique_ptr<AtomicFile> plot_file;
@@ -188,7 +199,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, stiffness))
     throw InputError(sc.file + ": simulation: " + strError(src));
-  const MotionRecord record{sim, samples, stiffness, spec.output_step};
+  const MotionRecord record{sim, samples, stiffness, spec.output_step, start.t, s.t};
   if (rc || observer_rc) {
     std::ostringstream why;
     why << sc.file << ": simulation failed at t = " << s.t << " s of " << duration << " s: "

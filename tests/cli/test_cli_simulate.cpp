@@ -43,7 +43,7 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
   const std::vector<std::string> header = split(line);
   const std::vector<std::string> joints = j.at("simulation").at("joint_names");
   EXPECT_EQ(header.front(), "t");
-  EXPECT_EQ(header.back(), "kinetic_energy");
+  EXPECT_EQ(header.back(), "work_gravity");  // the columns added since end the header
   for (const std::string& name : joints) {
     EXPECT_NE(std::find(header.begin(), header.end(), "q_" + name), header.end()) << name;
     EXPECT_NE(std::find(header.begin(), header.end(), "qdot_" + name), header.end()) << name;
