@@ -1,0 +1,248 @@
+// `kdl_space simulate` on motions: the SpaceDyn sample as a plain motion against the independent
+// engine, every shipped scenario, and what each feature of the simulation section must show in
+// the CSV and the JSON (modes that persist, hard stops, friction, the base's control, stiffness).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "cli_runner.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_motion_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+/// A CSV as columns by header name.
+std::map<std::string, std::vector<double>> readCsv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream h(line);
+  for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    std::stringstream r(line);
+    std::size_t i = 0;
+    for (std::string cell; std::getline(r, cell, ','); ++i) columns[header.at(i)].push_back(std::stod(cell));
+    EXPECT_EQ(i, header.size()) << line;
+  }
+  return columns;
+}
+
+/// A shipped scenario with its text changed (`from` replaced by `to`), written next to a copy of
+/// what it points to by relative path.
+std::string variant(const std::string& name, const std::string& from, const std::string& to) {
+  std::ifstream in(kScenarios + name + ".yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  s = std::regex_replace(s, std::regex("\\.\\./urdf/"), std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  const std::string path = scratch(name + "_variant.yaml");
+  std::ofstream(path) << s;
+  return path;
+}
+
+json simulateJson(const std::string& args) {
+  const ToolRun r = kdlSpace("simulate " + args + " --json");
+  EXPECT_EQ(r.rc, 0) << r.err;
+  return r.rc == 0 ? json::parse(r.out) : json();
+}
+
+TEST(PlainMotion, SpaceDynSampleMatchesTheIndependentEngineAtEverySample) {
+  const std::string csv = scratch("spacedyn.csv");
+  const json j = simulateJson(kScenarios + "spacedyn_twolink_pd.yaml --csv " + csv);
+  ASSERT_TRUE(j.contains("capture"));
+  EXPECT_TRUE(j.at("capture").is_null()) << "a plain motion has no capture";
+  std::ifstream ref_in(std::string(KDL_SPACE_SOURCE_DIR) + "/tests/data/reference/twolink_pd_motion.json");
+  const json ref = json::parse(ref_in);
+  const std::vector<json> samples = ref.at("samples");
+  auto c = readCsv(csv);
+  ASSERT_EQ(c.at("t").size(), samples.size());
+  const auto expectNear = [](double a, double b, const std::string& what) {
+    EXPECT_NEAR(a, b, 1e-8) << what;
+  };
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const json& s = samples[i];
+    const std::string at = " at t = " + std::to_string(s.at("t").get<double>());
+    expectNear(c["t"][i], s.at("t"), "t");
+    const char* axes = "xyz";
+    for (int k = 0; k < 3; ++k) {
+      expectNear(c[std::string("base_") + axes[k]][i], s.at("base_position")[k], "base position" + at);
+      expectNear(c[std::string("base_v") + axes[k]][i], s.at("base_twist")[k], "base v" + at);
+      expectNear(c[std::string("base_w") + axes[k]][i], s.at("base_twist")[3 + k], "base w" + at);
+      expectNear(c[std::string("P_") + axes[k]][i], s.at("linear_momentum")[k], "P" + at);
+      expectNear(c[std::string("L_") + axes[k]][i], s.at("angular_momentum_about_origin")[k], "L" + at);
+    }
+    const char* quat[4] = {"base_qx", "base_qy", "base_qz", "base_qw"};
+    for (int k = 0; k < 4; ++k) expectNear(c[quat[k]][i], s.at("base_quaternion")[k], quat[k] + at);
+    for (int k = 0; k < 2; ++k) {
+      const std::string name = "joint" + std::to_string(k + 1);
+      expectNear(c["q_" + name][i], s.at("q")[k], "q " + name + at);
+      expectNear(c["qdot_" + name][i], s.at("qdot")[k], "qdot " + name + at);
+    }
+    expectNear(c["kinetic_energy"][i], s.at("kinetic_energy"), "T" + at);
+    // The controller did all the work: its work is the kinetic energy gained, which the engine
+    // books as the PD potential given up less what its damping dissipated.
+    const double pd_work = samples[0].at("pd_potential_energy").get<double>() - s.at("pd_potential_energy").get<double>() -
+                           s.at("pd_dissipated_energy").get<double>();
+    expectNear(c["work_controller"][i], pd_work, "controller work" + at);
+    // tau = kp (set point - q) - kd qdot, from the CSV's own columns
+    const double q_des[2] = {-M_PI / 6, M_PI / 3};
+    for (int k = 0; k < 2; ++k) {
+      const std::string name = "joint" + std::to_string(k + 1);
+      EXPECT_NEAR(c["tau_" + name][i], 10 * (q_des[k] - c["q_" + name][i]) - 5 * c["qdot_" + name][i], 1e-9) << at;
+    }
+  }
+  const json& sim = j.at("simulation");
+  EXPECT_NEAR(sim.at("final").at("q")[0].get<double>(), -0.5235998218, 1e-9);
+  EXPECT_NEAR(sim.at("final").at("q")[1].get<double>(), 1.047197077, 1e-9);
+  EXPECT_EQ(sim.at("base"), "free");
+  EXPECT_TRUE(sim.at("limit_violations").empty());
+  EXPECT_NEAR(sim.at("energy_split").at("residual").get<double>(), 0.0, 1e-9);
+}
+
+TEST(ShippedScenarios, EveryOneSimulatesWithTheNewReports) {
+  for (const auto& entry : fs::directory_iterator(kScenarios)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().filename().string());
+    const json j = simulateJson(entry.path().string() + " --duration 2");
+    if (j.is_null()) continue;
+    const json& sim = j.at("simulation");
+    for (const char* key : {"limit_violations", "saturation", "energy_split", "base_control", "stiffness", "friction",
+                            "base", "locked_joints", "momentum_balance_error"})
+      EXPECT_TRUE(sim.contains(key)) << key;
+    // The energy bookkeeping closes: the kinetic energy changed by the work done on the system.
+    const json& e = sim.at("energy_split");
+    const double scale = 1.0 + std::abs(e.at("total_work").get<double>()) + sim.at("energy").get<double>();
+    EXPECT_LT(std::abs(e.at("residual").get<double>()), 1e-7 * scale) << e.dump();
+    if (!sim.at("momentum_balance_error").is_null()) {
+      EXPECT_LT(sim.at("momentum_balance_error").at("linear").get<double>(), 1e-10);
+      EXPECT_LT(sim.at("momentum_balance_error").at("angular").get<double>(), 1e-10);
+    }
+  }
+}
+
+TEST(Modes, AGroundedBaseStaysGroundedAndTheSectionCanFreeIt) {
+  const json grounded = simulateJson(kScenarios + "grounded_test_bed.yaml");
+  const json& sim = grounded.at("simulation");
+  EXPECT_EQ(sim.at("base"), "grounded");
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(sim.at("final").at("base_position")[k].get<double>(), 0.0);
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(sim.at("final").at("base_twist")[k].get<double>(), 0.0);
+  EXPECT_NEAR(sim.at("final").at("q")[0].get<double>(), 0.8, 1e-3) << "the shoulder reaches its set point";
+  const json freed = simulateJson(variant("grounded_test_bed", "  duration: 5", "  duration: 5\n  base: free"));
+  EXPECT_EQ(freed.at("simulation").at("base"), "free");
+  EXPECT_GT(std::abs(freed.at("simulation").at("final").at("base_twist")[5].get<double>()) +
+                std::abs(freed.at("simulation").at("final").at("base_position")[0].get<double>()),
+            1e-6);
+}
+
+TEST(Limits, HardStopsHoldTheJointAndKeepTheMomentum) {
+  const std::string csv = scratch("stop.csv");
+  const json j = simulateJson(kScenarios + "joint_limit_stop.yaml --csv " + csv);
+  const json& sim = j.at("simulation");
+  const auto c = readCsv(csv);
+  const double upper = 2.79253;
+  for (double q : c.at("q_joint4")) EXPECT_LE(q, upper + 1e-9);
+  bool found = false;
+  for (const json& v : sim.at("limit_violations"))
+    if (v.at("joint") == "joint4") {
+      found = true;
+      EXPECT_EQ(v.at("mode"), "stop");
+      EXPECT_GE(v.at("stops").get<int>(), 1);
+    }
+  EXPECT_TRUE(found) << sim.at("limit_violations").dump();
+  EXPECT_LT(sim.at("energy_split").at("limits").get<double>(), 0.0) << "an inelastic impact takes energy";
+  // Momentum: kept through every stop, changed only by the push (its impulse).
+  EXPECT_LT(sim.at("momentum_balance_error").at("linear").get<double>(), 1e-10);
+  EXPECT_LT(sim.at("momentum_balance_error").at("angular").get<double>(), 1e-10);
+  // The joint left the stop when pushed back: it ends inside its range.
+  EXPECT_LT(c.at("q_joint4").back(), upper - 1e-3);
+
+  // By default the limits only warn: the excursion is listed and the text says so once.
+  const std::string warn = variant("joint_limit_stop", "  limits: stop", "  limits: warn");
+  const json w = simulateJson(warn);
+  bool listed = false;
+  for (const json& v : w.at("simulation").at("limit_violations"))
+    if (v.at("joint") == "joint4") {
+      listed = true;
+      EXPECT_EQ(v.at("mode"), "warn");
+      EXPECT_GT(v.at("worst").get<double>(), upper);
+      EXPECT_GT(v.at("first_time").get<double>(), 0.0);
+    }
+  EXPECT_TRUE(listed);
+  const ToolRun text = kdlSpace("simulate " + warn);
+  EXPECT_NE(text.out.find("Warning: joint 'joint4' left its limits"), std::string::npos) << text.out;
+}
+
+TEST(Friction, TakesEnergyAndKeepsTheMomentum) {
+  const std::string csv = scratch("friction.csv");
+  const json j = simulateJson(kScenarios + "joint_friction.yaml --csv " + csv);
+  const json& sim = j.at("simulation");
+  EXPECT_LT(sim.at("energy_split").at("friction").get<double>(), -1.0);
+  EXPECT_LT(sim.at("max_linear_momentum_change").get<double>(), 1e-10);
+  EXPECT_LT(sim.at("max_angular_momentum_change").get<double>(), 1e-10);
+  const auto c = readCsv(csv);
+  const std::vector<double>& w = c.at("work_friction");
+  for (std::size_t i = 1; i < w.size(); ++i) EXPECT_LE(w[i], w[i - 1] + 1e-12) << "friction never gives energy";
+  EXPECT_EQ(sim.at("friction").at("joints").size(), 7u);
+  for (const json& f : sim.at("friction").at("joints"))
+    EXPECT_GE(f.at("regularisation_velocity").get<double>(), 0.001);
+  // Off: no work, no loss.
+  const json off = simulateJson(variant("joint_friction", "  duration: 10", "  duration: 10\n  friction: false"));
+  EXPECT_EQ(off.at("simulation").at("energy_split").at("friction").get<double>(), 0.0);
+}
+
+TEST(BaseControl, HoldsTheAttitudeWithinItsLimitsAndBalancesTheMomentum) {
+  const std::string csv = scratch("base.csv");
+  const json j = simulateJson(kScenarios + "base_attitude_control.yaml --csv " + csv);
+  const json& sim = j.at("simulation");
+  const json& bc = sim.at("base_control");
+  ASSERT_FALSE(bc.is_null());
+  EXPECT_LT(bc.at("momentum_balance_error").at("linear").get<double>(), 1e-10);
+  EXPECT_LT(bc.at("momentum_balance_error").at("angular").get<double>(), 1e-10);
+  EXPECT_NEAR(bc.at("impulse")[0].get<double>(), 5.0, 0.2) << "5 N for 1 s along the base's x (turning a little)";
+  EXPECT_LT(bc.at("attitude").at("final_error").get<double>(), 0.05);
+  EXPECT_GT(sim.at("saturation").at("base_control_time").get<double>(), 0.0);
+  const auto c = readCsv(csv);
+  // The torque is limited to 2 N m per base axis: its world norm is at most 2 sqrt(3).
+  for (std::size_t i = 0; i < c.at("t").size(); ++i) {
+    const double n = std::hypot(c.at("base_control_nx")[i], c.at("base_control_ny")[i], c.at("base_control_nz")[i]);
+    EXPECT_LE(n, 2.0 * std::sqrt(3.0) + 1e-9);
+  }
+}
+
+TEST(Stiffness, ExplicitRunIsFlaggedAndRosenbrockAgreesWithFarFewerSteps) {
+  const std::string dopri = variant("stiff_wrist_servo", "  integrator: rosenbrock\n  rtol: 1.0e-7\n  atol: 1.0e-9",
+                                    "  integrator: dopri5\n  rtol: 1.0e-11\n  atol: 1.0e-13");
+  const json explicit_run = simulateJson(dopri + " --duration 0.5");
+  const json stiff_run = simulateJson(kScenarios + "stiff_wrist_servo.yaml --duration 0.5");
+  const json& e = explicit_run.at("simulation");
+  const json& s = stiff_run.at("simulation");
+  EXPECT_TRUE(e.at("stiffness").at("stiff").get<bool>());
+  EXPECT_NE(e.at("stiffness").at("advice").get<std::string>().find("rosenbrock"), std::string::npos);
+  EXPECT_EQ(e.at("stiffness").at("fastest_joint"), "joint7");
+  EXPECT_FALSE(s.at("stiffness").at("stiff").get<bool>());
+  EXPECT_LT(s.at("accepted_steps").get<long>() * 20, e.at("accepted_steps").get<long>());
+  for (std::size_t k = 0; k < 7; ++k)
+    EXPECT_NEAR(s.at("final").at("q")[k].get<double>(), e.at("final").at("q")[k].get<double>(), 1e-6) << k;
+}
+
+}  // namespace
+}  // namespace kdl_space::test
