@@ -46,6 +46,8 @@ class Field {
   Eigen::Matrix3d matrix3() const;
   /// A mapping NAME: finite number.
   std::map<std::string, double> namedNumbers() const;
+  /// The items of a list, each with its path PATH[i] ("expected a list of `what`, got ..." else).
+  std::vector<Field> items(const std::string& what) const;
 
   const std::string& path() const { return path_; }
   bool isScalar() const { return node_.IsScalar(); }
