@@ -18,7 +18,8 @@ std::unique_ptr<FloatingSide> floatingSide(const FloatingSystem& s, ExIITMethod 
     throw InputError(who + ": the free-floating quantities cannot be computed at this state (" + who + ".base, " + who +
                      ".q): " + strError(rc));
   try {
-    return std::make_unique<FloatingSide>(s.model, std::move(kin), s.contact, s.velocity, s.response, method);
+    return std::make_unique<FloatingSide>(s.model, std::move(kin), s.contact, s.velocity, s.response, method,
+                                          s.locked);
   } catch (const ModelError& e) {
     throw InputError(who + ": " + e.what());
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "detail/text.hpp"
 #include "model_rules.hpp"
 
 namespace kdl_space {
@@ -28,21 +29,24 @@ Kinematics kinematicsAt(const FloatingModel* model, const State& state) {
 }  // namespace
 
 FloatingSide::FloatingSide(const FloatingSystem& s, ExIITMethod method)
-    : FloatingSide(s.model, s.state, s.contact, s.velocity, s.response, method) {}
+    : FloatingSide(s.model, s.state, s.contact, s.velocity, s.response, method, s.locked) {}
 
 FloatingSide::~FloatingSide() = default;
 
 FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
-                           const FloatingVelocity& before, Response response, ExIITMethod method)
-    : FloatingSide(model, kinematicsAt(model.get(), state), h, before, response, method) {}
+                           const FloatingVelocity& before, Response response, ExIITMethod method,
+                           std::vector<bool> locked)
+    : FloatingSide(model, kinematicsAt(model.get(), state), h, before, response, method, std::move(locked)) {}
 
 FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
-                           const FloatingVelocity& before, Response response, ExIITMethod method)
+                           const FloatingVelocity& before, Response response, ExIITMethod method,
+                           std::vector<bool> locked)
     : model_(checkedModel(std::move(model))),
       kin_(std::move(kin)),
       momentum_(model_),
       h_(h),
       response_(response),
+      locked_(std::move(locked)),
       before_(before),
       after_(before),
       dqdot_(model_->nj()),
@@ -52,6 +56,13 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
     refuse(std::to_string(before.qdot.rows()) + " joint rates given for the model's " + std::to_string(n) + " joints");
   if (!before.qdot.data.allFinite() || !allFinite(before.base_twist))
     refuse("the base twist or a joint rate is NaN or infinite");
+  if (locked_.empty()) locked_.assign(n, false);
+  if (locked_.size() != n)
+    refuse(std::to_string(locked_.size()) + " joint brakes given for the model's " + std::to_string(n) + " joints");
+  for (unsigned int j = 0; j < n; ++j)
+    if (locked_[j] && before.qdot(j) != 0.0)
+      refuse("joint " + detail::quoted(model_->jointNames()[j]) + " is braked but its rate before the impact is " +
+             detail::number(before.qdot(j)) + ", not 0 (a braked joint does not move)");
   if (response_ != Response::FreeFloating && response_ != Response::Grounded && response_ != Response::JointsLocked)
     refuse("the response is not one of FreeFloating, Grounded, JointsLocked");
   if (method != ExIITMethod::Recursive && method != ExIITMethod::Dense)
@@ -63,8 +74,10 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
     // eq. 20: no recursion
   } else if (method == ExIITMethod::Recursive && model_->mimic().empty()) {  // mimic joints: dense
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
+    recursive_->setLocked(locked_);  // sizes checked above
   } else {
     dense_ = std::make_unique<FreeFloatingSolver>(model_);
+    dense_->setLocked(locked_);
   }
   const char* stage = "";
   if (const int rc = prepare(stage)) refuse(stage, rc);
@@ -74,6 +87,8 @@ int FloatingSide::reset(const State& state, const FloatingVelocity& before) {
   ready_ = false;
   if (before.qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!before.qdot.data.allFinite() || !allFinite(before.base_twist)) return E_NOT_FINITE;
+  for (unsigned int j = 0; j < model_->nj(); ++j)
+    if (locked_[j] && before.qdot(j) != 0.0) return E_BAD_ARGUMENT;  // a braked joint does not move
   if (const int rc = forwardKinematics(*model_, state, kin_)) return rc;
   before_.base_twist = before.base_twist;
   before_.qdot.data = before.qdot.data;  // sizes checked: no allocation

@@ -26,6 +26,26 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   H_llt_.compute(Eigen::MatrixXd::Identity(n, n));
   H_star_llt_.compute(Eigen::MatrixXd::Identity(n, n));
   reserveContacts(2);  // dual-arm without allocation
+  locked_.assign(n, false);
+  H_locked_work_.setZero(n, n);
+}
+
+int FreeFloatingSolver::setLocked(const std::vector<bool>& locked) {
+  const unsigned int n = model_->nj();
+  if (!locked.empty() && locked.size() != n) return E_SIZE_MISMATCH;
+  locked_.assign(n, false);
+  for (std::size_t j = 0; j < locked.size(); ++j) locked_[j] = locked[j];
+  any_locked_ = false;
+  for (unsigned int j = 0; j < n; ++j) any_locked_ = any_locked_ || locked_[j];
+  computed_ = false;  // the factorisations depend on the locks
+  H_ok_ = false;
+  return E_NOERROR;
+}
+
+void FreeFloatingSolver::dropLocked(Eigen::Ref<Matrix6Xd> J) const {
+  if (!any_locked_) return;
+  for (Eigen::Index j = 0; j < J.cols(); ++j)
+    if (locked_[j]) J.col(j).setZero();
 }
 
 int FreeFloatingSolver::compute(const State& state) {
@@ -88,9 +108,28 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
   H_star_.data.noalias() -= A_m_.transpose().lazyProduct(Am_work_);  // eq. 7
   symmetrize(H_star_.data);
   if (!H_star_.data.allFinite()) return E_NOT_FINITE;
-  H_llt_.compute(H_.data);
-  H_ok_ = H_llt_.info() == Eigen::Success;
-  H_star_llt_.compute(H_star_.data);
+  if (any_locked_) {
+    // Braked coordinates removed: with their rows and columns those of the identity and their
+    // Jacobian columns 0 (dropLocked), J_f H_ff^-1 J_f^T is J H'^-1 J^T and their jumps are 0.
+    const auto unlock = [this](const Eigen::MatrixXd& M) {
+      H_locked_work_ = M;
+      for (Eigen::Index j = 0; j < M.rows(); ++j)
+        if (locked_[j]) {
+          H_locked_work_.row(j).setZero();
+          H_locked_work_.col(j).setZero();
+          H_locked_work_(j, j) = 1.0;
+        }
+    };
+    unlock(H_.data);
+    H_llt_.compute(H_locked_work_);
+    H_ok_ = H_llt_.info() == Eigen::Success;
+    unlock(H_star_.data);
+    H_star_llt_.compute(H_locked_work_);
+  } else {
+    H_llt_.compute(H_.data);
+    H_ok_ = H_llt_.info() == Eigen::Success;
+    H_star_llt_.compute(H_star_.data);
+  }
   if (H_star_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
   state_.world_T_base = kin.state.world_T_base;
   state_.q.data = kin.state.q.data;
@@ -216,6 +255,7 @@ int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
   Matrix6d G_star;
   if (const int rc = G_locked(h, G_star)) return rc;
   generalizedJacobian(h, J_work_);
+  dropLocked(J_work_);
   X_work_ = J_work_.transpose();
   for (int c = 0; c < 6; ++c) H_star_llt_.solveInPlace(X_work_.col(c));  // vector solves: no allocation
   G_star.noalias() += J_work_.lazyProduct(X_work_);  // eq. 11
@@ -229,6 +269,7 @@ int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
   if (const int rc = ready(h)) return rc;
   if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
   fixedBaseJacobian(h, J_work_);
+  dropLocked(J_work_);
   X_work_ = J_work_.transpose();
   for (int c = 0; c < 6; ++c) H_llt_.solveInPlace(X_work_.col(c));
   Matrix6d G_grounded;
@@ -276,6 +317,7 @@ int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const 
   switch (response) {
     case Response::FreeFloating:
       generalizedJacobian(h, J_work_);
+      dropLocked(J_work_);
       dqdot_work_.noalias() = J_work_.transpose() * F;
       H_star_llt_.solveInPlace(dqdot_work_);  // eq. 18: dqdot = H*^-1 J*^T F
       dPL.noalias() = R.transpose() * F;      // eq. 8
@@ -283,6 +325,7 @@ int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const 
     case Response::Grounded:
       if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
       fixedBaseJacobian(h, J_work_);
+      dropLocked(J_work_);
       dqdot_work_.noalias() = J_work_.transpose() * F;
       H_llt_.solveInPlace(dqdot_work_);  // eq. 23
       break;
@@ -317,6 +360,7 @@ int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::Matr
   for (Eigen::Index i = 0; i < k; ++i) {
     if (const int rc = R_h(contacts[i], R_all_work_[i])) return rc;
     generalizedJacobian(contacts[i], J_work_);
+    dropLocked(J_work_);
     J_all.middleRows<6>(6 * i) = J_work_;
   }
   X = J_all.transpose();

@@ -24,6 +24,20 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   dq_.setZero(model_->nj());
   a_.resize(nb);
   pa_.assign(nb, Vector6d::Zero());
+  locked_.assign(model_->nj(), false);
+  moves_.resize(nb);
+  for (std::size_t i = 0; i < nb; ++i) moves_[i] = model_->bodies()[i].joint >= 0;
+}
+
+int RecursiveExIITSolver::setLocked(const std::vector<bool>& locked) {
+  const unsigned int n = model_->nj();
+  if (!locked.empty() && locked.size() != n) return E_SIZE_MISMATCH;
+  locked_.assign(n, false);
+  for (std::size_t j = 0; j < locked.size(); ++j) locked_[j] = locked[j];
+  const std::vector<Body>& bodies = model_->bodies();
+  for (std::size_t i = 0; i < bodies.size(); ++i) moves_[i] = bodies[i].joint >= 0 && !locked_[bodies[i].joint];
+  computed_ = false;  // the articulated inertias depend on the locks
+  return E_NOERROR;
 }
 
 RecursiveExIITSolver::~RecursiveExIITSolver() = default;
@@ -55,7 +69,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
   // Articulated-body inertias, leaves first.
   for (std::size_t i = nb; i-- > 1;) {
     const detail::JointMotion& j = bodies[i];
-    if (j.joint < 0) {
+    if (!moves_[i]) {  // fixed or locked: the body rides on its parent
       IA_[j.parent] += IA_[i];
       continue;
     }
@@ -93,7 +107,6 @@ int RecursiveExIITSolver::G_star(const Contact& h, Matrix6d& G) { return this->G
 KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response response, Matrix6d& G) {
   if (const int rc = ready(h)) return rc;
   if (response != Response::FreeFloating && response != Response::Grounded) return E_BAD_ARGUMENT;
-  const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
   const int count = walkPath(h);
   // Outward along the path, the inverse inertia a wrench at body i meets (about p_b):
   // Omega_0 = (I^A_0)^-1 (a grounded base: 0), Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T
@@ -103,7 +116,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response re
   Matrix6d O = response == Response::FreeFloating ? Omega0_ : Matrix6d::Zero();
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
-    if (bodies[i].joint < 0) continue;
+    if (!moves_[i]) continue;  // fixed or locked
     const double d = Dinv_[i];
     const Vector6d& S = S_[i];
     const Vector6d w = O.leftCols<3>() * U_[i].head<3>() + O.rightCols<3>() * U_[i].tail<3>();  // two chains
@@ -143,17 +156,19 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
   for (int k = 0; k < count - 1; ++k) {
     const int i = path_[k];
     pa_[i] = p;
-    if (bodies[i].joint >= 0) p -= U_[i] * (S_[i].dot(p) * Dinv_[i]);
+    if (moves_[i]) p -= U_[i] * (S_[i].dot(p) * Dinv_[i]);
   }
   // The base's jump (eq. 18); a grounded base does not move (eq. 23). The joints' jumps outward.
   a_[0] = response == Response::FreeFloating ? Vector6d(-(Omega0_ * p)) : Vector6d::Zero();
   for (std::size_t i = 1; i < bodies.size(); ++i) {
     const detail::JointMotion& b = bodies[i];
     a_[i] = a_[b.parent];
-    if (b.joint >= 0) {
+    if (moves_[i]) {
       const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) * Dinv_[i];
       dq_(b.joint) = qdd;
       a_[i] += S_[i] * qdd;
+    } else if (b.joint >= 0) {
+      dq_(b.joint) = 0.0;  // braked: exactly no jump
     }
   }
   for (int k = 0; k < count - 1; ++k) pa_[path_[k]].setZero();  // zero off the path, as it was

@@ -41,9 +41,29 @@ KDL::JntArray joints(const Field& f, const FloatingModel& model) {
   return jointsByName(model, values);
 }
 
+/// The joints braked at the impact (`locked: [joint, ...]`), as flags in model order: each a
+/// movable joint of the model, named once, whose rate `qdot` is 0 (a braked joint does not move).
+std::vector<bool> lockedJoints(const Field& f, const FloatingModel& model, const KDL::JntArray& qdot,
+                               const std::string& qdot_path) {
+  std::vector<bool> locked(model.nj(), false);
+  for (const Field& item : f.items("joint names")) {
+    const std::string name = item.text();
+    const int j = model.jointIndex(name);
+    if (j < 0)
+      item.fail("the model has no movable joint " + echo(name) + " (its movable joints: " +
+                listNames(model.jointNames()) + ")");
+    if (locked[j]) item.fail("joint " + echo(name) + " is listed twice");
+    if (qdot(j) != 0.0)
+      item.fail("joint " + echo(name) + " is braked, so its rate " + qdot_path + "." + name + " must be 0, got " +
+                number(qdot(j)));
+    locked[j] = true;
+  }
+  return locked;
+}
+
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked"});
   FloatingSystem s;
   const Field urdf = f.at("urdf");
   urdf_path = urdf.text();
@@ -68,6 +88,8 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
   }
   if (f.has("q")) s.state.q = joints(f.at("q"), *s.model);
   if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model);
+  if (f.has("locked"))
+    s.locked = lockedJoints(f.at("locked"), *s.model, s.velocity.qdot, (f.path().empty() ? "" : f.path() + ".") + "qdot");
   const Field contact = f.at("contact");
   contact.onlyKeys({"link", "offset"});
   const std::string link = contact.at("link").text();

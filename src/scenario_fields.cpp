@@ -114,11 +114,11 @@ std::map<std::string, double> Field::namedNumbers() const {
   return values;
 }
 
-std::vector<Field> Field::items() const {
-  if (!node_.IsSequence()) fail("expected a list, got " + kindOf(node_));
-  std::vector<Field> items;
-  for (std::size_t i = 0; i < node_.size(); ++i) items.push_back(child(node_[i], path_ + "[" + std::to_string(i) + "]"));
-  return items;
+std::vector<Field> Field::items(const std::string& what) const {
+  if (!node_.IsSequence()) fail("expected a list of " + what + ", got " + kindOf(node_));
+  std::vector<Field> list;
+  for (std::size_t i = 0; i < node_.size(); ++i) list.push_back(child(node_[i], path_ + "[" + std::to_string(i) + "]"));
+  return list;
 }
 
 bool Field::flag() const {

@@ -46,8 +46,8 @@ class Field {
   Eigen::Matrix3d matrix3() const;
   /// A mapping NAME: finite number.
   std::map<std::string, double> namedNumbers() const;
-  /// The elements of a list (paths "PATH[i]").
-  std::vector<Field> items() const;
+  /// The items of a list, each with its path PATH[i] ("expected a list of `what`, got ..." else).
+  std::vector<Field> items(const std::string& what) const;
   /// true or false.
   bool flag() const;
   /// A number, or a list of 3 (one value for three axes).

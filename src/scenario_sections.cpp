@@ -224,7 +224,7 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
   }
   if (f.has("base_control")) s.base_control = baseControl(f.at("base_control"));
   if (f.has("wrenches"))
-    for (const Field& w : f.at("wrenches").items()) s.wrenches.push_back(wrench(w, robot));
+    for (const Field& w : f.at("wrenches").items("wrenches {link, force, torque, start, end}")) s.wrenches.push_back(wrench(w, robot));
   return s;
 }
 

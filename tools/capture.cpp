@@ -20,6 +20,14 @@ const char* lawName(ImpactKind k) {
   return "";
 }
 
+/// The names of the joints a system brakes at the impact (model order).
+std::vector<std::string> lockedNames(const FloatingSystem& s) {
+  std::vector<std::string> names;
+  for (std::size_t j = 0; j < s.locked.size(); ++j)
+    if (s.locked[j]) names.push_back(s.model->jointNames()[j]);
+  return names;
+}
+
 std::string row(const Eigen::VectorXd& v) {
   std::ostringstream s;
   s << std::setprecision(6) << "[";
@@ -50,6 +58,7 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
     jt["joints_treated_as_fixed"] = fixedJointsJson(*std::get<FloatingSystem>(p.target).model);
     jt["qdot_before"] = toJson(other.before.qdot.data);
     jt["qdot_after"] = toJson(other.after.qdot.data);
+    jt["locked_joints"] = lockedNames(std::get<FloatingSystem>(p.target));
   }
   Json j;
   j["impulse"] = toJson(r.impulse.F);
@@ -60,7 +69,8 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
                     {"qdot_before", toJson(r.robot.before.qdot.data)},
                     {"qdot_after", toJson(r.robot.after.qdot.data)},
                     {"contact_twist_before", toJson(r.robot.contact_twist_before)},
-                    {"contact_twist_after", toJson(r.robot.contact_twist_after)}};
+                    {"contact_twist_after", toJson(r.robot.contact_twist_after)},
+                    {"locked_joints", lockedNames(p.robot)}};
   j["target"] = jt;
   j["momentum_before"] = toJson(r.momentum_before);
   j["momentum_after"] = toJson(r.momentum_after);
@@ -91,6 +101,12 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
     out << (r.impulse.sticking ? "Contact sticks at the end of the impact.\n" : "Contact slides at the end of the impact.\n");
   out << "Contact point " << row(r.contact_point) << " m on link '"
       << p.robot.model->bodies()[p.robot.contact.body].name << "'\n";
+  const std::vector<std::string> braked = lockedNames(p.robot);
+  if (!braked.empty()) {
+    out << "Braked joints (locked at the impact, rates stay 0):";
+    for (std::size_t k = 0; k < braked.size(); ++k) out << (k ? ", '" : " '") << braked[k] << "'";
+    out << "\n";
+  }
   out << "Impulse on the robot (f; n) [N s; N m s]: " << row(r.impulse.F) << "\n";
   out << "Robot contact twist (v; w): before " << row(robot.contact_twist_before) << "\n"
       << "                            after  " << row(robot.contact_twist_after) << "\n";

@@ -74,7 +74,8 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
   JointControl locked;
   locked.mode = JointControl::Mode::Locked;
   for (unsigned int j = 0; j < robot.model->nj(); ++j)
-    if (robot.response == Response::JointsLocked) sim->setJointControl(jointIn(*model, *robot.model, j), locked);
+    if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j]))
+      sim->setJointControl(jointIn(*model, *robot.model, j), locked);
   for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(*model, *robot.model, joint), control);
   for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(*model, *robot.model, joint), mode);
   sim->setBaseControl(spec.base_control);

@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <memory>
+#include <vector>
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/free_floating_solver.hpp"
@@ -62,6 +63,10 @@ struct FloatingSystem {
   FloatingVelocity velocity;   ///< base twist (of the base origin) and joint rates
   Contact contact;             ///< where it touches
   Response response = Response::FreeFloating;  ///< free, grounded or joints locked
+  /// Joints braked at the impact (model order, size model->nj(); empty: none): the system's G is
+  /// that of the partly locked system and their rates stay 0 (they must be 0 before). With
+  /// Response::JointsLocked every joint is braked anyway.
+  std::vector<bool> locked;
 };
 
 /// \brief A free-floating robot (or grounded, or with locked joints) as an impact side.
@@ -72,29 +77,33 @@ struct FloatingSystem {
 /// grounded G and the velocity jump by the articulated-body recursion, the locked G, momentum,
 /// energy and twists by MomentumSolver; no n x n matrix is built. A model with mimic joints
 /// always takes the dense route (the recursion cannot couple joints). ExIITMethod::Dense uses the
-/// paper's formulas (FreeFloatingSolver) for G and the velocity jump.
+/// paper's formulas (FreeFloatingSolver) for G and the velocity jump. Braked joints (`locked`)
+/// are fixed joints to both routes (on the dense one a braked mimic leader brakes its followers).
 class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
  public:
   /// \throws ModelError (a set-up call) if the model is null, the state or velocity has the
   /// wrong size or is not finite, the contact is no body of the model or its offset is not
-  /// finite, `response` or `method` is no enumerator, or the response is unavailable (grounded
-  /// with a singular H). The message starts with "FloatingSide: ".
+  /// finite, `response` or `method` is no enumerator, the response is unavailable (grounded
+  /// with a singular H), `locked` has another size than nj() (or 0), or a braked joint's rate
+  /// before is not 0 (named). The message starts with "FloatingSide: ".
+  /// \param locked joints braked at the impact (FloatingSystem::locked).
   FloatingSide(std::shared_ptr<const FloatingModel> model, const State& state, const Contact& h,
                const FloatingVelocity& before, Response response = Response::FreeFloating,
-               ExIITMethod method = ExIITMethod::Recursive);
+               ExIITMethod method = ExIITMethod::Recursive, std::vector<bool> locked = {});
   /// \brief The same from the kinematics of the side's state, already computed by
   /// forwardKinematics for `model` (the side keeps them: it owns its state). \throws ModelError
   /// as above, or if `kin` is not a successful forwardKinematics of `model`.
   FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematics kin, const Contact& h,
                const FloatingVelocity& before, Response response = Response::FreeFloating,
-               ExIITMethod method = ExIITMethod::Recursive);
+               ExIITMethod method = ExIITMethod::Recursive, std::vector<bool> locked = {});
   explicit FloatingSide(const FloatingSystem& system, ExIITMethod method = ExIITMethod::Recursive);
   ~FloatingSide() override;
 
   /// \brief The same side at another state and velocity (same model, contact, response and
-  /// method), reusing its solvers and workspaces: a compute call, allocation-free, that never
-  /// throws. \return 0, or the code of the part that refused (E_SIZE_MISMATCH, E_NOT_FINITE,
-  /// E_NOT_POSITIVE_DEFINITE...); on an error the side answers nothing (applyImpulse returns
+  /// method and braked joints), reusing its solvers and workspaces: a compute call,
+  /// allocation-free, that never throws. \return 0, or the code of the part that refused
+  /// (E_SIZE_MISMATCH, E_NOT_FINITE, E_NOT_POSITIVE_DEFINITE, E_BAD_ARGUMENT for a braked joint
+  /// whose rate is not 0...); on an error the side answers nothing (applyImpulse returns
   /// E_NOT_COMPUTED) until a successful reset.
   int reset(const State& state, const FloatingVelocity& before);
 
@@ -114,6 +123,8 @@ class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
   const Kinematics& kinematics() const { return kin_; }
   const Contact& contact() const { return h_; }
   Response response() const { return response_; }
+  /// The joints braked at the impact (model order, size nj(); all false if none).
+  const std::vector<bool>& locked() const { return locked_; }
   /// World position of the contact point.
   Vector3d contactPoint() const { return kin_.point(h_); }
   const FloatingVelocity& before() const { return before_; }
@@ -131,6 +142,7 @@ class KDL_SPACE_EXPORT FloatingSide : public ImpactSide {
   std::unique_ptr<FreeFloatingSolver> dense_;        ///< ExIITMethod::Dense, free or grounded
   Contact h_;
   Response response_;
+  std::vector<bool> locked_;  ///< per joint: braked (size nj())
   Matrix6d G_;
   FloatingVelocity before_, after_;
   Vector6d h_before_, h_after_, t_before_, t_after_, v_g_before_, v_g_after_;

@@ -44,6 +44,18 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   const FloatingModel& model() const { return *model_; }
   const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
 
+  /// \brief Joints braked at the impact (model order, size nj(); empty: none). G_star, G_grounded,
+  /// G (FreeFloating, Grounded) and velocityJump then answer for the partly locked system: the
+  /// braked coordinates removed, G* = J*_f H*_ff^-1 J*_f^T + R_h M_a^-1 R_h^T and
+  /// G = J_f H_ff^-1 J_f^T with f the free joints; their rate jumps are exactly 0 (a mimic
+  /// joint follows its leader's coordinate: braked with it). The accessors (H, H*, A_m, J, J*)
+  /// and momentum, energy, handTwist stay those of the whole model. A set-up call (it may
+  /// allocate); takes effect at the next compute(). \return 0, or E_SIZE_MISMATCH (another size
+  /// than nj() or 0; the locks are unchanged).
+  int setLocked(const std::vector<bool>& locked);
+  /// The braked joints (model order, size nj(); all false unless setLocked says otherwise).
+  const std::vector<bool>& locked() const { return locked_; }
+
   /// \brief Centroid terms, H, A_m, H* at the state of `kin`; factorises H* and H.
   /// \return E_NOERROR, E_SIZE_MISMATCH (kin of another model), E_NOT_COMPUTED (kin not valid),
   /// E_NOT_FINITE (a state so far away that the centroid terms overflow), or
@@ -139,6 +151,8 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   void fixedBaseJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J) const;
   /// J* of h into J_star (6 x n, sized), eq. 4.
   void generalizedJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J_star) const;
+  /// Zeroes the columns of the braked joints (J_f, J*_f with the locked columns 0).
+  void dropLocked(Eigen::Ref<Matrix6Xd> J) const;
   /// x <- M_a^-1 x for a 6-row block (M_a is block diagonal: 1/w and a factorised I_g).
   void M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const;
 
@@ -146,6 +160,9 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   Kinematics own_;  ///< for compute(State) only
   bool computed_ = false;
   bool H_ok_ = false;
+  std::vector<bool> locked_;     ///< per joint: braked (setLocked)
+  bool any_locked_ = false;
+  Eigen::MatrixXd H_locked_work_;  ///< H or H* with the braked rows and columns made those of the identity (n x n)
   KDL::Frame world_T_base_;
   State state_;                           ///< copy of the last computed state
   std::vector<KDL::Frame> world_T_body_;  ///< per body

@@ -34,6 +34,8 @@ struct Symmetric6d;  // src/detail/symmetric6d.hpp: a packed symmetric 6x6
 /// G* = R_h Omega R_h^T (eq. 5, 11) = J_full M_full^-1 J_full^T without any n x n matrix.
 /// `velocityJump`: the impulse's bias forces from h's body to the base, the base's jump
 /// -(I^A_0)^-1 p^A_0, and the joints' jumps outward.
+/// Joints braked at the impact (setLocked) are fixed joints to all three: their bodies' articulated
+/// inertias pass to the parent whole, the path skips them, their rate jumps are exactly 0.
 /// Compute calls return 0 or an Error code and never throw.
 class KDL_SPACE_EXPORT RecursiveExIITSolver {
  public:
@@ -42,6 +44,15 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   RecursiveExIITSolver(const RecursiveExIITSolver&);
   RecursiveExIITSolver& operator=(const RecursiveExIITSolver&);
   const FloatingModel& model() const { return *model_; }
+
+  /// \brief Joints braked at the impact (model order, size nj(); empty: none): each is treated as
+  /// a fixed joint at its current position by compute, G and velocityJump (for FreeFloating and
+  /// Grounded), so G is that of the partly locked system and their rate jumps are exactly 0. A
+  /// set-up call (it may allocate); takes effect at the next compute().
+  /// \return 0, or E_SIZE_MISMATCH (another size than nj() or 0; the locks are unchanged).
+  int setLocked(const std::vector<bool>& locked);
+  /// The braked joints (model order, size nj(); all false unless setLocked says otherwise).
+  const std::vector<bool>& locked() const { return locked_; }
 
   /// \brief Articulated-body inertias at the state of `kin` (forwardKinematics of this model).
   /// Keeps what its queries need; no reference to `kin`.
@@ -79,6 +90,8 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::shared_ptr<const FloatingModel> model_;
   Kinematics own_;                                 ///< for compute(State) only
   bool computed_ = false;
+  std::vector<bool> locked_;                       ///< per joint: braked (setLocked)
+  std::vector<char> moves_;                        ///< per body: a joint that moves (not fixed, not locked)
   Vector3d p_b_ = Vector3d::Zero();                ///< base origin: the common reference point
   std::vector<Matrix3d> R_;                        ///< per body: world rotation (copied from kin)
   std::vector<Vector3d> p_;                        ///< per body: world position of the frame origin

@@ -44,6 +44,8 @@ struct Scenario {
 /// \brief Reads and checks a scenario file; URDF paths are relative to the scenario's folder.
 /// Every number is finite, every name exists in its model, a rigid target's mass and inertia
 /// are those of a rigid body; a free-floating target's contact is checked by solveCapture.
+/// The joints a system's `locked:` list brakes at the impact are in its FloatingSystem::locked
+/// (`capture.robot.locked`: what a simulation keeps braked after the impact too).
 /// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
 /// be > 0 kg, got -3") for every problem, the file's own (missing, empty, not YAML) included.
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);

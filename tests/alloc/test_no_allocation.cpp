@@ -189,6 +189,11 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   std::vector<bool> locked(n, false);
   locked[n / 2] = true;
   ASSERT_EQ(locked_fd.setLocked(locked), E_NOERROR);
+  // The impact solvers with braked joints (set up before counting).
+  FreeFloatingSolver locked_solver(model);
+  RecursiveExIITSolver locked_recursive(model);
+  ASSERT_EQ(locked_solver.setLocked(locked), E_NOERROR);
+  ASSERT_EQ(locked_recursive.setLocked(locked), E_NOERROR);
   Kinematics kin(*model);
   MomentumSolver momentum(model);
   KDL::JntArray qdot(n), tau(n), dqdot(n);
@@ -214,6 +219,13 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   FloatingSide robot_dense(solver.sharedModel(), solver.state(), h, v, Response::FreeFloating, ExIITMethod::Dense);
   FloatingSide robot_grounded(solver.sharedModel(), solver.state(), h, v, Response::Grounded);
   FloatingSide robot_locked(solver.sharedModel(), solver.state(), h, v, Response::JointsLocked);
+  FloatingVelocity braked_v = v;
+  for (unsigned int j = 0; j < n; ++j)
+    if (locked[j]) braked_v.qdot(j) = 0.0;  // a braked joint does not move
+  FloatingSide robot_braked(solver.sharedModel(), solver.state(), h, braked_v, Response::FreeFloating,
+                            ExIITMethod::Recursive, locked);
+  FloatingSide robot_braked_dense(solver.sharedModel(), solver.state(), h, braked_v, Response::Grounded,
+                                  ExIITMethod::Dense, locked);
   RigidBodySide target(box, p_h);
   const Matrix6d G_B = target.G();
 
@@ -255,6 +267,17 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
   NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, F, d_base, dqdot), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(recursive.G(h, Response::Grounded, G), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(recursive.velocityJump(h, Response::Grounded, F, d_base, dqdot), E_NOERROR));
+  for (const State* s : {&state, &other}) {
+    NO_ALLOCATION(EXPECT_EQ(locked_solver.compute(*s), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(locked_recursive.compute(*s), E_NOERROR));
+  }
+  NO_ALLOCATION(EXPECT_EQ(locked_solver.G_star(contacts, G_all), E_NOERROR));
+  for (Response r : {Response::FreeFloating, Response::Grounded}) {
+    NO_ALLOCATION(EXPECT_EQ(locked_solver.G(h, r, G), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(locked_solver.velocityJump(h, r, F, dPL, dqdot), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(locked_recursive.G(h, r, G), E_NOERROR));
+    NO_ALLOCATION(EXPECT_EQ(locked_recursive.velocityJump(h, r, F, d_base, dqdot), E_NOERROR));
+  }
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(state, v, tau, no_wrenches, a), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(fd.CartToJnt(other, v, tau, wrenches, a), E_NOERROR));
   NO_ALLOCATION(EXPECT_EQ(forwardKinematics(*model, other, kin), E_NOERROR));
@@ -275,7 +298,11 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
       NO_ALLOCATION(EXPECT_EQ(side->reset(other, v), E_NOERROR));
       NO_ALLOCATION(EXPECT_EQ(side->reset(state, v), E_NOERROR));
     }
-    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded, &robot_locked})
+    for (FloatingSide* side : {&robot_braked, &robot_braked_dense}) {
+      NO_ALLOCATION(EXPECT_EQ(side->reset(other, braked_v), E_NOERROR));
+      NO_ALLOCATION(EXPECT_EQ(side->reset(state, braked_v), E_NOERROR));
+    }
+    for (FloatingSide* side : {&robot, &robot_dense, &robot_grounded, &robot_locked, &robot_braked, &robot_braked_dense})
       NO_ALLOCATION(EXPECT_EQ(side->applyImpulse(impulse.F), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(target.applyImpulse(-impulse.F), E_NOERROR));
     NO_ALLOCATION(EXPECT_EQ(collide(robot, target, law, impulse), E_NOERROR));

@@ -42,7 +42,9 @@ TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
                                                "virtual_mass"}));
   EXPECT_EQ(keys(j.at("robot")), (std::vector<std::string>{"base_twist_after", "base_twist_before",
                                                            "contact_twist_after", "contact_twist_before",
-                                                           "joint_names", "joints_treated_as_fixed", "qdot_after", "qdot_before"}));
+                                                           "joint_names", "joints_treated_as_fixed", "locked_joints",
+                                                           "qdot_after", "qdot_before"}));
+  EXPECT_EQ(j.at("robot").at("locked_joints"), nlohmann::json::array()) << "none braked";
   EXPECT_EQ(keys(j.at("target")), (std::vector<std::string>{"twist_after", "twist_before"}));
 
   const nlohmann::json& robot = j.at("robot");
@@ -116,6 +118,62 @@ target:
   twist: [-0.1, 0, 0, 0, 0, 0]
 law: {type: point, normal: [1, 0, 0], restitution: 0.5}
 )";
+
+// `robot.locked`: the braked joints are reported by name and keep rate 0 through the impact;
+// without the brakes the same scenario moves them (the check can fail).
+TEST(CaptureTool, BrakedJointsAreReportedAndStayStill) {
+  const std::string text = R"(
+robot:
+  urdf: ../../../urdf/space_arm7.urdf
+  contact: {link: end_effector, offset: [0, 0, 0.05]}
+  base: {twist: [0.002, 0, 0, 0, 0, 0.001]}
+  q: {joint2: 0.7, joint3: 0.9, joint5: -0.4, joint6: 0.6}
+  qdot: {joint1: 0.02}
+  mode: MODE
+  locked: [joint6, joint2]
+target:
+  mass: 50
+  inertia: [[2.1, 0, 0], [0, 2.6, 0], [0, 0, 3.0]]
+  pose: {position: [0.3, -2.9, 1.7]}
+  twist: [0.03, -0.02, 0.01, 0.05, 0.08, -0.06]
+law: {type: capture}
+)";
+  for (const std::string mode : {"free", "grounded"}) {
+    SCOPED_TRACE(mode);
+    std::string braked = text;
+    braked.replace(braked.find("MODE"), 4, mode);
+    std::string free = braked;
+    free.erase(free.find("  locked:"), std::string("  locked: [joint6, joint2]\n").size());
+    const std::string braked_file = scenarioFile("braked_" + mode, braked), free_file = scenarioFile("free_" + mode, free);
+    const ToolRun r = kdlSpace("capture " + braked_file + " --json");
+    const ToolRun u = kdlSpace("capture " + free_file + " --json");
+    const ToolRun summary = kdlSpace("capture " + braked_file);
+    const ToolRun free_summary = kdlSpace("capture " + free_file);
+    std::remove(braked_file.c_str());
+    std::remove(free_file.c_str());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    ASSERT_EQ(u.rc, 0) << u.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out), k = nlohmann::json::parse(u.out);
+    const nlohmann::json& robot = j.at("robot");
+    EXPECT_EQ(robot.at("locked_joints"), nlohmann::json::parse(R"(["joint2", "joint6"])")) << "model order";
+    EXPECT_EQ(k.at("robot").at("locked_joints"), nlohmann::json::array());
+    const std::vector<std::string> names = robot.at("joint_names");
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == "joint2" || names[i] == "joint6") {
+        EXPECT_EQ(robot.at("qdot_after").at(i).get<double>(), 0.0) << names[i];
+        EXPECT_GT(std::abs(k.at("robot").at("qdot_after").at(i).get<double>()), 1e-6) << names[i] << " moves unbraked";
+      }
+    if (mode == "free") {
+      const Eigen::MatrixXd before = m(j.at("momentum_before")), after = m(j.at("momentum_after"));
+      EXPECT_TRUE(near(after, before, 1e-9, 1e-9 * before.norm(), "momentum"));
+    }
+    ASSERT_EQ(summary.rc, 0) << summary.err;
+    EXPECT_NE(summary.out.find("Braked joints (locked at the impact, rates stay 0): 'joint2', 'joint6'\n"),
+              std::string::npos)
+        << summary.out;
+    EXPECT_EQ(free_summary.out.find("Braked joints"), std::string::npos);
+  }
+}
 
 TEST(CaptureTool, BadScenariosNameTheField) {
   const std::string good = kGood;

@@ -118,6 +118,12 @@ const std::vector<Broken>& corpus() {
       {"unknown_joint.yaml",
        "{f}:6: robot.q.elbow: the model has no movable joint 'elbow' (its movable joints: joint1, joint2)", false},
       {"bad_mode.yaml", "{f}:8: robot.mode: 'floating' is not one of free, grounded, locked", false},
+      {"locked_unknown_joint.yaml",
+       "{f}:9: robot.locked[0]: the model has no movable joint 'elbow' (its movable joints: joint1, joint2)", false},
+      {"locked_twice.yaml", "{f}:9: robot.locked[1]: joint 'joint1' is listed twice", false},
+      {"locked_not_a_list.yaml", "{f}:9: robot.locked: expected a list of joint names, got 'joint1'", false},
+      {"locked_joint_moves.yaml",
+       "{f}:9: robot.locked[1]: joint 'joint2' is braked, so its rate robot.qdot.joint2 must be 0, got 0.1", false},
       {"base_far_away.yaml",
        "{f}: robot: the free-floating quantities cannot be computed at this state (robot.base, robot.q): an input "
        "holds NaN or infinite values, or a result overflowed",

@@ -210,6 +210,23 @@ TEST(ForwardDynamicsCodes, CartToJntChecksEverySizeAndValue) {
   EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, tau, none, a), E_NOERROR));
 
   EXPECT_EQ(fd.setLocked(std::vector<bool>(n + 1)), E_SIZE_MISMATCH);
+  // The impact solvers' brakes: size nj() or empty (none); a refusal keeps the locks.
+  RecursiveExIITSolver recursive(model);
+  FreeFloatingSolver dense(model);
+  std::vector<bool> one(n, false);
+  one[0] = true;
+  EXPECT_EQ(recursive.setLocked(one), E_NOERROR);
+  EXPECT_EQ(dense.setLocked(one), E_NOERROR);
+  for (const std::size_t size : {std::size_t{1}, std::size_t{n - 1}, std::size_t{n + 1}}) {
+    EXPECT_EQ(recursive.setLocked(std::vector<bool>(size, true)), E_SIZE_MISMATCH) << size;
+    EXPECT_EQ(dense.setLocked(std::vector<bool>(size, true)), E_SIZE_MISMATCH) << size;
+  }
+  EXPECT_EQ(recursive.locked(), one) << "unchanged after a refusal";
+  EXPECT_EQ(dense.locked(), one) << "unchanged after a refusal";
+  EXPECT_EQ(recursive.setLocked({}), E_NOERROR);
+  EXPECT_EQ(dense.setLocked({}), E_NOERROR);
+  EXPECT_EQ(recursive.locked(), std::vector<bool>(n, false)) << "empty: none";
+  EXPECT_EQ(dense.locked(), std::vector<bool>(n, false)) << "empty: none";
   EXPECT_EQ(fd.setGravity(Vector3d(0, 0, kNaN)), E_NOT_FINITE);
   EXPECT_EQ(fd.gravity(), Vector3d::Zero()) << "unchanged after a refusal";
   EXPECT_EQ(fd.setGravity(Vector3d(0, 0, -9.81)), E_NOERROR);

@@ -75,6 +75,27 @@ TEST(LoadScenario, AFreeFloatingTarget) {
   EXPECT_TRUE(r.floating_target.has_value());
 }
 
+TEST(LoadScenario, BrakedJointsOfTheRobotAndOfAFreeFloatingTarget) {
+  const Scenario s = loadScenario(dataDir() + "/scenarios/braked_robot_to_robot.yaml");
+  const FloatingSystem& robot = s.capture.robot;
+  ASSERT_TRUE(std::holds_alternative<FloatingSystem>(s.capture.target));
+  const FloatingSystem& target = std::get<FloatingSystem>(s.capture.target);
+  EXPECT_EQ(robot.locked, (std::vector<bool>{false, false, false, false, false, true, true}));  // model order
+  EXPECT_EQ(target.locked, (std::vector<bool>{false, true}));
+  const CaptureResult r = solveCapture(s.capture);
+  ASSERT_TRUE(r.floating_target.has_value());
+  EXPECT_EQ(r.robot.after.qdot(robot.model->jointIndex("joint6")), 0.0);
+  EXPECT_EQ(r.robot.after.qdot(robot.model->jointIndex("joint7")), 0.0);
+  EXPECT_EQ(r.floating_target->after.qdot(target.model->jointIndex("joint2")), 0.0);
+  EXPECT_NE(r.robot.after.qdot(robot.model->jointIndex("joint5")), 0.0) << "an unbraked joint moves";
+  EXPECT_TRUE(near(r.momentum_after, r.momentum_before, 1e-9, 1e-9 * r.momentum_before.norm(), "momentum"));
+  // Without the brakes the same capture moves those joints.
+  CaptureProblem unbraked = s.capture;
+  unbraked.robot.locked.clear();
+  std::get<FloatingSystem>(unbraked.target).locked.clear();
+  EXPECT_NE(solveCapture(unbraked).robot.after.qdot(robot.model->jointIndex("joint7")), 0.0);
+}
+
 TEST(LoadScenario, EveryShippedAndTestScenarioLoadsAndSolves) {
   int count = 0;
   for (const std::string& folder : {kShipped, dataDir() + "/scenarios/"})
@@ -124,6 +145,9 @@ TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
   EXPECT_EQ(refusal(kBroken + "huge_number.yaml"),
             kBroken + "huge_number.yaml:10: target.mass: '1e400' is too large (not a finite number)");
   EXPECT_EQ(refusal(kBroken + "empty.yaml"), kBroken + "empty.yaml: the file is empty; expected a scenario file (YAML or JSON)");
+  EXPECT_EQ(refusal(kBroken + "locked_joint_moves.yaml"),
+            kBroken + "locked_joint_moves.yaml:9: robot.locked[1]: joint 'joint2' is braked, so its rate "
+                      "robot.qdot.joint2 must be 0, got 0.1");
   EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
 }
 
