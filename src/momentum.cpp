@@ -59,6 +59,9 @@ int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
   Vector6d h_b;
   double twoT = 0.0;
   sweep(kin, toEigen(v.base_twist), v.qdot.data, h_b, twoT);
+  // The rotors' own energy, as the armature on H's diagonal (their momentum is neglected, as in H)
+  const std::vector<double>& armature = model_->armature();
+  for (unsigned int j = 0; j < model_->nj(); ++j) twoT += armature[j] * v.qdot(j) * v.qdot(j);
   p_b_ = kin.p_b;
   r_g_ = kin.r_g;
   for (std::size_t i = 0; i < nb; ++i) {

@@ -61,9 +61,24 @@ std::vector<bool> lockedJoints(const Field& f, const FloatingModel& model, const
   return locked;
 }
 
+/// A joint's armature: a reflected inertia [kg m^2 or kg], or {rotor_inertia: I, gear_ratio: n}
+/// for n^2 I.
+double rotorInertia(const Field& f) {
+  if (f.isScalar()) {
+    const double a = f.number();
+    if (a < 0.0) f.fail("must be >= 0, got " + number(a));
+    return a;
+  }
+  f.onlyKeys({"rotor_inertia", "gear_ratio"});
+  const double I = f.at("rotor_inertia").number(), n = f.at("gear_ratio").number();
+  if (I < 0.0) f.at("rotor_inertia").fail("must be >= 0, got " + number(I));
+  if (!(n > 0.0)) f.at("gear_ratio").fail("must be > 0, got " + number(n));
+  return n * n * I;
+}
+
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature"});
   FloatingSystem s;
   const Field urdf = f.at("urdf");
   urdf_path = urdf.text();
@@ -77,6 +92,11 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
     urdf.fail(e.what());
   } catch (const ModelError& e) {
     urdf.fail(e.what());
+  }
+  if (f.has("armature")) {  // rotor inertias, reflected: a number, or n^2 I_rotor
+    std::vector<double> armature = s.model->armature();
+    for (const auto& [j, value] : sections::byJoint<double>(f.at("armature"), *s.model, rotorInertia)) armature[j] = value;
+    s.model = std::make_shared<const FloatingModel>(s.model->withArmature(armature));
   }
   s.state = State(*s.model);
   s.velocity = FloatingVelocity(*s.model);

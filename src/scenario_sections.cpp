@@ -1,7 +1,5 @@
 #include "scenario_sections.hpp"
 
-#include <fnmatch.h>
-
 #include <cmath>
 
 #include "detail/text.hpp"
@@ -13,36 +11,6 @@ using detail::listNames;
 using detail::number;
 using fields::echo;
 using fields::Field;
-
-/// Per-joint values given by name or pattern, resolved to joint indices: "*" first, then the
-/// other patterns in file order, then exact names (the most specific wins). A name that is no
-/// joint and a pattern that matches none are refused.
-template <typename T, typename Read>
-std::vector<std::pair<unsigned int, T>> byJoint(const Field& f, const FloatingModel& robot, Read read) {
-  const std::vector<std::string>& names = robot.jointNames();
-  std::vector<std::pair<int, T>> chosen(names.size(), {-1, T{}});  // (rank, value)
-  const std::vector<std::string> keys = f.keys();
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    const std::string& key = keys[k];
-    const Field entry = f.at(key);
-    const bool pattern = key.find_first_of("*?[") != std::string::npos;
-    const int rank = key == "*" ? 0 : pattern ? 1 + static_cast<int>(k) : 1 << 30;
-    bool matched = false;
-    const T value = read(entry);
-    for (std::size_t j = 0; j < names.size(); ++j) {
-      if (pattern ? fnmatch(key.c_str(), names[j].c_str(), 0) != 0 : key != names[j]) continue;
-      matched = true;
-      if (rank >= chosen[j].first) chosen[j] = {rank, value};
-    }
-    if (!matched)
-      entry.fail(std::string(pattern ? "the pattern matches no movable joint" : "the robot has no movable joint " + echo(key)) +
-                 " (its movable joints: " + listNames(names) + ")");
-  }
-  std::vector<std::pair<unsigned int, T>> out;
-  for (std::size_t j = 0; j < names.size(); ++j)
-    if (chosen[j].first >= 0) out.emplace_back(static_cast<unsigned int>(j), chosen[j].second);
-  return out;
-}
 
 /// One joint's control: free, locked or {pd: {kp, kd, set_point: NUMBER | hold}}.
 JointControl jointControl(const Field& j) {

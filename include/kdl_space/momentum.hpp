@@ -34,6 +34,7 @@ class KDL_SPACE_EXPORT MomentumSolver {
   /// Total momentum (P_g; L_g about the system CoM r_g), eq. 2.
   const Vector6d& momentumAtCoM() const { return PL_g_; }
   /// Kinetic energy [J].
+  /// Kinetic energy [J], the rotors' (1/2 armature qdot^2) included, as in the dense H.
   double kineticEnergy() const { return T_; }
   /// Locked twist at the CoM: (v_g; w_g) = M_a^-1 (P_g; L_g) (eq. 12).
   const Vector6d& centroidTwist() const { return v_g_; }

@@ -16,6 +16,38 @@ namespace {
 
 constexpr double kRel = 1e-10;
 
+// The rotors' energy: with an armature a_j on every joint, T = 1/2 nu^T M nu with a on H's diagonal
+// (the dense route), and exactly 1/2 sum a_j qdot_j^2 more than without.
+TEST(MomentumSolver, KineticEnergyCountsTheRotors) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto bare = std::make_shared<const FloatingModel>(loadUrdfFile(urdfDir() + "/space_arm7.urdf"));
+  std::vector<double> armature(bare->nj());
+  for (double& a : armature) a = 2.0 + u(rng);
+  const auto geared = std::make_shared<const FloatingModel>(bare->withArmature(armature));
+  FreeFloatingSolver dense(geared);
+  MomentumSolver fast(geared), fast_bare(bare);
+  Kinematics kin(*geared), kin_bare(*bare);
+  const State state = randomState(*geared, rng);
+  FloatingVelocity v(*geared);
+  v.base_twist = KDL::Twist(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+  double rotors = 0.0;
+  for (unsigned int j = 0; j < geared->nj(); ++j) {
+    v.qdot(j) = u(rng);
+    rotors += 0.5 * armature[j] * v.qdot(j) * v.qdot(j);
+  }
+  ASSERT_EQ(dense.compute(state), E_NOERROR);
+  ASSERT_EQ(forwardKinematics(*geared, state, kin), E_NOERROR);
+  ASSERT_EQ(forwardKinematics(*bare, state, kin_bare), E_NOERROR);
+  ASSERT_EQ(fast.compute(kin, v), E_NOERROR);
+  ASSERT_EQ(fast_bare.compute(kin_bare, v), E_NOERROR);
+  double T = 0.0;
+  ASSERT_EQ(dense.kineticEnergy(v.base_twist, v.qdot, T), E_NOERROR);
+  EXPECT_NEAR(fast.kineticEnergy(), T, kRel * T);
+  EXPECT_NEAR(fast.kineticEnergy() - fast_bare.kineticEnergy(), rotors, kRel * T);
+  EXPECT_TRUE(near(fast.momentum(), fast_bare.momentum(), kRel, 1e-12, "the rotors' momentum is neglected, as in H"));
+}
+
 TEST(MomentumSolver, AgreesWithTheDenseFormulas) {
   std::mt19937 rng(4242);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
