@@ -241,6 +241,10 @@ class KDL_SPACE_EXPORT Simulator {
   bool base_saturated_ = false;
   std::vector<KDL::Wrench> f_ext_;  ///< per body, world axes, moment about the body's origin
   Vector6d external_ = Vector6d::Zero();  ///< sum of external wrenches (f; moment about the origin)
+  /// During a step, the time at which the scheduled wrenches are read: its midpoint. A step never
+  /// straddles a switch, but its last stages sit on the switch that ends it, where activeAt()
+  /// tells the next interval's state. NaN outside a step (outputs: the stage time itself).
+  double wrench_clock_ = std::numeric_limits<double>::quiet_NaN();
   double external_power_[3] = {0.0, 0.0, 0.0};  ///< base control, wrenches, gravity [W]
   FloatingAcceleration acc_;
   std::vector<Vector> k_;
