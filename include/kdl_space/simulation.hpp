@@ -97,7 +97,9 @@ struct SimulationStats {
 
 /// \brief The fastest closed-loop rate of the joint servos at a state, and the explicit step it
 /// allows. For PD joint j with apparent inertia m_j (1 / (M^-1)_jj: the acceleration of a unit
-/// torque from rest), rate_j = max(kd_j / m_j, sqrt(kp_j / m_j)) [1/s]; an explicit Runge-Kutta
+/// torque from rest), rate_j is the largest |s| of m_j s^2 + kd_j s + kp_j = 0 [1/s] (kd_j with
+/// the joint's damping and friction / v_s when joint friction acts): sqrt(kp_j / m_j) when
+/// underdamped, (kd_j + sqrt(kd_j^2 - 4 m_j kp_j)) / (2 m_j) otherwise; an explicit Runge-Kutta
 /// method is stable for steps below about 2.8 / rate (RK4's bound on the real axis; dopri5's is 3.3).
 struct Stiffness {
   double fastest_rate = 0.0;  ///< [1/s]
