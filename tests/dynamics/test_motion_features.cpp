@@ -6,8 +6,9 @@
 //   4. hard stops: momentum kept, the joint held at the limit, the energy lost, the post-stop
 //      velocity against the plastic impact computed here from H*, and the release;
 //   5. the base control and a thruster: momentum change = external impulse, the torque limits
-//      in base axes, the attitude set point reached; a single body under a constant force.
-// Part 2 (test_motion_features_2.cpp): friction, armature, the Rosenbrock method, effort limits.
+//      in base axes, the attitude set point reached.
+// Part 2 (test_motion_features_2.cpp): a single body under a scheduled force, friction, armature,
+// the Rosenbrock method, effort limits.
 // No expected value is the library's own output.
 #include <gtest/gtest.h>
 
@@ -504,79 +505,6 @@ TEST(MotionFeatures, BaseControlAndThrusterImpulseBalance) {
   const KDL::Rotation error = s.state.world_T_base.M;
   EXPECT_LT(error.GetRot().Norm(), 1e-3);
   EXPECT_LT(s.velocity.base_twist.rot.Norm(), 1e-3);
-}
-
-TEST(MotionFeatures, SingleBodyUnderConstantForceClosedForm) {
-  // A constant world force F through the CoM on [t0, t1): the CoM's velocity changes by
-  // F (t1 - t0) / m, its path is the closed form below, the body's rotation is torque-free.
-  // t0 = 0.43 and t1 = 1.7 give steps of unequal length before the two switches (a step that
-  // saw the force at its end while ending on a switch would be caught).
-  const double m = 4.0;
-  const Vector3d c(0.1, -0.2, 0.05);
-  const std::string urdf = R"(<robot name="one"><link name="body"><inertial><origin xyz="0.1 -0.2 0.05" rpy="0 0 0"/>
-    <mass value="4"/><inertia ixx="0.5" ixy="0.02" ixz="0" iyy="0.7" iyz="-0.01" izz="0.9"/></inertial></link></robot>)";
-  const ModelPtr model = std::make_shared<const FloatingModel>(loadUrdfString(urdf, "one"));
-  ASSERT_EQ(model->nj(), 0u);
-  ASSERT_EQ(model->totalMass(), m);
-  const Vector3d F(2.0, -1.0, 0.5);
-  const double t0 = 0.43, t1 = 1.7;
-  for (int k = 0; k < 2; ++k) {
-    SCOPED_TRACE(k == 0 ? "dopri5" : "RK4");
-    SimulationOptions options;
-    options.rtol = 1e-12;
-    options.atol = 1e-14;
-    if (k == 1) {
-      options.integrator = Integrator::RK4;
-      options.step = 0.1;
-    }
-    Simulator sim(model, options);
-    ScheduledWrench w;
-    w.body = 0;
-    w.point = c;  // through the CoM
-    w.wrench << F, Vector3d::Zero();
-    w.start = t0;
-    w.end = t1;
-    sim.addWrench(w);
-    SimulationState s;
-    s.state = State(*model);
-    s.velocity.qdot = KDL::JntArray(0);
-    s.state.world_T_base = basePose(KDL::Vector(1.0, 0.5, -0.2), 0.3, 0.2, -0.4);
-    const Vector3d omega(0.3, -0.2, 0.5), v0(0.05, 0.02, -0.01);
-    s.velocity.base_twist = KDL::Twist(toKDL(v0), toKDL(omega));
-    auto com = [&](const SimulationState& x) {
-      return Vector3d(toEigen(x.state.world_T_base.p) + toEigen(x.state.world_T_base.M) * c);
-    };
-    auto com_velocity = [&](const SimulationState& x) {
-      const Vector3d r = toEigen(x.state.world_T_base.M) * c;
-      return Vector3d(toEigen(x.velocity.base_twist.vel) + toEigen(x.velocity.base_twist.rot).cross(r));
-    };
-    const Vector3d p_g0 = com(s), v_g0 = com_velocity(s);
-    // The momentum is integrated exactly by any Runge-Kutta step when the force is constant over
-    // each step (1e-12: round-off); the CoM position goes through the base origin and the
-    // orientation, whose integration error is ~1e-13 for dopri5 at 1e-12 and ~1e-8 for RK4 at 0.1 s.
-    const double tol_p = k == 0 ? 1e-10 : 1e-7;
-    int outputs = 0;
-    ASSERT_EQ(sim.run(s, 3.0, 0.25,
-                      [&](const SimulationState& x) {
-                        ++outputs;
-                        const double t = x.t;
-                        const double active = std::clamp(t, t0, t1) - t0;  // time under the force
-                        const double after = std::max(0.0, t - t1);
-                        const Vector3d v_expected = v_g0 + F / m * active;
-                        const Vector3d p_expected = p_g0 + v_g0 * t + F / m * (0.5 * active * active + active * after);
-                        SCOPED_TRACE("t = " + std::to_string(t));
-                        EXPECT_TRUE(near(com_velocity(x), v_expected, 0.0, 1e-12, "CoM velocity"));
-                        EXPECT_TRUE(near(com(x), p_expected, 0.0, tol_p, "CoM position"));
-                        EXPECT_TRUE(near(x.impulse.head<3>(), F * active, 0.0, 1e-12, "linear impulse"));
-                        // Work of the force = change of the CoM's kinetic energy (the rotation's
-                        // energy is unchanged: no moment about the CoM).
-                        EXPECT_NEAR(x.work.wrenches, 0.5 * m * (v_expected.squaredNorm() - v_g0.squaredNorm()),
-                                    k == 0 ? 1e-10 : 1e-7);
-                      }),
-              E_NOERROR);
-    EXPECT_EQ(outputs, 13);
-    EXPECT_TRUE(near(com_velocity(s) - v_g0, F * (t1 - t0) / m, 0.0, 1e-12, "CoM velocity change"));
-  }
 }
 
 }  // namespace
