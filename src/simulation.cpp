@@ -213,6 +213,7 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
 }
 
 int Simulator::stepRK4(double t, double h, Vector& x) {
+  const detail::WrenchClock clock(wrench_clock_, t, h);
   if (int rc = derivative(t, x, k_[0])) return rc;
   x_tmp_ = x + 0.5 * h * k_[0];
   if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[1])) return rc;
@@ -236,6 +237,7 @@ double Simulator::errorNorm(const Vector& x, const Vector& x_new, const Vector& 
 }
 
 int Simulator::stepDP54(double t, double h, const Vector& x, double& error, bool& trial_failed) {
+  const detail::WrenchClock clock(wrench_clock_, t, h);
   trial_failed = false;
   for (int i = 0; i < 7; ++i) {
     x_tmp_ = x;

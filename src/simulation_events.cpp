@@ -74,7 +74,7 @@ int Simulator::actuate(double t) {
       apply(0, kin_.com[0], scratch_.base_wrench.head<3>(), scratch_.base_wrench.tail<3>(), external_power_[0]);
     }
     for (const ScheduledWrench& w : wrenches_) {
-      if (!w.activeAt(t)) continue;
+      if (!w.activeAt(std::isnan(wrench_clock_) ? t : wrench_clock_)) continue;
       const Matrix3d& R = kin_.R[w.body];
       Vector3d f = w.wrench.head<3>(), m = w.wrench.tail<3>();
       if (w.body_axes) {

@@ -2,6 +2,7 @@
 // forward dynamics it runs.
 #pragma once
 
+#include <limits>
 #include <variant>
 
 #include "kdl_space/dense_forward_dynamics.hpp"
@@ -20,5 +21,14 @@ struct StateLayout {
 
 /// The articulated-body recursion; the dense route for a model with mimic joints.
 using Dynamics = std::variant<ForwardDynamicsSolver, DenseForwardDynamics>;
+
+/// Sets Simulator's wrench clock to a step's midpoint for the step's duration (NaN after it).
+struct WrenchClock {
+  double& clock;
+  WrenchClock(double& c, double t, double h) : clock(c) { clock = t + 0.5 * h; }
+  ~WrenchClock() { clock = std::numeric_limits<double>::quiet_NaN(); }
+  WrenchClock(const WrenchClock&) = delete;
+  WrenchClock& operator=(const WrenchClock&) = delete;
+};
 
 }  // namespace kdl_space::detail

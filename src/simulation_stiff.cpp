@@ -15,6 +15,7 @@ void Simulator::makeStiffStepper() {
 double Simulator::stiffErrorExponent() const { return -1.0 / (detail::RosenbrockStepper::embedded_order + 1); }
 
 int Simulator::stepRosenbrock(double t, double h, const Vector& x, double& error, bool& trial_failed) {
+  const detail::WrenchClock clock(wrench_clock_, t, h);
   // A lambda holding only `this` is stored inside std::function: no allocation.
   const int rc = stiff_->step([this](double s, const Vector& y, Vector& dy) { return derivative(s, y, dy); }, t, h, x,
                               x_new_, error, options_.rtol, options_.atol);

@@ -102,7 +102,9 @@ struct SimulationStats {
 
 /// \brief The fastest closed-loop rate of the joint servos at a state, and the explicit step it
 /// allows. For PD joint j with apparent inertia m_j (1 / (M^-1)_jj: the acceleration of a unit
-/// torque from rest), rate_j = max(kd_j / m_j, sqrt(kp_j / m_j)) [1/s]; an explicit Runge-Kutta
+/// torque from rest), rate_j is the largest |s| of m_j s^2 + kd_j s + kp_j = 0 [1/s] (kd_j with
+/// the joint's damping and friction / v_s when joint friction acts): sqrt(kp_j / m_j) when
+/// underdamped, (kd_j + sqrt(kd_j^2 - 4 m_j kp_j)) / (2 m_j) otherwise; an explicit Runge-Kutta
 /// method is stable for steps below about 2.8 / rate (RK4's bound on the real axis; dopri5's is 3.3).
 struct Stiffness {
   double fastest_rate = 0.0;  ///< [1/s]
@@ -254,6 +256,10 @@ class KDL_SPACE_EXPORT Simulator {
   bool base_saturated_ = false;
   std::vector<KDL::Wrench> f_ext_;  ///< per body, world axes, moment about the body's origin
   Vector6d external_ = Vector6d::Zero();  ///< sum of external wrenches (f; moment about the origin)
+  /// During a step, the time at which the scheduled wrenches are read: its midpoint. A step never
+  /// straddles a switch, but its last stages sit on the switch that ends it, where activeAt()
+  /// tells the next interval's state. NaN outside a step (outputs: the stage time itself).
+  double wrench_clock_ = std::numeric_limits<double>::quiet_NaN();
   double external_power_[3] = {0.0, 0.0, 0.0};  ///< base control, wrenches, gravity [W]
   FloatingAcceleration acc_;
   std::vector<Vector> k_;
