@@ -165,11 +165,30 @@ TEST(MotionFeatures, FrictionNeverGivesEnergy) {
                       // The joint torque is the friction law at the state's rates (no control).
                       for (unsigned int j = 0; j < model->nj(); ++j) {
                         const JointProperties& p = model->jointProperties()[j];
-                        EXPECT_NEAR(x.tau(j), frictionTorque(x.velocity.qdot(j), p.damping, p.friction, 1e-2), 1e-14);
+                        // v_s: at least the option's, larger on a light joint (friction_rate)
+                        const double v_s = sim.frictionVelocities()[j];
+                        EXPECT_GE(v_s, 1e-2);
+                        EXPECT_NEAR(x.tau(j), frictionTorque(x.velocity.qdot(j), p.damping, p.friction, v_s), 1e-14);
                       }
                     }),
             E_NOERROR);
   EXPECT_LT(previous, -0.1 * T0) << "friction must have taken a good part of the energy";
+
+  // Each joint's v_s = max(friction_velocity, friction / (m_j friction_rate)), m_j = 1 / (M^-1)_jj
+  // at the start, from the dense mass matrix [[M_a, A_m], [A_m^T, H]] (about the CoM).
+  SimulationState start = atRest(*model);
+  for (unsigned int j = 0; j < model->nj(); ++j) start.state.q(j) = 0.4 * std::sin(j + 1.0);
+  FreeFloatingSolver dense(model);
+  ASSERT_EQ(dense.compute(start.state), E_NOERROR);
+  const unsigned int n = model->nj();
+  Eigen::MatrixXd M(6 + n, 6 + n);
+  M << dense.M_a(), dense.A_m(), dense.A_m().transpose(), dense.H().data;
+  const Eigen::MatrixXd M_inv = M.inverse();
+  for (unsigned int j = 0; j < n; ++j) {
+    const double m_j = 1.0 / M_inv(6 + j, 6 + j);
+    const double expected = std::max(options.friction_velocity, 0.8 / (m_j * options.friction_rate));
+    EXPECT_NEAR(sim.frictionVelocities()[j], expected, 1e-9 * expected) << model->jointNames()[j];
+  }
 }
 
 /// A grounded base and one link on a revolute joint about z: mass 2 at (0.3, 0.1, 0) from the
