@@ -163,6 +163,8 @@ int Simulator::startRun(SimulationState& s) {
   const unsigned int n = model().nj();
   for (unsigned int j = 0; j < n; ++j)
     if (controls_[j].mode == JointControl::Mode::PD && controls_[j].hold) controls_[j].set_point = s.state.q(j);
+  if (base_control_.attitude.hold) base_control_.attitude.set_point = s.state.world_T_base.M;
+  if (base_control_.position.hold) base_control_.position.set_point = toEigen(s.state.world_T_base.p);
   std::fill(at_stop_.begin(), at_stop_.end(), false);
   applyLocks();
   // The Coulomb regularisation of each joint, from its apparent inertia here.

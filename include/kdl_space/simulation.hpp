@@ -169,7 +169,7 @@ class KDL_SPACE_EXPORT Simulator {
   /// \brief Integrates from s.t to t_end. `observer` (may be empty) sees s.t, every multiple of
   /// output_dt after it, and t_end. An exception thrown by the observer or the torque callback
   /// propagates (the run stops there); run() itself never throws. The set points of `hold`
-  /// controls are taken from s.
+  /// controls (joints, base attitude and position) are taken from s.
   /// \return 0 or an Error code: E_SIZE_MISMATCH (s.state.q or s.velocity.qdot, or a callback
   /// that resized tau), E_NOT_FINITE (an input, the time bounds, or a state that blew up),
   /// E_BAD_ARGUMENT (output_dt <= 0, t_end < s.t, a grounded base given a twist, or a joint

@@ -156,6 +156,28 @@ TEST(Modes, AGroundedBaseStaysGroundedAndTheSectionCanFreeIt) {
             1e-6);
 }
 
+TEST(Modes, BrakedJointsStayBrakedAfterTheCaptureUnlessReleased) {
+  const std::string csv = scratch("braked.csv");
+  const json j = simulateJson(kScenarios + "braked_wrist_capture.yaml --duration 3 --csv " + csv);
+  EXPECT_EQ(j.at("capture").at("robot").at("locked_joints"), json({"joint5", "joint6", "joint7"}));
+  EXPECT_EQ(j.at("simulation").at("locked_joints"), json({"joint5", "joint6", "joint7"}));
+  const auto c = readCsv(csv);
+  for (const char* joint : {"joint5", "joint6", "joint7"}) {
+    const std::vector<double>& q = c.at(std::string("q_") + joint);
+    for (double x : q) EXPECT_EQ(x, q.front()) << joint;
+    for (double x : c.at(std::string("qdot_") + joint)) EXPECT_EQ(x, 0.0) << joint;
+  }
+  // simulation.joints releases a brake after the impact: the wrist then moves.
+  const std::string released = variant("braked_wrist_capture", "  joints:\n", "  joints:\n    joint7: free\n");
+  const std::string csv2 = scratch("released.csv");
+  const json r = simulateJson(released + " --duration 3 --csv " + csv2);
+  EXPECT_EQ(r.at("simulation").at("locked_joints"), json({"joint5", "joint6"}));
+  const auto c2 = readCsv(csv2);
+  double moved = 0.0;
+  for (double x : c2.at("qdot_joint7")) moved = std::max(moved, std::abs(x));
+  EXPECT_GT(moved, 1e-6);
+}
+
 TEST(Limits, HardStopsHoldTheJointAndKeepTheMomentum) {
   const std::string csv = scratch("stop.csv");
   const json j = simulateJson(kScenarios + "joint_limit_stop.yaml --csv " + csv);

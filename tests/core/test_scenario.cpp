@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <map>
 
 #include "kdl_space/scenario.hpp"
 #include "test_util.hpp"
@@ -94,6 +96,34 @@ TEST(LoadScenario, BrakedJointsOfTheRobotAndOfAFreeFloatingTarget) {
   unbraked.robot.locked.clear();
   std::get<FloatingSystem>(unbraked.target).locked.clear();
   EXPECT_NE(solveCapture(unbraked).robot.after.qdot(robot.model->jointIndex("joint7")), 0.0);
+}
+
+// simulation.joints and simulation.limits by name and pattern: "*" is the default, a later
+// pattern wins over an earlier one, a name over every pattern, in whatever order they are written.
+TEST(LoadScenario, JointPatternsResolveByPrecedence) {
+  const std::string path = (fs::path(::testing::TempDir()) / "patterns.yaml").string();
+  std::ofstream(path) << "robot:\n  urdf: " << urdfDir() << "/space_arm7.urdf\n  contact: {link: end_effector}\n"
+                      << "simulation:\n  joints:\n    joint6: locked\n    \"joint[5-7]\": free\n"
+                      << "    \"*\": {pd: {kp: 10, kd: 2, set_point: hold}}\n    \"joint?\": {pd: {kp: 20, kd: 3, set_point: 0.5}}\n"
+                      << "  limits: {\"*\": stop, \"joint[1-2]\": ignore, joint1: warn}\n";
+  const Scenario s = loadScenario(path);
+  EXPECT_FALSE(s.impact);
+  std::map<unsigned int, JointControl> c(s.simulation.joints.begin(), s.simulation.joints.end());
+  ASSERT_EQ(c.size(), 7u);
+  for (unsigned int j : {0u, 1u, 2u, 3u}) {  // "joint?" (written after "*") wins over "*"
+    EXPECT_EQ(c[j].mode, JointControl::Mode::PD);
+    EXPECT_EQ(c[j].kp, 20.0);
+    EXPECT_FALSE(c[j].hold);
+    EXPECT_EQ(c[j].set_point, 0.5);
+  }
+  // "joint[5-7]" and "joint?" both match joint5 and joint7: the one written later wins
+  EXPECT_EQ(c[4].mode, JointControl::Mode::PD);
+  EXPECT_EQ(c[6].mode, JointControl::Mode::PD);
+  EXPECT_EQ(c[5].mode, JointControl::Mode::Locked) << "a name wins over every pattern";
+  std::map<unsigned int, LimitMode> l(s.simulation.limits.begin(), s.simulation.limits.end());
+  EXPECT_EQ(l[0], LimitMode::Warn);
+  EXPECT_EQ(l[1], LimitMode::Ignore);
+  for (unsigned int j = 2; j < 7; ++j) EXPECT_EQ(l[j], LimitMode::Stop);
 }
 
 TEST(LoadScenario, EveryShippedAndTestScenarioLoadsAndSolves) {

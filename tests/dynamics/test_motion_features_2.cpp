@@ -471,5 +471,45 @@ TEST(MotionFeatures, EffortLimitSaturatesThePd) {
   }
 }
 
+// `hold` set points of the base control are the base's pose at the start of the run (not the
+// identity): the arm swings, the base is pulled back to where it started.
+TEST(MotionFeatures, BaseControlHoldsTheStartPose) {
+  const ModelPtr model = load(urdfDir() + "/space_arm7.urdf");
+  SimulationOptions options;
+  options.rtol = 1e-9;
+  options.atol = 1e-11;
+  Simulator sim(model, options);
+  BaseControl c;
+  c.attitude.on = c.attitude.hold = true;
+  c.attitude.kp = 400.0;
+  c.attitude.kd = 1500.0;
+  c.position.on = c.position.hold = true;
+  c.position.kp = 50.0;
+  c.position.kd = 400.0;
+  sim.setBaseControl(c);
+  JointControl pd;
+  pd.mode = JointControl::Mode::PD;
+  pd.kp = 200.0;
+  pd.kd = 150.0;
+  pd.set_point = 0.5;
+  sim.setJointControl(0, pd);
+  SimulationState s = atRest(*model);
+  const KDL::Frame start(KDL::Rotation::RPY(0.3, -0.2, 0.5), KDL::Vector(1.0, 2.0, 3.0));
+  s.state.world_T_base = start;
+  double largest = 0.0;  // the base does move: the hold is not trivially met
+  ASSERT_EQ(sim.run(s, 60.0, 1.0,
+                    [&](const SimulationState& x) {
+                      largest = std::max(largest, (x.state.world_T_base.M * start.M.Inverse()).GetRot().Norm());
+                    }),
+            E_NOERROR);
+  EXPECT_GT(largest, 1e-5);  // (with the identity as set point it would turn by ~0.6 rad)
+  EXPECT_LT((s.state.world_T_base.M * start.M.Inverse()).GetRot().Norm(), 1e-3);
+  EXPECT_LT((s.state.world_T_base.p - start.p).Norm(), 1e-3);
+  EXPECT_NEAR(s.state.q(0), 0.5, 1e-3);
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(sim.baseControl().attitude.set_point(r, k), start.M(r, k));
+  EXPECT_TRUE(near(sim.baseControl().position.set_point, toEigen(start.p), 0.0, 0.0, "position set point"));
+}
+
 }  // namespace
 }  // namespace kdl_space::test
