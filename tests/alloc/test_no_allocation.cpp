@@ -313,23 +313,41 @@ TEST_P(EveryComputeCall, AllocatesNothing) {
 TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
   const auto model = load(GetParam());
   std::mt19937 rng(6);
-  for (Integrator integrator : {Integrator::RK4, Integrator::DormandPrince54}) {
-    SimulationOptions options;
-    options.integrator = integrator;
-    options.step = 0.01;
-    Simulator sim(model, options);
-    sim.setJointControl(0, {JointControl::Mode::PD, 10.0, 5.0, 0.2});
-    if (model->nj() > 2) sim.setJointControl(1, {JointControl::Mode::Locked});
-    sim.setTorqueCallback([](const SimulationState& s, KDL::JntArray& tau) { tau.data = -0.1 * s.velocity.qdot.data; });
-    SimulationState s;
-    s.state = randomState(*model, rng);
-    s.velocity.qdot = KDL::JntArray(model->nj());
-    ASSERT_EQ(sim.engageBrakes(s), E_NOERROR);  // a set-up call, outside the count
-    const auto observer = [&](const SimulationState& x) { EXPECT_TRUE(x.state.q.data.allFinite()); };
-    const std::function<void(const SimulationState&)> watch = observer;  // constructed before counting
-    ASSERT_EQ(sim.run(s, 0.05, 0.01, watch), E_NOERROR);                  // warm-up
-    EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, s.t + 0.2, 0.05, watch), E_NOERROR); }), 0);
-  }
+  for (bool grounded : {false, true})
+    for (Integrator integrator : {Integrator::RK4, Integrator::DormandPrince54, Integrator::Rosenbrock}) {
+      SCOPED_TRACE(std::string(grounded ? "grounded, " : "free, ") + std::to_string(static_cast<int>(integrator)));
+      SimulationOptions options;
+      options.integrator = integrator;
+      options.step = 0.01;
+      options.grounded = grounded;
+      Simulator sim(model, options);
+      JointControl hold{JointControl::Mode::PD, 10.0, 5.0, 0.2};
+      hold.hold = true;
+      sim.setJointControl(0, hold);
+      if (model->nj() > 2) sim.setJointControl(1, {JointControl::Mode::Locked});
+      sim.setTorqueCallback([](const SimulationState& s, KDL::JntArray& tau) { tau.data = -0.1 * s.velocity.qdot.data; });
+      if (!grounded) {  // the base's own control and a thruster firing inside the counted run
+        BaseControl c;
+        c.attitude.on = c.attitude.hold = c.position.on = c.position.hold = true;
+        c.attitude.kp = c.attitude.kd = c.position.kp = c.position.kd = 1.0;
+        c.attitude.torque_limit = Vector3d::Constant(0.5);
+        sim.setBaseControl(c);
+      }
+      ScheduledWrench w;
+      w.body = static_cast<unsigned int>(model->bodies().size() - 1);
+      w.wrench << 1.0, 0.0, 0.0, 0.0, 0.0, 0.1;
+      w.start = 0.1;
+      w.end = 0.2;
+      sim.addWrench(w);
+      SimulationState s;
+      s.state = randomState(*model, rng);
+      s.velocity.qdot = KDL::JntArray(model->nj());
+      ASSERT_EQ(sim.engageBrakes(s), E_NOERROR);  // a set-up call, outside the count
+      const auto observer = [&](const SimulationState& x) { EXPECT_TRUE(x.state.q.data.allFinite()); };
+      const std::function<void(const SimulationState&)> watch = observer;  // constructed before counting
+      ASSERT_EQ(sim.run(s, 0.05, 0.01, watch), E_NOERROR);                  // warm-up
+      EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, s.t + 0.2, 0.05, watch), E_NOERROR); }), 0);
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, EveryComputeCall,
