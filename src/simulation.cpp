@@ -42,6 +42,7 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   controls_.assign(n, JointControl{});
   limit_modes_.assign(n, LimitMode::Warn);
   at_stop_.assign(n, false);
+  just_stopped_.assign(n, false);
   locked_now_.assign(n, false);
   saturated_.assign(n, false);
   friction_velocity_.assign(n, options_.friction_velocity);

@@ -217,9 +217,18 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
   if (base_saturated_) stats_.base_saturation_time += t - t_prev;
 
   // 1. A hard stop crossed: the instant located by the Illinois method on the step's length.
+  std::fill(just_stopped_.begin(), just_stopped_.end(), false);
   if (overshoot(x) > 0.0) {
     double a = 0.0, b = 1.0, ga = overshoot(x_prev), gb = overshoot(x), theta = 0.0;
     x_event_ = x_prev;
+    // A step from a limit (a joint just released): first a point inside, then the crossing after it.
+    for (double probe = 0.5; ga >= 0.0 && probe > 1e-6; probe *= 0.5) {
+      if (const int rc = retake(t_prev, probe * h, x_prev, x_event_)) return rc;
+      const double g = overshoot(x_event_);
+      if (g < 0.0) a = probe, ga = g;
+      else b = probe, gb = g;
+    }
+    if (ga >= 0.0) x_event_ = x_prev;  // it leaves the limit at once: stopped where it is
     int side = 0;
     for (int iteration = 0; ga < 0.0 && iteration < 100; ++iteration) {
       theta = (a * gb - b * ga) / (gb - ga);
@@ -260,12 +269,14 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
     x(L.work + 2) += T_after - T_before;  // EnergySplit::limits
     for (unsigned int j : stop) {
       at_stop_[j] = true;
+      just_stopped_[j] = true;
       ++stats_.joints[j].stops;
     }
     applyLocks();
   }
 
-  // 2. Joints at a stop are released when their free acceleration points away from the limit.
+  // 2. Joints at a stop are released when their free acceleration points away from the limit (not
+  // in the step that stopped them: each stop holds for a step at least, so the run moves on).
   if (std::find(at_stop_.begin(), at_stop_.end(), true) != at_stop_.end()) {
     for (int j = 0; j < L.n; ++j) locked_now_[j] = controls_[j].mode == JointControl::Mode::Locked;
     std::visit([&](auto& d) { d.setLocked(locked_now_); }, dynamics_);
@@ -282,7 +293,7 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
       return rc;
     }
     for (int j = 0; j < L.n; ++j) {
-      if (!at_stop_[j]) continue;
+      if (!at_stop_[j] || just_stopped_[j]) continue;
       const bool at_upper = x(L.q + j) >= props[j].upper;
       if (at_upper ? acc_.qddot(j) < 0.0 : acc_.qddot(j) > 0.0) at_stop_[j] = false;
     }

@@ -243,6 +243,7 @@ class KDL_SPACE_EXPORT Simulator {
   std::vector<JointControl> controls_;
   std::vector<LimitMode> limit_modes_;
   std::vector<bool> at_stop_;  ///< joints held at a hard stop now
+  std::vector<bool> just_stopped_;  ///< stopped in this step (afterStep's)
   std::vector<bool> locked_now_;  ///< braked or at a stop: what the dynamics hold
   std::vector<double> friction_velocity_;  ///< v_s per joint
   BaseControl base_control_;

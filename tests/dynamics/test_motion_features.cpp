@@ -374,6 +374,40 @@ TEST(MotionFeatures, HardStopKeepsMomentumAndHolds) {
   EXPECT_LT(s.state.q(StopCase::kJoint), c.upper - 0.05) << "the joint should have left the stop";
 }
 
+// A torque that pushes the joint into its stop and pulls it away, again and again (a square wave
+// by callback): every hit is an impact at the limit, every pull a release, the run goes on (a
+// joint is never stopped and released in the same step), the momentum is kept throughout.
+TEST(MotionFeatures, RepeatedStopsAndReleasesKeepTheMomentum) {
+  const StopCase c;
+  for (Integrator integrator : {Integrator::RK4, Integrator::DormandPrince54, Integrator::Rosenbrock}) {
+    SCOPED_TRACE(static_cast<int>(integrator));
+    SimulationOptions o = StopCase::options();
+    o.integrator = integrator;
+    o.step = 1e-3;
+    if (integrator == Integrator::Rosenbrock) o.rtol = 1e-9, o.atol = 1e-11;
+    Simulator sim(c.model, o);
+    sim.setLimitMode(StopCase::kJoint, LimitMode::Stop);
+    sim.setTorqueCallback([](const SimulationState& x, KDL::JntArray& tau) {
+      tau(StopCase::kJoint) = std::fmod(x.t, 1.0) < 0.5 ? 30.0 : -30.0;
+    });
+    SimulationState s = c.initial();
+    double T0;
+    Vector6d h0;
+    ASSERT_EQ(sim.energyAndMomentum(s, T0, h0), E_NOERROR);
+    ASSERT_EQ(sim.run(s, 4.0, 0.01,
+                      [&](const SimulationState& x) {
+                        double T;
+                        Vector6d h;
+                        ASSERT_EQ(sim.energyAndMomentum(x, T, h), E_NOERROR);
+                        EXPECT_TRUE(near(h, h0, 0.0, 1e-10 * h0.norm(), "momentum"));
+                        EXPECT_LE(x.state.q(StopCase::kJoint), c.upper + 1e-9);
+                      }),
+              E_NOERROR);
+    EXPECT_GE(sim.stats().joints[StopCase::kJoint].stops, 3) << "a hit in each push";
+    EXPECT_LT(sim.stats().accepted_steps, 100000);
+  }
+}
+
 TEST(MotionFeatures, HardStopVelocityIsThePlasticImpact) {
   // The state at the impact found with the limit ignored (the same motion until then), by
   // bisection on q_j = upper; the plastic impact computed here: H* dqdot = e_j lambda (an internal
