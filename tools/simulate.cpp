@@ -30,7 +30,8 @@ std::string simulationFailure(int rc, const SimulationSpec& spec, const MotionRe
              " is spent (an unstable controller? raise max_steps, or loosen rtol and atol)" +
              (advice.empty() ? std::string() : "; " + advice);
     case E_STEP_UNDERFLOW:
-      return std::string(strError(rc)) + " (loosen simulation.rtol and atol)";
+      return std::string(strError(rc)) + " (loosen simulation.rtol and atol)" +
+             (advice.empty() ? std::string() : "; " + advice);
     case E_NOT_FINITE: {
       std::ostringstream why;
       why << std::setprecision(3) << "the motion blew up to NaN or infinite values (unstable PD gains, or too large an "
