@@ -110,13 +110,17 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
   if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model);
   if (f.has("locked"))
     s.locked = lockedJoints(f.at("locked"), *s.model, s.velocity.qdot, (f.path().empty() ? "" : f.path() + ".") + "qdot");
-  const Field contact = f.at("contact");
-  contact.onlyKeys({"link", "offset"});
-  const std::string link = contact.at("link").text();
-  const Eigen::VectorXd o = contact.has("offset") ? contact.at("offset").vector(3) : Eigen::VectorXd::Zero(3);
-  if (s.model->bodyIndex(link) < 0)
-    contact.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*s.model)) + ")");
-  s.contact = s.model->contact(link, KDL::Vector(o(0), o(1), o(2)));
+  if (f.has("contact")) {  // required for an impact (loadScenario); a plain motion has none: the base
+    const Field contact = f.at("contact");
+    contact.onlyKeys({"link", "offset"});
+    const std::string link = contact.at("link").text();
+    const Eigen::VectorXd o = contact.has("offset") ? contact.at("offset").vector(3) : Eigen::VectorXd::Zero(3);
+    if (s.model->bodyIndex(link) < 0)
+      contact.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*s.model)) + ")");
+    s.contact = s.model->contact(link, KDL::Vector(o(0), o(1), o(2)));
+  } else {
+    s.contact.body = 0;  // the base's origin
+  }
   if (f.has("mode")) {
     const std::string mode = f.at("mode").text();
     if (mode == "free") s.response = Response::FreeFloating;
@@ -225,7 +229,9 @@ Scenario loadScenario(const std::string& path) {
   // A plain motion has neither target nor law; an impact needs both.
   s.impact = top.has("target") || top.has("law");
   if (s.impact) {
+    top.at("robot").at("contact");  // reports it missing: an impact needs the robot's contact point
     const Field target = top.at("target");
+    if (target.has("urdf")) target.at("contact");
     if (target.has("urdf")) s.capture.target = system(target, folder, s.target_urdf);
     else s.capture.target = rigidTarget(target);
     s.capture.law = law(top.at("law"), s.capture.has_normal);

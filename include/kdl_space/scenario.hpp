@@ -35,7 +35,8 @@ struct Scenario {
   std::string file;         ///< the path it was read from
   std::string robot_urdf;   ///< the robot's URDF (resolved path)
   std::string target_urdf;  ///< a free-floating target's URDF (resolved path); empty for a rigid target
-  /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot.
+  /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot (whose
+  /// `contact` may then be omitted: the base's origin).
   bool impact = true;
   CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
   SimulationSpec simulation;

@@ -169,6 +169,7 @@ const std::vector<Broken>& corpus() {
       {"plain_motion_without_simulation.yaml",
        "{f}:2: a scenario without target and law is a plain motion: it needs a simulation section", false},
       {"target_without_law.yaml", "{f}:2: law: missing (a required field)", false},
+      {"impact_without_contact.yaml", "{f}:3: robot.contact: missing (a required field)", false},
       // Scenarios that capture solves and simulate cannot run.
       {"grounded_base_moving.yaml",
        "{f}: simulation: the base is grounded (held still), but its twist at the start of the motion is [0.0978199, "
