@@ -175,8 +175,9 @@ class KDL_SPACE_EXPORT Simulator {
   /// E_BAD_ARGUMENT (output_dt <= 0, t_end < s.t, a grounded base given a twist, or a joint
   /// outside a hard stop at the start), E_MAX_STEPS when options().max_steps are spent,
   /// E_STEP_UNDERFLOW when the adaptive step falls to round-off, or a code of the dynamics. On an
-  /// error found before the first step s is untouched; later, s is left at the last accepted step
-  /// whose state can be evaluated (s.t tells how far the run got). A run allocates nothing
+  /// error found before the first step s's state and velocity are untouched (unless a hard stop
+  /// engaged at the start); later, s is left at the last accepted step whose state can be
+  /// evaluated (s.t tells how far the run got). A run allocates nothing
   /// unless a joint has Coulomb friction (its regularisation is set at the start) or a hard stop
   /// is met.
   int run(SimulationState& s, double t_end, double output_dt,
