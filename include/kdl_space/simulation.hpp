@@ -75,7 +75,8 @@ struct SimulationState {
   Vector6d base_wrench = Vector6d::Zero(); ///< the base control's (f; n about the base CoM), world
   EnergySplit work;                        ///< since the start of the run
   /// External impulse since the start of the run (base control, wrenches, gravity): (f; moment
-  /// about the world origin) integrated. The momentum changes by exactly this.
+  /// about the world origin) integrated. A free base's momentum changes by exactly this (a
+  /// grounded base's also by what the ground takes, which is not counted).
   Vector6d impulse = Vector6d::Zero();
 };
 
