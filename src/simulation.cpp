@@ -191,7 +191,7 @@ int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
 int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   const detail::StateLayout L(model().nj());
   if (const int rc = unpack(x, t, scratch_)) return rc;
-  if (const int rc = actuate(t)) return rc;
+  if (const int rc = actuate(t, x)) return rc;
   const bool external = base_control_.on() || !wrenches_.empty();
   static const std::vector<KDL::Wrench> none;
   if (const int rc = std::visit(
@@ -261,7 +261,7 @@ int Simulator::stepDP54(double t, double h, const Vector& x, double& error, bool
 
 int Simulator::publish(const Vector& x, double t, SimulationState& s) {
   if (const int rc = unpack(x, t, scratch_)) return rc;
-  if (const int rc = actuate(t)) return rc;
+  if (const int rc = actuate(t, x)) return rc;
   s.t = scratch_.t;
   s.state.world_T_base = scratch_.state.world_T_base;
   s.state.q.data = scratch_.state.q.data;  // sizes checked by run(): no allocation

@@ -23,7 +23,7 @@ Vector6d bodyTwist(const FloatingModel& model, const Kinematics& kin, const Floa
 
 }  // namespace
 
-int Simulator::actuate(double t) {
+int Simulator::actuate(double t, const Vector& x) {
   const unsigned int n = model().nj();
   const KDL::JntArray& q = scratch_.state.q;
   const KDL::JntArray& qdot = scratch_.velocity.qdot;
@@ -84,12 +84,16 @@ int Simulator::actuate(double t) {
       apply(static_cast<int>(w.body), kin_.p[w.body] + R * w.point, f, m, external_power_[1]);
     }
   }
-  if (options_.gravity != Vector3d::Zero()) {  // M g at the CoM; its power M g . v_g
+  if (options_.gravity != Vector3d::Zero()) {  // M g at the CoM; its power M g . v_g = g . P
     const Vector3d weight = model().totalMass() * options_.gravity;
     external_.head<3>() += weight;
     external_.tail<3>() += kin_.r_g.cross(weight);
-    if (const int rc = momentum_.compute(kin_, scratch_.velocity)) return rc;
-    external_power_[2] = options_.gravity.dot(momentum_.momentum().head<3>());
+    if (options_.grounded) {  // P is no state of a grounded base
+      if (const int rc = momentum_.compute(kin_, scratch_.velocity)) return rc;
+      external_power_[2] = options_.gravity.dot(momentum_.momentum().head<3>());
+    } else {
+      external_power_[2] = options_.gravity.dot(x.segment<3>(detail::StateLayout(model().nj()).h));
+    }
   }
   return E_NOERROR;
 }
@@ -282,7 +286,7 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
     std::visit([&](auto& d) { d.setLocked(locked_now_); }, dynamics_);
     static const std::vector<KDL::Wrench> none;
     int rc = unpack(x, t, scratch_);
-    if (!rc) rc = actuate(t);
+    if (!rc) rc = actuate(t, x);
     if (!rc)
       rc = std::visit([&](auto& d) {
         return d.CartToJnt(kin_, scratch_.velocity, scratch_.tau,

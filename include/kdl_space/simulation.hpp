@@ -206,8 +206,9 @@ class KDL_SPACE_EXPORT Simulator {
   /// unpack() into the scratch state with its torques and work, then copied into s only if it
   /// succeeds.
   int publish(const Vector& x, double t, SimulationState& s);
-  /// The joint torques (controls limited, then friction) and the external wrenches at scratch_.
-  int actuate(double t);
+  /// The joint torques (controls limited, then friction) and the external wrenches at scratch_,
+  /// unpacked from x (whose momentum gives gravity's power on a free base).
+  int actuate(double t, const Vector& x);
   int derivative(double t, const Vector& x, Vector& dx);
   int stepRK4(double t, double h, Vector& x);
   /// One trial step; `trial_failed` when a stage away from x (or the error estimate) could not be

@@ -119,6 +119,15 @@ TEST(PlainMotion, SpaceDynSampleMatchesTheIndependentEngineAtEverySample) {
   EXPECT_NEAR(sim.at("energy_split").at("residual").get<double>(), 0.0, 1e-9);
 }
 
+// Gravity on a free base (a ground test bed on air bearings): its work g . P, read from the
+// momentum state, closes the energy bookkeeping.
+TEST(PlainMotion, GravityWorkOnAFreeBaseClosesTheEnergyBalance) {
+  const json j = simulateJson(variant("spacedyn_twolink_pd", "  duration: 10", "  duration: 3\n  gravity: [0, -9.81, 0]"));
+  const json& e = j.at("simulation").at("energy_split");
+  EXPECT_GT(e.at("gravity").get<double>(), 1000.0);
+  EXPECT_LT(std::abs(e.at("residual").get<double>()), 1e-10 * e.at("total_work").get<double>());
+}
+
 TEST(ShippedScenarios, EveryOneSimulatesWithTheNewReports) {
   for (const auto& entry : fs::directory_iterator(kScenarios)) {
     if (entry.path().extension() != ".yaml") continue;
