@@ -23,7 +23,7 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   path_.resize(nb);
   dq_.setZero(model_->nj());
   a_.resize(nb);
-  pa_.assign(nb, Vector6d::Zero());
+  Sp_.assign(nb, 0.0);
   locked_.assign(model_->nj(), false);
   moves_.resize(nb);
   for (std::size_t i = 0; i < nb; ++i) moves_[i] = model_->bodies()[i].joint >= 0;
@@ -153,25 +153,28 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
   const Vector3d r = R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_;
   const int count = walkPath(h);
   Vector6d p = -transfer(r).transpose() * F;  // the impulse as a bias force at p_b
-  for (int k = 0; k < count - 1; ++k) {
+  for (int k = 0; k < count - 1; ++k) {  // inward along the path: S_i^T p_i is all the outward pass needs
     const int i = path_[k];
-    pa_[i] = p;
-    if (moves_[i]) p -= U_[i] * (S_[i].dot(p) * Dinv_[i]);
+    if (!moves_[i]) continue;
+    const double Sp = S_[i].dot(p);
+    Sp_[i] = Sp;
+    p -= U_[i] * (Sp * Dinv_[i]);
   }
   // The base's jump (eq. 18); a grounded base does not move (eq. 23). The joints' jumps outward.
   a_[0] = response == Response::FreeFloating ? Vector6d(-(Omega0_ * p)) : Vector6d::Zero();
   for (std::size_t i = 1; i < bodies.size(); ++i) {
     const detail::JointMotion& b = bodies[i];
-    a_[i] = a_[b.parent];
+    const Vector6d& a_parent = a_[b.parent];
     if (moves_[i]) {
-      const double qdd = -(S_[i].dot(pa_[i]) + U_[i].dot(a_[b.parent])) * Dinv_[i];
+      const double qdd = -(Sp_[i] + U_[i].dot(a_parent)) * Dinv_[i];
       dq_(b.joint) = qdd;
-      a_[i] += S_[i] * qdd;
-    } else if (b.joint >= 0) {
-      dq_(b.joint) = 0.0;  // braked: exactly no jump
+      a_[i] = a_parent + S_[i] * qdd;
+    } else {
+      a_[i] = a_parent;
+      if (b.joint >= 0) dq_(b.joint) = 0.0;  // braked: exactly no jump
     }
   }
-  for (int k = 0; k < count - 1; ++k) pa_[path_[k]].setZero();  // zero off the path, as it was
+  for (int k = 0; k < count - 1; ++k) Sp_[path_[k]] = 0.0;  // zero off the path, as it was
   if (!a_[0].allFinite() || !dq_.allFinite()) return E_NOT_FINITE;
   d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
   dqdot.data = dq_;

@@ -104,7 +104,7 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::vector<int> path_;                          ///< scratch: contact path
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   Eigen::VectorXd dq_;                             ///< scratch: joint-rate jumps (n)
-  std::vector<Vector6d> pa_;                       ///< scratch: bias force per body (one impulse; zero between calls)
+  std::vector<double> Sp_;                         ///< scratch: S^T p, the bias force along the joint (zero off the path)
 };
 
 }  // namespace kdl_space
