@@ -308,6 +308,7 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   if (const int rc = derivative(s.t, x, k_[0])) return rc;
   if (const int rc = publish(x, s.t, s)) return rc;
   if (observer) observer(s);
+  if (stop_ && stop_(s)) return E_NOERROR;
 
   // RK4 takes `step` as given; max_step bounds only the adaptive methods.
   const bool adaptive = options_.integrator != Integrator::RK4;
@@ -367,6 +368,7 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
       if (const int rc = publish(x, t, s)) return failed(rc);
       if (observer) observer(s);
       ++outputs;
+      if (stop_ && stop_(s)) break;
     }
   }
   if (stats_.min_step == kInf) stats_.min_step = 0.0;

@@ -348,6 +348,14 @@ int Simulator::apparentInertia(unsigned int j, double& m) {
   return std::isfinite(m) && m > 0.0 ? E_NOERROR : E_NOT_POSITIVE_DEFINITE;
 }
 
+int Simulator::apparentInertia(const SimulationState& s, unsigned int j, double& m) {
+  if (s.state.q.rows() != model().nj()) return E_SIZE_MISMATCH;
+  if (j >= model().nj() || controls_[j].mode == JointControl::Mode::Locked) return E_BAD_ARGUMENT;
+  applyLocks();
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+  return apparentInertia(j, m);
+}
+
 int Simulator::stiffness(const SimulationState& s, Stiffness& result) {
   const unsigned int n = model().nj();
   if (s.state.q.rows() != n) return E_SIZE_MISMATCH;

@@ -159,6 +159,9 @@ class KDL_SPACE_EXPORT Simulator {
   void addWrench(const ScheduledWrench& wrench);
   const std::vector<ScheduledWrench>& wrenches() const { return wrenches_; }
   void setTorqueCallback(TorqueCallback callback) { callback_ = std::move(callback); }
+  /// run() ends at the first output sample (the start included) where `stop` returns true, after
+  /// the observer has seen it: s is left there. Empty (the default): run() goes on to t_end.
+  void setStopCondition(std::function<bool(const SimulationState&)> stop) { stop_ = std::move(stop); }
 
   /// \brief Brakes on: the locked joints' rates become zero by an internal impulse (momentum
   /// unchanged), as when brakes engage. Call before run() if locked joints may be moving.
@@ -191,6 +194,10 @@ class KDL_SPACE_EXPORT Simulator {
   /// The servos' fastest rate at a state (O(n^2): one articulated-body pass per PD joint).
   /// \return 0 or a code of the dynamics.
   int stiffness(const SimulationState& s, Stiffness& result);
+  /// The inertia joint j's torque meets at s: 1 / (M^-1)_jj, the acceleration of a unit torque
+  /// from rest, with the brakes of the joint controls. \return 0, E_SIZE_MISMATCH, E_BAD_ARGUMENT
+  /// (j out of range or braked), or a code of the dynamics.
+  int apparentInertia(const SimulationState& s, unsigned int j, double& m);
 
   const SimulationStats& stats() const { return stats_; }
   /// Each joint's v_s of the last run (model order; see SimulationOptions::friction_rate).
@@ -252,6 +259,7 @@ class KDL_SPACE_EXPORT Simulator {
   BaseControl base_control_;
   std::vector<ScheduledWrench> wrenches_;
   TorqueCallback callback_;
+  std::function<bool(const SimulationState&)> stop_;
   SimulationStats stats_;
   // workspaces
   SimulationState scratch_;
