@@ -7,6 +7,7 @@
 #include "kdl_space/input_file.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "model_rules.hpp"
+#include "scenario_approach.hpp"
 #include "scenario_fields.hpp"
 #include "scenario_sections.hpp"
 
@@ -223,7 +224,7 @@ Scenario loadScenario(const std::string& path) {
     throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law (or robot and simulation)");
   if (!root.IsMap())
     top.fail("a scenario is a mapping with robot, target and law (or robot and simulation), not " + fields::kindOf(root));
-  top.onlyKeys({"robot", "target", "law", "simulation"});
+  top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
   s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
   // A plain motion has neither target nor law; an impact needs both.
@@ -237,6 +238,13 @@ Scenario loadScenario(const std::string& path) {
     s.capture.law = law(top.at("law"), s.capture.has_normal);
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
+  }
+  if (top.has("approach")) {
+    const Field approach = top.at("approach");
+    if (!s.impact) approach.fail("an approach reaches a target: give target and law too");
+    if (!s.target_urdf.empty())
+      approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
+    s.approach = sections::approach(approach, *s.capture.robot.model);
   }
   if (top.has("simulation")) s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model);
   return s;

@@ -1,5 +1,6 @@
 #include "csv_writer.hpp"
 
+#include <cmath>
 #include <iomanip>
 
 namespace kdl_space::cli {
@@ -15,7 +16,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
   out_ << ",P_x,P_y,P_z,L_x,L_y,L_z,kinetic_energy";
   for (const auto& j : joints) out_ << ",tau_" << j;
   if (base_control_) out_ << ",base_control_fx,base_control_fy,base_control_fz,base_control_nx,base_control_ny,base_control_nz";
-  out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity\n";
+  out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity,phase,grasp_distance\n";
 }
 
 void CsvWriter::write(const Sample& s) {
@@ -31,6 +32,8 @@ void CsvWriter::write(const Sample& s) {
   if (base_control_)
     for (int i = 0; i < 6; ++i) out_ << ',' << s.base_wrench(i);
   for (int i = 0; i < 6; ++i) out_ << ',' << s.work(i);
+  out_ << ',' << s.phase << ',';
+  if (!std::isnan(s.grasp_distance)) out_ << s.grasp_distance;  // empty outside the approach
   out_ << '\n';
 }
 

@@ -59,18 +59,22 @@ std::string plotTerminal(const std::string& path, std::size_t panels) {
 /// Base attitude, joint angles, momentum and energy error over time, drawn by gnuplot into
 /// out.tmp() (the caller commits it).
 void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
-               const std::string& title, bool torques) {
+               const std::string& title, bool torques, double capture_time) {
   const std::string& path = out.path();
   const std::size_t groups = std::max<std::size_t>(1, (joints.size() + kJointsPerPanel - 1) / kJointsPerPanel);
-  const std::size_t panels = 2 + groups * (torques ? 2 : 1);
+  bool distance = false;  // an approach: its distance to the grasp point
+  for (const Sample& s : samples) distance = distance || !std::isnan(s.grasp_distance);
+  const std::size_t panels = 2 + groups * (torques ? 2 : 1) + (distance ? 1 : 0);
   const std::string terminal = plotTerminal(path, panels);
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp"), log(out.tmp() + ".log");
   {
     std::ofstream d(data.path());
     d << std::setprecision(12);
-    const Sample& s0 = samples.front();
-    const double h_scale = std::max(s0.h.norm(), 1e-300);
+    const Sample* first = &samples.front();  // of the phase: the balance restarts at the capture
     for (const Sample& s : samples) {
+      if (std::string(s.phase) == "post" && std::string(first->phase) != "post") first = &s;
+      const Sample& s0 = *first;
+      const double h_scale = std::max(s0.h.norm(), 1e-300);
       double roll, pitch, yaw;
       KDL::Rotation::Quaternion(s.quat(0), s.quat(1), s.quat(2), s.quat(3)).GetRPY(roll, pitch, yaw);
       const double dh = (s.h - s0.h - s.impulse).norm(), dT = std::abs(s.T - s0.T - s.work.sum());
@@ -80,7 +84,7 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
       d << ' ' << std::max(s0.h.norm() > 0 ? dh / h_scale : dh, 1e-17) << ' '
         << std::max(s0.T > 0 ? dT / s0.T : dT, 1e-17);
       for (Eigen::Index j = 0; j < s.tau.size(); ++j) d << ' ' << s.tau(j);
-      d << '\n';
+      d << ' ' << (std::isnan(s.grasp_distance) ? std::string("NaN") : std::to_string(s.grasp_distance)) << '\n';
     }
     d.close();
     if (!d) throw InputError("--plot " + path + ": cannot write the plot's data next to it");
@@ -89,7 +93,11 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     std::ofstream g(script.path());
     g << "set terminal " << terminal << "\nset output " << quotedPath(out.tmp()) << "\n"
       << "set multiplot layout " << panels << ",1 title " << label(title) << "\n"
-      << "set grid\nset key outside right\nset xlabel 'time [s]'\n"
+      << "set grid\nset key outside right\nset xlabel 'time [s]'\nset datafile missing 'NaN'\n";
+    if (std::isfinite(capture_time))  // an arrow of the graph: drawn on every panel
+      g << "set arrow 1 from " << capture_time << ", graph 0 to " << capture_time << ", graph 1 nohead dt 2 lc rgb 'red'\n"
+        << "set label 1 'capture' at " << capture_time << ", graph 0.95 offset 0.5,0 tc rgb 'red'\n";
+    g
       << "set ylabel 'base attitude [deg]'\n"
       << "plot " << quotedPath(data.path()) << " using 1:2 with lines title 'roll', '' using 1:3 with lines title 'pitch', "
       << "'' using 1:4 with lines title 'yaw'\n";
@@ -108,7 +116,10 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     jointPanels("joint position [rad or m]", 5);
     const std::size_t c = 5 + joints.size();
     if (torques) jointPanels("joint torque [N m or N]", c + 2);
-    g << "set ylabel 'change since t = 0 (relative)'\nset logscale y\nset format y '10^{%L}'\n"
+    if (distance)
+      g << "set ylabel 'hand to grasp point [m]'\nplot " << quotedPath(data.path()) << " using 1:" << c + 2 + joints.size()
+        << " with lines title 'distance'\n";
+    g << "set ylabel 'change since the phase began (relative)'\nset logscale y\nset format y '10^{%L}'\n"
       << "plot " << quotedPath(data.path()) << " using 1:" << c << " with lines title 'momentum |h - h_0 - impulse|', '' using 1:"
       << c + 1 << " with lines title 'energy |T - T_0 - work|'\n"
       << "unset multiplot\n";

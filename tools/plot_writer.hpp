@@ -4,6 +4,7 @@
 // that a legend never squeezes a panel.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -20,8 +21,11 @@ std::string plotTerminal(const std::string& path, std::size_t panels = 3);
 
 /// \brief Draws the samples into out.tmp() with gnuplot (the caller commits it); throws
 /// InputError if gnuplot fails or its scratch files cannot be written.
-/// `torques`: draw the joint torques too.
+/// `torques`: draw the joint torques too. `capture_time` (finite): a vertical line marks the
+/// capture on every panel. With samples of the approach, a panel shows the hand-to-grasp distance.
+/// The momentum and energy balance of each phase is measured from the phase's first sample.
 void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
-               const std::string& title, bool torques);
+               const std::string& title, bool torques,
+               double capture_time = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace kdl_space::cli

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 
 namespace kdl_space::cli {
 
@@ -18,6 +19,10 @@ struct Sample {
   /// Work since the start: controller, friction, limits, base control, wrenches, gravity [J].
   Eigen::Matrix<double, 6, 1> work = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> impulse = Eigen::Matrix<double, 6, 1>::Zero();  ///< external, since the start
+  /// "approach", "capture" (the approach's last row: the instant of contact, before the impact),
+  /// "post" (after the impact) or "motion" (a plain motion).
+  const char* phase = "post";
+  double grasp_distance = std::numeric_limits<double>::quiet_NaN();  ///< hand to grasp point [m] (approach)
 };
 
 }  // namespace kdl_space::cli

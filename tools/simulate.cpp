@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "approach_report.hpp"
 #include "capture.hpp"
 #include "cli_common.hpp"
 #include "csv_writer.hpp"
@@ -65,8 +66,11 @@ unsigned int jointIn(const FloatingModel& model, const FloatingModel& robot, uns
 }
 
 /// The simulator as the scenario says: the robot's mode holds through the motion (a grounded base
-/// stays grounded, braked joints stay braked) unless the simulation section changes it.
-std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model) {
+/// stays grounded, braked joints stay braked) unless the simulation section changes it. For the
+/// approach (`approach`), the joints are left free for its velocity servo (the simulation
+/// section's joint controls act after the capture).
+std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                         bool approach = false) {
   const SimulationSpec& spec = sc.simulation;
   const FloatingSystem& robot = sc.capture.robot;
   SimulationOptions options = spec.options;
@@ -77,7 +81,8 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
   for (unsigned int j = 0; j < robot.model->nj(); ++j)
     if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j]))
       sim->setJointControl(jointIn(*model, *robot.model, j), locked);
-  for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(*model, *robot.model, joint), control);
+  if (!approach)
+    for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(*model, *robot.model, joint), control);
   for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(*model, *robot.model, joint), mode);
   sim->setBaseControl(spec.base_control);
   for (ScheduledWrench w : spec.wrenches) {
@@ -85,6 +90,74 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
     sim->addWrench(w);
   }
   return sim;
+}
+
+/// One output row from a state of the run of `sim`.
+Sample sampleOf(Simulator& sim, const SimulationState& x, int& rc) {
+  Sample smp;
+  smp.t = x.t;
+  smp.p = toEigen(x.state.world_T_base.p);
+  x.state.world_T_base.M.GetQuaternion(smp.quat(0), smp.quat(1), smp.quat(2), smp.quat(3));
+  smp.twist = toEigen(x.velocity.base_twist);
+  smp.q = x.state.q.data;
+  smp.qd = x.velocity.qdot.data;
+  smp.tau = x.tau.data;
+  smp.base_wrench = x.base_wrench;
+  smp.work << x.work.controller, x.work.friction, x.work.limits, x.work.base_control, x.work.wrenches, x.work.gravity;
+  smp.impulse = x.impulse;
+  if (const int e = sim.energyAndMomentum(x, smp.T, smp.h)) rc = e;
+  return smp;
+}
+
+/// A simulator built from the scenario, or its refusal in the scenario's words.
+std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                        bool approach) {
+  try {
+    return makeSimulator(sc, model, approach);
+  } catch (const ModelError& e) {
+    throw InputError(sc.file + ": " + e.what());
+  }
+}
+
+/// The approach phase: from the robot's initial state until the hand holds the grasp point; the
+/// samples (the last one: the contact instant) go to `samples`. `problem` gets the robot's and
+/// the target's states at the contact instant.
+ApproachOutcome approachPhase(const Scenario& sc, CaptureProblem& problem, double output_step,
+                              std::vector<Sample>& samples, SimulationState& s) {
+  const FloatingSystem& robot = sc.capture.robot;
+  std::unique_ptr<Simulator> sim = simulatorFor(sc, robot.model, true);
+  const auto controller = inScenario(sc, [&] {
+    try {
+      return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach,
+                                                  FreeRigidMotion(std::get<RigidTarget>(sc.capture.target)));
+    } catch (const ModelError& e) {
+      throw InputError(std::string("approach: ") + e.what());
+    }
+  });
+  s.state = robot.state;
+  s.velocity = robot.velocity;
+  if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
+  ApproachOutcome outcome;
+  int observer_rc = E_NOERROR;
+  const auto observer = [&](const SimulationState& x, const ApproachCommand& cmd) {
+    Sample smp = sampleOf(*sim, x, observer_rc);
+    smp.phase = "approach";
+    smp.grasp_distance = cmd.error.head<3>().norm();
+    samples.push_back(std::move(smp));
+  };
+  const int rc = runApproach(*sim, *controller, s, output_step, observer, outcome.record);
+  if (rc || observer_rc) {
+    std::ostringstream why;
+    why << sc.file << ": the approach failed at t = " << s.t << " s: " << strError(rc ? rc : observer_rc);
+    throw InputError(why.str());
+  }
+  if (const int e = controller->target(s.t, outcome.target_at_contact))
+    throw InputError(sc.file + ": approach: the target's motion: " + strError(e));
+  if (!samples.empty()) samples.back().phase = "capture";
+  problem.robot.state = s.state;
+  problem.robot.velocity = s.velocity;
+  problem.target = outcome.target_at_contact;
+  return outcome;
 }
 
 }  // namespace
@@ -135,7 +208,32 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
       throw InputError(why.str());
     }
   }
-  const CaptureProblem& problem = sc.capture;
+  CaptureProblem problem = sc.capture;  // with an approach: the states at the contact instant
+  std::vector<Sample> approach_samples;
+  std::optional<ApproachOutcome> approach;
+  SimulationState s;
+  s.state = problem.robot.state;
+  s.velocity = problem.robot.velocity;
+  std::optional<CsvWriter> csv;
+  if (sc.approach) {
+    approach = approachPhase(sc, problem, spec.output_step, approach_samples, s);
+    if (!approach->record.reached) {
+      // What happened is written out (the CSV, the plot) before the run is refused.
+      if (!o.csv.empty()) {
+        CsvWriter partial(o.csv, problem.robot.model->jointNames(), spec.base_control.on());
+        for (const Sample& x : approach_samples) partial.write(x);
+        partial.close();
+        partial.file().commit();
+      }
+      if (!o.plot.empty()) {
+        AtomicFile plot(o.plot, "--plot");
+        writePlot(plot, approach_samples, problem.robot.model->jointNames(),
+                  "kdl_space simulate " + fs::path(sc.file).filename().string() + ": the approach", true);
+        plot.commit();
+      }
+      throw InputError(approachFailure(sc, *approach));
+    }
+  }
   std::optional<CaptureResult> capture;
   std::shared_ptr<const FloatingModel> model = problem.robot.model;
   if (sc.impact) {
@@ -144,15 +242,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   }
   const bool payload_attached = model != problem.robot.model;
 
-  std::unique_ptr<Simulator> simulator;
-  try {
-    simulator = makeSimulator(sc, model);
-  } catch (const ModelError& e) {
-    throw InputError(sc.file + ": " + e.what());
-  }
+  std::unique_ptr<Simulator> simulator = simulatorFor(sc, model, false);
   Simulator& sim = *simulator;
   const std::vector<std::string>& joints = model->jointNames();
-  SimulationState s;
   s.state = problem.robot.state;
   s.velocity = capture ? capture->robot.after : problem.robot.velocity;
   if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
@@ -177,27 +269,19 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   Stiffness stiffness;
 
   std::vector<Sample> samples;
-  std::optional<CsvWriter> csv;
   std::unique_ptr<AtomicFile> plot_file;
   if (!o.csv.empty()) csv.emplace(o.csv, joints, spec.base_control.on());
+  if (csv)
+    for (const Sample& x : approach_samples) csv->write(x);
   int observer_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x) {
-    Sample smp;
-    smp.t = x.t;
-    smp.p = toEigen(x.state.world_T_base.p);
-    x.state.world_T_base.M.GetQuaternion(smp.quat(0), smp.quat(1), smp.quat(2), smp.quat(3));
-    smp.twist = toEigen(x.velocity.base_twist);
-    smp.q = x.state.q.data;
-    smp.qd = x.velocity.qdot.data;
-    smp.tau = x.tau.data;
-    smp.base_wrench = x.base_wrench;
-    smp.work << x.work.controller, x.work.friction, x.work.limits, x.work.base_control, x.work.wrenches, x.work.gravity;
-    smp.impulse = x.impulse;
-    if (const int rc = sim.energyAndMomentum(x, smp.T, smp.h)) observer_rc = rc;
+    Sample smp = sampleOf(sim, x, observer_rc);
+    smp.phase = sc.impact ? "post" : "motion";
     if (csv) csv->write(smp);
     samples.push_back(std::move(smp));
   };
-  const int rc = sim.run(s, duration, spec.output_step, observer);
+  const double t_capture = s.t;  // 0 without an approach
+  const int rc = sim.run(s, t_capture + duration, spec.output_step, observer);
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, stiffness))
     throw InputError(sc.file + ": simulation: " + strError(src));
@@ -213,7 +297,10 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   for (const Sample& x : samples) torques = torques || x.tau.cwiseAbs().maxCoeff() > 0.0;
   if (!o.plot.empty()) {
     plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
-    writePlot(*plot_file, samples, joints, "kdl_space simulate " + fs::path(sc.file).filename().string(), torques);
+    std::vector<Sample> all = approach_samples;
+    all.insert(all.end(), samples.begin(), samples.end());
+    writePlot(*plot_file, all, joints, "kdl_space simulate " + fs::path(sc.file).filename().string(), torques || approach,
+              sc.impact && approach ? t_capture : std::numeric_limits<double>::quiet_NaN());
   }
   // Every output is complete: give them their names (a failed rename takes the other back).
   if (csv) csv->file().commit();
@@ -241,6 +328,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   if (o.json) {
     Json j;
     j["capture"] = capture ? captureJson(sc, *capture) : Json(nullptr);
+    j["approach"] = approach ? approachJson(sc, *approach) : Json(nullptr);
     Json final_state{{"t", last.t},
                      {"base_position", toJson(last.p)},
                      {"base_quaternion", toJson(last.quat)},
@@ -276,6 +364,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     out << j.dump(2) << "\n";
     return;
   }
+  if (approach) printApproach(out, sc, *approach);
   if (capture) {
     printCaptureSummary(out, sc, *capture);
     const std::string& contact_link = problem.robot.model->bodies()[problem.robot.contact.body].name;

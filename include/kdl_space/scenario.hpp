@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "kdl_space/approach.hpp"
 #include "kdl_space/capture.hpp"
 #include "kdl_space/export.hpp"
 #include "kdl_space/simulation.hpp"
@@ -39,6 +40,9 @@ struct Scenario {
   /// `contact` may then be omitted: the base's origin).
   bool impact = true;
   CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
+  /// The `approach` section: the robot starts from its initial state, reaches the grasp point on
+  /// the moving (rigid) target, and the law applies at the contact instant, from the states then.
+  std::optional<ApproachSpec> approach;
   SimulationSpec simulation;
 };
 

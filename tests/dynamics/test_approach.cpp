@@ -194,7 +194,7 @@ TEST(Approach, ReactionNullSpaceTurnsTheBaseLess) {
   const ApproachRecord reaction = approach(Vector6d::Zero(), Vector6d::Zero(), Vector3d(0.1, -0.15, 0.1), spec);
   EXPECT_TRUE(plain.reached);
   EXPECT_TRUE(reaction.reached);
-  EXPECT_LT(reaction.base_rotation, 0.8 * plain.base_rotation);  // measured: 0.015 rad against 0.022)
+  EXPECT_LT(reaction.base_rotation, 0.8 * plain.base_rotation);  // measured: 0.015 rad against 0.022
 }
 
 TEST(Approach, RefusesBadSettings) {
