@@ -9,7 +9,9 @@
 //      momentum and energy are the capture's after; also with dual_arm as a tree target re-rooted
 //      at one tool (the other arm hangs as before);
 //   3. after a translational capture, a Spherical grasp: the same, the grasp point is the same
-//      seen from both sides at a later random ball-joint configuration, the chart margin is 1;
+//      seen from both sides at a later random ball-joint configuration, the chart margin is 1,
+//      G* of the O(n) recursion = the dense one through the massless ball links; armature and
+//      joint properties carry over (a reversed joint's limits negated and swapped);
 //   4. contact points too far apart (the distance named), a target with mimic joints, velocities
 //      that do not satisfy the capture law: refused with InputError.
 #include <gtest/gtest.h>
@@ -170,7 +172,7 @@ TEST(JoinedSystem, RigidJoinContinuesBothMotions) {
 
 /// space_arm7 captures dual_arm at its left tool, both at random states and velocities, the
 /// target's base placed so that the contact points coincide.
-CaptureProblem randomTreeProblem(ImpactKind kind, std::mt19937& rng) {
+CaptureProblem randomTreeProblem(ImpactKind kind, std::mt19937& rng, const std::string& target_link = "left_tool") {
   CaptureProblem p;
   p.law.kind = kind;
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -185,7 +187,7 @@ CaptureProblem randomTreeProblem(ImpactKind kind, std::mt19937& rng) {
     return s;
   };
   p.robot = system("space_arm7.urdf", "end_effector", KDL::Vector(0, 0, 0.05));
-  FloatingSystem t = system("dual_arm.urdf", "left_tool", KDL::Vector(0.01, -0.02, 0.03));
+  FloatingSystem t = system("dual_arm.urdf", target_link, KDL::Vector(0.01, -0.02, 0.03));
   const Vector3d gap = FloatingSide(p.robot).contactPoint() - FloatingSide(t).contactPoint();
   t.state.world_T_base.p += toKDL(gap);
   p.target = t;
@@ -204,6 +206,38 @@ TEST(JoinedSystem, TreeTargetReRootedAtOneTool) {
       EXPECT_EQ(js.target_joint_sign[j], tm.jointNames()[j].rfind("left_", 0) == 0 ? -1.0 : 1.0) << tm.jointNames()[j];
     expectContinues(p, r, js);
   }
+  // Grasped at its base: nothing is reversed.
+  const CaptureProblem p = randomTreeProblem(ImpactKind::Capture, rng, "satellite");
+  const CaptureResult r = solveCapture(p);
+  const JoinedSystem js = join(p, r, GraspJoint::Rigid);
+  for (const double sign : js.target_joint_sign) EXPECT_EQ(sign, 1.0);
+  expectContinues(p, r, js);
+}
+
+TEST(JoinedSystem, ArmatureAndJointPropertiesCarryOver) {
+  CaptureProblem p = scenarioProblem(ImpactKind::Capture);
+  FloatingSystem& target = std::get<FloatingSystem>(p.target);
+  JointProperties j1;
+  j1.lower = -1.0, j1.upper = 2.0, j1.effort = 7.0, j1.velocity = 0.5, j1.damping = 0.3, j1.friction = 0.2;
+  target.model = std::make_shared<const FloatingModel>(
+      target.model->withArmature({0.1, 0.2}).withJointProperties({{"joint1", j1}}));
+  p.robot.model = std::make_shared<const FloatingModel>(p.robot.model->withArmature(std::vector<double>(7, 0.05)));
+  const CaptureResult r = solveCapture(p);
+  const JoinedSystem js = join(p, r, GraspJoint::Rigid);
+  const int k = js.model->jointIndex("target/joint1");
+  ASSERT_GE(k, 0);
+  const JointProperties& got = js.model->jointProperties()[k];  // reversed: [-upper, -lower]
+  EXPECT_EQ(got.lower, -2.0);
+  EXPECT_EQ(got.upper, 1.0);
+  EXPECT_EQ(got.effort, 7.0);
+  EXPECT_EQ(got.velocity, 0.5);
+  EXPECT_EQ(got.damping, 0.3);
+  EXPECT_EQ(got.friction, 0.2);
+  EXPECT_EQ(js.model->armature()[k], 0.1);
+  EXPECT_EQ(js.model->armature()[js.model->jointIndex("target/joint2")], 0.2);
+  EXPECT_EQ(js.model->armature()[js.model->jointIndex("joint3")], 0.05);
+  EXPECT_EQ(js.model->jointProperties()[js.model->jointIndex("joint3")].upper, 2.96706);
+  expectContinues(p, r, js);  // the rotors' energy included
 }
 
 TEST(JoinedSystem, SphericalAfterTranslationalCapture) {
@@ -231,6 +265,21 @@ TEST(JoinedSystem, SphericalAfterTranslationalCapture) {
                                                 target.contact.offset);
     EXPECT_LT((kin.point(on_robot) - kin.point(on_target)).norm(), 1e-12);
     EXPECT_NEAR(sphericalChartMargin(js, s), std::abs(std::cos(s.q(js.grasp_joints[1]))), 1e-15);
+    // The massless ball links are no obstacle to the O(n) recursions: G* by both routes, and the
+    // articulated-body forward dynamics runs (finite accelerations at the join).
+    Matrix6d G_rec, G_dense;
+    RecursiveExIITSolver rec(js.model);
+    FreeFloatingSolver dense(js.model);
+    ASSERT_EQ(rec.compute(s), 0);
+    ASSERT_EQ(dense.compute(s), 0);
+    ASSERT_EQ(rec.G_star(on_robot, G_rec), 0);
+    ASSERT_EQ(dense.G_star(on_robot, G_dense), 0);
+    EXPECT_TRUE(near(G_rec, G_dense, 1e-9, 1e-9 * G_dense.norm(), "G* of the spherical join"));
+    FloatingAcceleration acc;
+    acc.qddot.resize(js.model->nj());
+    ForwardDynamicsSolver fd(js.model);
+    ASSERT_EQ(fd.CartToJnt(js.state, js.velocity, KDL::JntArray(js.model->nj()), {}, acc), 0);
+    EXPECT_TRUE(acc.qddot.data.allFinite());
   }
 }
 
