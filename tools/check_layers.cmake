@@ -14,7 +14,7 @@ function(layer_of name out)
     "state,kinematics,momentum=2"
     "free_floating_solver,recursive_ex_iit=3"
     "impact,impact_friction,collision=4"
-    "capture=5"
+    "capture,joined_system=5"
     "forward_dynamics,dense_forward_dynamics,simulation,simulation_events,simulation_stiff,simulation_layout,actuation,approach,rigid_motion=6"
     "urdf_loader,urdf_check,urdf_xml,urdf_graph,urdf_numbers,urdf_summary,scenario,scenario_fields,scenario_sections,scenario_approach,input_file=7")
   foreach(row IN LISTS table)
