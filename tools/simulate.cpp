@@ -10,6 +10,7 @@
 
 #include "approach_report.hpp"
 #include "capture.hpp"
+#include "kdl_space/joined_system.hpp"
 #include "cli_common.hpp"
 #include "csv_writer.hpp"
 #include "detail/text.hpp"
@@ -160,6 +161,39 @@ ApproachOutcome approachPhase(const Scenario& sc, CaptureProblem& problem, doubl
   return outcome;
 }
 
+/// A rigid target as a free-floating system of one body (no joints), its frame at the CoM with
+/// the inertia's axes of the target's frame: what a ball joint can join to the robot.
+FloatingSystem oneBody(const RigidTarget& t, const Vector3d& contact_point, const Vector6d& twist_at_com) {
+  const Matrix3d& I = t.inertia;
+  FloatingSystem s;
+  s.model = std::make_shared<const FloatingModel>(
+      KDL::Tree("target"), KDL::RigidBodyInertia(t.mass, KDL::Vector::Zero(),
+                                                 KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2))));
+  s.state = State(*s.model);
+  s.state.world_T_base = KDL::Frame(t.pose.M, t.pose * toKDL(t.com));
+  s.velocity = FloatingVelocity(*s.model);
+  s.velocity.base_twist = toTwist(twist_at_com);
+  s.contact = Contact{0, s.state.world_T_base.Inverse() * toKDL(contact_point)};
+  return s;
+}
+
+/// After a capture that joins the target to the robot (a free-floating target captured rigidly
+/// or translationally, a rigid target captured translationally): the joined system.
+std::optional<JoinedSystem> joined(const CaptureProblem& problem, const CaptureResult& capture) {
+  const ImpactKind kind = problem.law.kind;
+  if (kind != ImpactKind::Capture && kind != ImpactKind::TranslationalCapture) return std::nullopt;
+  const GraspJoint grasp = kind == ImpactKind::Capture ? GraspJoint::Rigid : GraspJoint::Spherical;
+  if (const auto* target = std::get_if<FloatingSystem>(&problem.target))
+    return joinAtGrasp(problem.robot, capture.robot.after, *target, capture.floating_target->after, grasp,
+                       problem.touch_tolerance);
+  if (grasp == GraspJoint::Rigid) return std::nullopt;  // the payload route (attachTarget)
+  const RigidTarget& rigid = std::get<RigidTarget>(problem.target);
+  FloatingSystem body = oneBody(rigid, capture.contact_point, capture.target_twist_before);
+  FloatingVelocity after = body.velocity;
+  after.base_twist = toTwist(capture.target_twist_after);
+  return joinAtGrasp(problem.robot, capture.robot.after, body, after, grasp, problem.touch_tolerance);
+}
+
 }  // namespace
 
 CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
@@ -235,18 +269,34 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     }
   }
   std::optional<CaptureResult> capture;
+  std::optional<JoinedSystem> joint;  // the target joined to the robot's tree
   std::shared_ptr<const FloatingModel> model = problem.robot.model;
   if (sc.impact) {
     capture = inScenario(sc, [&] { return solveCapture(problem); });
-    model = inScenario(sc, [&] { return attachTarget(problem, *capture); });
+    joint = inScenario(sc, [&] {
+      try {
+        return joined(problem, *capture);
+      } catch (const ModelError& e) {
+        throw InputError(std::string("target: cannot join the captured target to the robot: ") + e.what());
+      }
+    });
+    model = joint ? joint->model : inScenario(sc, [&] { return attachTarget(problem, *capture); });
   }
   const bool payload_attached = model != problem.robot.model;
 
   std::unique_ptr<Simulator> simulator = simulatorFor(sc, model, false);
   Simulator& sim = *simulator;
   const std::vector<std::string>& joints = model->jointNames();
-  s.state = problem.robot.state;
-  s.velocity = capture ? capture->robot.after : problem.robot.velocity;
+  s.state = joint ? joint->state : problem.robot.state;
+  s.velocity = joint ? joint->velocity : capture ? capture->robot.after : problem.robot.velocity;
+  if (joint)  // the target's brakes stay on
+    if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) {
+      JointControl locked;
+      locked.mode = JointControl::Mode::Locked;
+      for (std::size_t j = 0; j < joint->target_joints.size(); ++j)
+        if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
+          sim.setJointControl(static_cast<unsigned int>(joint->target_joints[j]), locked);
+    }
   if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
     std::ostringstream why;
     why << sc.file << ": simulation: the base is grounded (held still), but its twist at the start of the motion is "
@@ -271,12 +321,23 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   std::vector<Sample> samples;
   std::unique_ptr<AtomicFile> plot_file;
   if (!o.csv.empty()) csv.emplace(o.csv, joints, spec.base_control.on());
+  if (model->nj() != problem.robot.model->nj())  // the target brought joints: NaN in the approach's rows
+    for (Sample& x : approach_samples) {
+      Eigen::VectorXd q = Eigen::VectorXd::Constant(model->nj(), NAN), qd = q, tau = q;
+      for (unsigned int j = 0; j < problem.robot.model->nj(); ++j) {
+        const unsigned int k = jointIn(*model, *problem.robot.model, j);
+        q(k) = x.q(j), qd(k) = x.qd(j), tau(k) = x.tau(j);
+      }
+      x.q = q, x.qd = qd, x.tau = tau;
+    }
   if (csv)
     for (const Sample& x : approach_samples) csv->write(x);
   int observer_rc = E_NOERROR;
+  double chart_margin = 1.0;  // a ball joint's distance from its chart's singularity (1: at the centre)
   const auto observer = [&](const SimulationState& x) {
     Sample smp = sampleOf(sim, x, observer_rc);
     smp.phase = sc.impact ? "post" : "motion";
+    if (joint && joint->grasp == GraspJoint::Spherical) chart_margin = std::min(chart_margin, sphericalChartMargin(*joint, x.state));
     if (csv) csv->write(smp);
     samples.push_back(std::move(smp));
   };
@@ -341,6 +402,10 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
                            {"accepted_steps", sim.stats().accepted_steps},
                            {"rejected_steps", sim.stats().rejected_steps},
                            {"payload_attached", payload_attached},
+                           {"target_joined", joint ? Json{{"grasp", joint->grasp == GraspJoint::Rigid ? "rigid" : "spherical"},
+                                                          {"target_prefix", joint->target_prefix},
+                                                          {"min_chart_margin", chart_margin}}
+                                                   : Json(nullptr)},
                            {"joint_names", joints},
                            {"joints_treated_as_fixed", fixedJointsJson(*model)},
                            {"final", final_state},
@@ -368,8 +433,11 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   if (capture) {
     printCaptureSummary(out, sc, *capture);
     const std::string& contact_link = problem.robot.model->bodies()[problem.robot.contact.body].name;
-    out << "\nAfter the impact: " << (payload_attached ? "the target is attached to link '" + contact_link + "'"
-                                                      : std::string("the target separates; the robot alone"));
+    out << "\nAfter the impact: "
+        << (joint ? "the target joins the robot's tree at link '" + contact_link + "' by a " +
+                        (joint->grasp == GraspJoint::Rigid ? "fixed joint" : "ball joint (grasp_rz, grasp_ry, grasp_rx)")
+            : payload_attached ? "the target is attached to link '" + contact_link + "'"
+                               : std::string("the target separates; the robot alone"));
   } else {
     out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
   }
@@ -388,6 +456,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   out << "Largest change over the run: linear momentum " << dP << " N s, angular momentum " << dL
       << " N m s, kinetic energy " << dT << " J (of " << first.T << " J)\n";
   printMotionReport(out, record);
+  if (joint && joint->grasp == GraspJoint::Spherical && chart_margin < 0.1)
+    out << "Warning: the ball joint came within " << chart_margin
+        << " of its chart's singularity (|cos grasp_ry|): its angles are ill-conditioned there\n";
   if (!o.csv.empty()) out << "CSV: " << o.csv << "\n";
   if (!o.plot.empty()) out << "Plot: " << o.plot << "\n";
 }
