@@ -5,6 +5,7 @@
 
 #include "detail/text.hpp"
 #include "kdl_space/input_file.hpp"
+#include "kdl_space/kinematics.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "model_rules.hpp"
 #include "scenario_approach.hpp"
@@ -79,7 +80,7 @@ double rotorInertia(const Field& f) {
 
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place"});
   FloatingSystem s;
   const Field urdf = f.at("urdf");
   urdf_path = urdf.text();
@@ -134,6 +135,9 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
 
 /// A rigid target in the file's terms; its mass and inertia those of a rigid body.
 RigidTarget rigidTarget(const Field& f) {
+  if (f.has("place"))
+    f.at("place").fail("a rigid target has no contact point of its own (the point hit is the robot's contact point): "
+                       "place it with pose");
   f.onlyKeys({"mass", "inertia", "pose", "com", "twist"});
   RigidTarget b;
   b.mass = f.at("mass").number();
@@ -162,6 +166,15 @@ RigidTarget rigidTarget(const Field& f) {
   if (f.has("com")) b.com = f.at("com").vector(3);
   if (f.has("twist")) b.twist = f.at("twist").vector(6);
   return b;
+}
+
+/// `place: touch`: the target's base moved (translated) so that its contact point is the robot's.
+void place(const Field& f, const FloatingSystem& robot, FloatingSystem& target) {
+  if (f.text() != "touch") f.fail(echo(f.text()) + " is not touch (the target's base moved so that its contact point is the robot's)");
+  Kinematics a(*robot.model), b(*target.model);
+  if (forwardKinematics(*robot.model, robot.state, a) || forwardKinematics(*target.model, target.state, b))
+    f.fail("the contact points cannot be computed at the given states");
+  target.state.world_T_base.p += toKDL(a.point(robot.contact) - b.point(target.contact));
 }
 
 /// The impact law; `has_normal` is set when a normal is given.
@@ -227,14 +240,20 @@ Scenario loadScenario(const std::string& path) {
   top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
   s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
+  if (top.at("robot").has("place")) top.at("robot").at("place").fail("only a free-floating target is placed (target.place: touch)");
   // A plain motion has neither target nor law; an impact needs both.
   s.impact = top.has("target") || top.has("law");
   if (s.impact) {
     top.at("robot").at("contact");  // reports it missing: an impact needs the robot's contact point
     const Field target = top.at("target");
     if (target.has("urdf")) target.at("contact");
-    if (target.has("urdf")) s.capture.target = system(target, folder, s.target_urdf);
-    else s.capture.target = rigidTarget(target);
+    if (target.has("urdf")) {
+      FloatingSystem t = system(target, folder, s.target_urdf);
+      if (target.has("place")) place(target.at("place"), s.capture.robot, t);
+      s.capture.target = std::move(t);
+    } else {
+      s.capture.target = rigidTarget(target);
+    }
     s.capture.law = law(top.at("law"), s.capture.has_normal);
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
