@@ -154,7 +154,7 @@ ApproachOutcome approachPhase(const Scenario& sc, CaptureProblem& problem, doubl
   }
   if (const int e = controller->target(s.t, outcome.target_at_contact))
     throw InputError(sc.file + ": approach: the target's motion: " + strError(e));
-  if (!samples.empty()) samples.back().phase = "capture";
+  if (outcome.record.reached && !samples.empty()) samples.back().phase = "capture";
   problem.robot.state = s.state;
   problem.robot.velocity = s.velocity;
   problem.target = outcome.target_at_contact;

@@ -3,6 +3,7 @@
 // the CSV and the JSON (modes that persist, hard stops, friction, the base's control, stiffness).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -37,7 +38,9 @@ std::map<std::string, std::vector<double>> readCsv(const std::string& path) {
   while (std::getline(in, line)) {
     std::stringstream r(line);
     std::size_t i = 0;
-    for (std::string cell; std::getline(r, cell, ','); ++i) columns[header.at(i)].push_back(std::stod(cell));
+    for (std::string cell; std::getline(r, cell, ','); ++i)  // phase: text; grasp_distance: empty outside the approach
+      columns[header.at(i)].push_back(header.at(i) == "phase" || cell.empty() ? std::nan("") : std::stod(cell));
+    if (!line.empty() && line.back() == ',') columns[header.at(i++)].push_back(std::nan(""));  // an empty last cell
     EXPECT_EQ(i, header.size()) << line;
   }
   return columns;
@@ -131,8 +134,6 @@ TEST(PlainMotion, GravityWorkOnAFreeBaseClosesTheEnergyBalance) {
 TEST(ShippedScenarios, EveryOneSimulatesWithTheNewReports) {
   for (const auto& entry : fs::directory_iterator(kScenarios)) {
     if (entry.path().extension() != ".yaml") continue;
-    // A capture of one free-floating robot by another: `simulate` does not join them yet.
-    if (entry.path().filename() == "robot_to_robot_capture.yaml") continue;
     SCOPED_TRACE(entry.path().filename().string());
     const json j = simulateJson(entry.path().string() + " --duration 2");
     if (j.is_null()) continue;
@@ -276,6 +277,146 @@ TEST(Stiffness, ExplicitRunIsFlaggedAndRosenbrockAgreesWithFarFewerSteps) {
   EXPECT_LT(s.at("accepted_steps").get<long>() * 10, e.at("accepted_steps").get<long>());
   for (std::size_t k = 0; k < 7; ++k)
     EXPECT_NEAR(s.at("final").at("q")[k].get<double>(), e.at("final").at("q")[k].get<double>(), 1e-6) << k;
+}
+
+
+// --- The whole operation: approach, contact, capture of any target, the motion after ----------
+
+/// The phase column of a CSV, row by row.
+std::vector<std::string> phases(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::stringstream h(line);
+  std::size_t index = 0, at = 0;
+  for (std::string cell; std::getline(h, cell, ','); ++index)
+    if (cell == "phase") at = index;
+  std::vector<std::string> out;
+  while (std::getline(in, line)) {
+    std::stringstream r(line);
+    std::string cell;
+    for (std::size_t i = 0; i <= at; ++i) std::getline(r, cell, ',');
+    out.push_back(cell);
+  }
+  return out;
+}
+
+TEST(Operation, ApproachReachesTheTumblingBoxAndTheCaptureStartsFromTheStatesThen) {
+  const std::string csv = scratch("approach.csv");
+  const json j = simulateJson(kScenarios + "approach_tumbling_box.yaml --duration 2 --csv " + csv);
+  ASSERT_FALSE(j.is_null());
+  const json& a = j.at("approach");
+  ASSERT_TRUE(a.at("reached").get<bool>());
+  const double t_c = a.at("t_contact").get<double>();
+  EXPECT_GT(t_c, 1.0);
+  EXPECT_LE(a.at("final_position_error").get<double>(), 0.005);
+  EXPECT_LE(a.at("final_orientation_error").get<double>(), 0.05);
+  EXPECT_GT(a.at("min_singular_value").get<double>(), 0.0);
+  EXPECT_GT(a.at("base_attitude_change").get<double>(), 0.0);  // the base reacted to the arm
+  // One CSV across the phases: approach rows, the contact row, then the motion after the capture.
+  const std::vector<std::string> p = phases(csv);
+  const auto c = readCsv(csv);
+  const std::size_t contact = std::find(p.begin(), p.end(), "capture") - p.begin();
+  ASSERT_LT(contact + 1, p.size());
+  for (std::size_t i = 0; i < contact; ++i) EXPECT_EQ(p[i], "approach") << i;
+  for (std::size_t i = contact + 1; i < p.size(); ++i) EXPECT_EQ(p[i], "post") << i;
+  EXPECT_DOUBLE_EQ(c.at("t")[contact], t_c);
+  EXPECT_DOUBLE_EQ(c.at("t")[contact + 1], t_c);
+  EXPECT_NEAR(c.at("t").back(), t_c + 2.0, 1e-9);
+  EXPECT_LE(c.at("grasp_distance")[contact], 0.005);
+  EXPECT_GT(c.at("grasp_distance")[0], 0.1);
+  EXPECT_TRUE(std::isnan(c.at("grasp_distance").back()));
+  // The capture is solved from the states at the contact instant, not the scenario's start
+  // (all joints at rest there): its rates before are the contact row's, after the next row's.
+  const json& robot = j.at("capture").at("robot");
+  const std::vector<std::string> joints = robot.at("joint_names");
+  double moving = 0.0;
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const double before = robot.at("qdot_before")[k].get<double>(), after = robot.at("qdot_after")[k].get<double>();
+    EXPECT_NEAR(c.at("qdot_" + joints[k])[contact], before, 1e-12) << joints[k];
+    EXPECT_NEAR(c.at("qdot_" + joints[k])[contact + 1], after, 1e-12) << joints[k];
+    moving = std::max(moving, std::abs(before));
+  }
+  EXPECT_GT(moving, 1e-3);
+  // The box's twist at the contact instant is its torque-free tumble then, not its initial twist.
+  const std::vector<double> twist0{0.003, -0.002, 0.001, 0.02, 0.03, -0.02};
+  const json& target_before = j.at("capture").at("target").at("twist_before");
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(target_before[k].get<double>(), twist0[k], 1e-15);
+  EXPECT_GT(std::abs(target_before[3].get<double>() - twist0[3]), 1e-5);
+  // After the capture, momentum is conserved by the motion.
+  EXPECT_LT(j.at("simulation").at("max_angular_momentum_change").get<double>(), 1e-12);
+}
+
+TEST(Operation, AnUnreachableGraspPointIsReportedWithTheClosestDistanceAndTheApproachWritten) {
+  const std::string csv = scratch("unreachable.csv");
+  const std::string path = variant("approach_tumbling_box", "grasp: {position: [0.141, 0.243, -0.105]",
+                                   "max_duration: 3\n  grasp: {position: [8.0, 0.0, 0.0]");
+  std::string text;
+  {
+    std::ifstream in(path);
+    std::stringstream t;
+    t << in.rdbuf();
+    text = std::regex_replace(t.str(), std::regex("\n  max_duration: 30"), "");
+  }
+  std::ofstream(path) << text;
+  const ToolRun r = kdlSpace("simulate " + path + " --csv " + csv);
+  EXPECT_EQ(r.rc, 3) << r.err;
+  EXPECT_NE(r.err.find("approach: the hand never reached the grasp point in 3 s (approach.max_duration): closest "),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out, "");
+  const std::vector<std::string> p = phases(csv);
+  ASSERT_EQ(p.size(), 61u);  // 0, 0.05, ..., 3 s
+  for (const std::string& phase : p) EXPECT_EQ(phase, "approach");
+}
+
+TEST(Operation, ACapturedFreeFloatingRobotMovesOnAsOneTree) {
+  for (const char* name : {"robot_to_robot_capture", "dual_arm_captures_robot"}) {
+    SCOPED_TRACE(name);
+    const json j = simulateJson(kScenarios + name + ".yaml --duration 3");
+    ASSERT_FALSE(j.is_null());
+    const json& sim = j.at("simulation");
+    EXPECT_EQ(sim.at("target_joined").at("grasp"), "rigid");
+    // the joined system's momentum is the capture's after it (both sides), and stays so
+    const json& h = j.at("capture").at("momentum_after");
+    double scale = 0.0;
+    for (int k = 0; k < 6; ++k) scale = std::max(scale, std::abs(h[k].get<double>()));
+    EXPECT_LT(sim.at("max_linear_momentum_change").get<double>(), 1e-12 * scale);
+    EXPECT_LT(sim.at("max_angular_momentum_change").get<double>(), 1e-12 * scale);
+    // the target's joints are coordinates of the joined model
+    EXPECT_GT(sim.at("joint_names").size(), j.at("capture").at("robot").at("joint_names").size());
+    EXPECT_NEAR(sim.at("energy").get<double>(), j.at("capture").at("energy_after").get<double>(),
+                1e-10 * j.at("capture").at("energy_after").get<double>());
+  }
+}
+
+TEST(Operation, PlaceTouchPutsTheTargetsContactOnTheRobots) {
+  // without `place: touch` the hand is 1.5 m or more away from the tool: refused, naming the distance
+  const ToolRun r = kdlSpace("capture " + variant("dual_arm_captures_robot", "  place: touch", ""));
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find("target.contact: the target's contact point is "), std::string::npos) << r.err;
+  // with it, the two contact points touch (within the capture's 1 mm) and the capture is solved
+  const ToolRun placed = kdlSpace("capture " + kScenarios + "dual_arm_captures_robot.yaml --json");
+  ASSERT_EQ(placed.rc, 0) << placed.err;
+  EXPECT_EQ(json::parse(placed.out).at("target").at("joint_names"), json({"joint1", "joint2"}));
+}
+
+TEST(Operation, ATranslationalCaptureHangsTheTargetOnABallJoint) {
+  const std::string csv = scratch("ball.csv");
+  const json j = simulateJson(kScenarios + "translational_capture.yaml --duration 3 --csv " + csv);
+  ASSERT_FALSE(j.is_null());
+  const json& sim = j.at("simulation");
+  EXPECT_EQ(sim.at("target_joined").at("grasp"), "spherical");
+  const double margin = sim.at("target_joined").at("min_chart_margin").get<double>();
+  EXPECT_GT(margin, 0.1);
+  EXPECT_LE(margin, 1.0);
+  EXPECT_LT(sim.at("max_angular_momentum_change").get<double>(), 1e-12);
+  // the box turns relative to the hand: the ball joint's angles move
+  const auto c = readCsv(csv);
+  double turned = 0.0;
+  for (const char* k : {"q_grasp_rz", "q_grasp_ry", "q_grasp_rx"}) turned = std::max(turned, std::abs(c.at(k).back()));
+  EXPECT_GT(turned, 1e-3);
+  EXPECT_EQ(c.at(std::string("q_grasp_rz")).front(), 0.0);  // the chart's centre at the capture
 }
 
 }  // namespace

@@ -83,7 +83,7 @@ const std::vector<Broken>& corpus() {
       {"missing_robot.yaml", "{f}:2: robot: missing (a required field)", false},
       {"missing_target_mass.yaml", "{f}:10: target.mass: missing (a required field)", false},
       {"missing_law_type.yaml", "{f}:15: law.type: missing (a required field)", false},
-      {"unknown_top_field.yaml", "{f}:21: colour: unknown field (expected one of robot, target, law, simulation)", false},
+      {"unknown_top_field.yaml", "{f}:21: colour: unknown field (expected one of robot, target, law, approach, simulation)", false},
       {"unknown_target_field.yaml",
        "{f}:13: target.colour: unknown field (expected one of mass, inertia, pose, com, twist)", false},
       {"duplicate_field.yaml", "{f}:11: target.mass: given twice", false},

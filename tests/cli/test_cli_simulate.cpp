@@ -43,7 +43,8 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
   const std::vector<std::string> header = split(line);
   const std::vector<std::string> joints = j.at("simulation").at("joint_names");
   EXPECT_EQ(header.front(), "t");
-  EXPECT_EQ(header.back(), "work_gravity");  // the columns added since end the header
+  EXPECT_EQ(header.back(), "grasp_distance");  // the columns added since end the header
+  EXPECT_EQ(header[header.size() - 3], "work_gravity");
   for (const std::string& name : joints) {
     EXPECT_NE(std::find(header.begin(), header.end(), "q_" + name), header.end()) << name;
     EXPECT_NE(std::find(header.begin(), header.end(), "qdot_" + name), header.end()) << name;
@@ -53,8 +54,13 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
   std::vector<std::vector<double>> rows;
   while (std::getline(in, line)) {
     std::vector<double> row;
-    for (const std::string& cell : split(line)) row.push_back(std::stod(cell));
-    ASSERT_EQ(row.size(), header.size()) << line;
+    std::vector<std::string> cells = split(line);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();  // grasp_distance: empty after the impact
+    ASSERT_EQ(cells.size(), header.size()) << line;
+    EXPECT_EQ(cells[header.size() - 2], "post");  // the phase: after the impact
+    EXPECT_EQ(cells.back(), "");
+    cells.resize(header.size() - 2);
+    for (const std::string& cell : cells) row.push_back(std::stod(cell));
     rows.push_back(row);
   }
   ASSERT_EQ(rows.size(), 41u);  // t = 0, 0.05, ..., 2
@@ -98,13 +104,13 @@ TEST(SimulateTool, ReadableSummary) {
 
 TEST(SimulateTool, BadInputFailsCleanlyAndLeavesNoFile) {
   const std::string csv = scratch("bad.csv"), plot = scratch("bad.svg");
-  // A scenario that loads but cannot be simulated (translational capture), and bad options.
-  const std::string scenario = scratch("translational.yaml");
+  // A scenario that loads but cannot be simulated (a step budget too small), and bad options.
+  const std::string scenario = scratch("small_budget.yaml");
   std::ifstream in(kScenario);
   std::stringstream text;
   text << in.rdbuf();
   std::string yaml = text.str();
-  yaml.replace(yaml.find("type: capture"), 13, "type: translational");
+  yaml.replace(yaml.find("rtol: 1.0e-10"), 13, "rtol: 1.0e-10\n  max_steps: 10");
   for (const std::string dir : {std::string("../urdf/")})
     yaml.replace(yaml.find(dir), dir.size(), std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
   std::ofstream(scenario) << yaml;
@@ -113,7 +119,7 @@ TEST(SimulateTool, BadInputFailsCleanlyAndLeavesNoFile) {
     int rc;
     std::string needle;
   } cases[] = {
-      {"simulate " + scenario + " --csv " + csv + " --plot " + plot, 3, "translational"},
+      {"simulate " + scenario + " --csv " + csv + " --plot " + plot, 3, "more than simulation.max_steps = 10"},
       {"simulate " + kScenario + " --duration -1 --csv " + csv, 2, "duration"},
       {"simulate " + kScenario + " --plot " + scratch("bad.gif"), 2, ".svg or .png"},
       {"simulate /nonexistent.yaml --csv " + csv, 3, "nonexistent"},
