@@ -108,6 +108,18 @@ const std::vector<Broken>& corpus() {
        "{f}:11: target.inertia: is no rigid body's inertia: its principal moments break the triangle inequality "
        "I1 + I2 >= I3 (principal moments 1, 1, 3 kg m^2)",
        false},
+      // The approach and the placing of the target.
+      {"approach_zero_gain.yaml", "{f}:18: approach.gain: must be > 0, got 0", false},
+      {"approach_negative_tolerance.yaml", "{f}:18: approach.tolerance.position: must be > 0, got -0.01", false},
+      {"approach_missing_grasp.yaml", "{f}:17: approach.grasp: missing (a required field)", false},
+      {"approach_unknown_field.yaml",
+       "{f}:18: approach.speed: unknown field (expected one of grasp, track, gain, damping, singular_threshold, "
+       "rate_limits, servo_bandwidth, null_space, tolerance, max_duration)",
+       false},
+      {"place_touch_rigid.yaml",
+       "{f}:10: target.place: a rigid target has no contact point of its own (the point hit is the robot's contact "
+       "point): place it with pose",
+       false},
       {"target_not_touching.yaml",
        "{f}: target.contact: the target's contact point is 2 m from the robot's; they must touch (within 1 mm)", false},
       // The robot: its URDF, links, joints, mode, state.
