@@ -215,7 +215,7 @@ std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t in
 
 std::string sceneTerminal(const std::string& path, std::size_t panels, const std::string& option) {
   const std::string ext = fs::path(path).extension().string();
-  const std::string size = std::to_string(560 * std::max<std::size_t>(1, panels)) + ",620";
+  const std::string size = std::to_string(640 * std::max<std::size_t>(1, panels)) + ",720";
   if (ext == ".svg") return "svg size " + size + " dynamic font 'sans,11'";
   if (ext == ".png") return "pngcairo size " + size + " font 'sans,10'";
   throw UsageError(option + " " + path + ": the file name must end in .svg or .png");
@@ -264,7 +264,8 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
     g << "set multiplot layout 1," << panels.size() << " title " << label(title) << "\n"
       << "set view equal xyz\nset view 62, 35\nset xyplane relative 0\nset grid\n"
       << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]' rotate parallel\n"
-      << "set key below horizontal samplen 2 spacing 1 font ',9'\n";
+      << "set key below Left reverse horizontal maxcols 2 width 2 samplen 2 spacing 1 font ',9'\n"
+      << "set margins 2, 2, 0, 0\n";
     const char* axis = "xyz";
     for (int k = 0; k < 3; ++k)
       g << "set " << axis[k] << "range [" << centre(k) - half << ":" << centre(k) + half << "]\n";
