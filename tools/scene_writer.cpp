@@ -177,8 +177,12 @@ void writeBlock(std::ostream& g, const std::string& name, const std::vector<Vect
 }
 
 /// The plot clauses of one panel (only what it has: gnuplot warns about empty data).
-std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t index) {
+std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t index, std::size_t panels) {
   std::vector<std::string> out;
+  // Arrow heads of the same size on the page whatever the number of panels side by side.
+  std::ostringstream head_size;
+  head_size << "head filled size screen " << 0.012 / static_cast<double>(std::max<std::size_t>(1, panels)) << ",20";
+  const std::string head = head_size.str();
   const std::string prefix = "$p" + std::to_string(index) + "_";
   const auto segments = [&](const std::string& name, const std::vector<Segment>& list, const std::string& style) {
     if (list.empty()) return;
@@ -195,7 +199,7 @@ std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t in
     segments(who + "base", f.base_box, "nohead lw 1.5 lc rgb '#707070' title " + label(what + " base box"));
     segments(who + "links", f.links, "nohead lw 3 lc rgb '" + rgb + "' title " + label(what));
     points(who + "origins", f.origins, "pt 7 ps 0.6 lc rgb '" + rgb + "' notitle");
-    segments(who + "axes", f.axes, "head filled size screen 0.01,20 lw 1.5 lc rgb '#e377c2' title " +
+    segments(who + "axes", f.axes, head + " lw 1.5 lc rgb '#e377c2' title " +
                                         label(what + " joint axes"));
   };
   figure("r", p.robot, "#1f4e99", "robot");
@@ -203,8 +207,8 @@ std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t in
   segments("tbox", p.target_box, "nohead lw 2 lc rgb '#ff7f0e' title 'target (box of inertia)'");
   if (!p.target_frame.empty()) {
     writeBlock(g, prefix + "tframe", p.target_frame, true);
-    out.push_back(prefix + "tframe using 1:2:3:4:5:6:7 with vectors head filled size screen 0.01,20 lw 2 "
-                           "lc rgb variable title 'target frame (x, y, z)'");
+    out.push_back(prefix + "tframe using 1:2:3:4:5:6:7 with vectors " + head +
+                  " lw 2 lc rgb variable title 'target frame (x, y, z)'");
   }
   points("contact", p.contact, "pt 7 ps 1.6 lc rgb '#d62728' title 'contact point'");
   points("grasp", p.grasp, "pt 6 ps 2.2 lw 2 lc rgb '#2ca02c' title 'grasp point'");
@@ -260,7 +264,7 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
     g << std::setprecision(12);
     g << "set terminal " << terminal << "\nset output " << gpQuoted(file.tmp()) << "\n";
     std::vector<std::vector<std::string>> plots;
-    for (std::size_t i = 0; i < panels.size(); ++i) plots.push_back(clauses(g, panels[i], i));
+    for (std::size_t i = 0; i < panels.size(); ++i) plots.push_back(clauses(g, panels[i], i, panels.size()));
     g << "set multiplot layout 1," << panels.size() << " title " << label(title) << "\n"
       << "set view equal xyz\nset view 62, 35\nset xyplane relative 0\nset grid\n"
       << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]' rotate parallel\n"
