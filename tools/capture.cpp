@@ -1,9 +1,14 @@
 #include "capture.hpp"
 
+#include <cstdlib>
+#include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "kdl_space/kinematics.hpp"
+#include "scene_writer.hpp"
 
 namespace kdl_space::cli {
 namespace {
@@ -40,6 +45,10 @@ std::string row(const Eigen::VectorXd& v) {
 CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
   CLI::App* cmd = app.add_subcommand("capture", "Solve the impact or capture of a scenario (YAML or JSON)");
   cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON)")->required();
+  const CLI::Validator file_name(
+      [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "");
+  cmd->add_option("--scene", o.scene, "Draw the robot, the target and the contact point at the impact in 3-D (.svg or .png)")
+      ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   return cmd;
 }
@@ -133,15 +142,56 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
   }
 }
 
+SceneSnapshot impactSnapshot(const Scenario& sc) {
+  const CaptureProblem& p = sc.capture;
+  SceneSnapshot s;
+  s.label = "impact";
+  s.robot = p.robot.model;
+  s.robot_state = p.robot.state;
+  s.robot_contact = p.robot.contact;
+  if (const auto* rigid = std::get_if<RigidTarget>(&p.target)) {
+    s.target_body = rigid->toWorld();
+    s.target_frame = rigid->pose;
+  } else if (const auto* other = std::get_if<FloatingSystem>(&p.target)) {
+    s.target_robot = other->model;
+    s.target_state = other->state;
+    Kinematics kin(*other->model);
+    if (forwardKinematics(*other->model, other->state, kin) == E_NOERROR && other->contact.body >= 0)
+      s.grasp_point = kin.point(other->contact);
+  }
+  return s;
+}
+
 void runCapture(const CaptureOptions& o, std::ostream& out) {
+  // An output that cannot be written is refused before any work.
+  if (!o.scene.empty()) {
+    namespace fs = std::filesystem;
+    sceneTerminal(o.scene);
+    checkOutputFile(o.scene, "--scene");
+    std::error_code ec;
+    if (fs::equivalent(o.scene, o.scenario, ec))
+      throw UsageError("--scene " + o.scene + ": is the scenario file; it would be overwritten");
+    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0)
+      throw InputError("--scene " + o.scene + ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
+  }
   const Scenario sc = loadScenario(o.scenario);
   if (!sc.impact)
     throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
   const CaptureResult result = inScenario(sc, [&] { return solveCapture(sc.capture); });
-  if (o.json)
-    out << captureJson(sc, result).dump(2) << "\n";
-  else
+  if (!o.scene.empty()) {
+    AtomicFile scene(o.scene, "--scene");
+    writeScene(scene, {impactSnapshot(sc)},
+               "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
+    scene.commit();
+  }
+  if (o.json) {
+    Json j = captureJson(sc, result);
+    j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);
+    out << j.dump(2) << "\n";
+  } else {
     printCaptureSummary(out, sc, result);
+    if (!o.scene.empty()) out << "Scene: " << o.scene << "\n";
+  }
 }
 
 }  // namespace kdl_space::cli

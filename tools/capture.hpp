@@ -1,5 +1,6 @@
-// `kdl_space capture SCENARIO [--json]`: the impact of the robot with its target, everything
-// before and after (the library's loadScenario and solveCapture, printed).
+// `kdl_space capture SCENARIO [--scene FILE] [--json]`: the impact of the robot with its target,
+// everything before and after (the library's loadScenario and solveCapture, printed), and a
+// picture of the impact instant (--scene).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -7,12 +8,14 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "scene_writer.hpp"
 #include "kdl_space/scenario.hpp"
 
 namespace kdl_space::cli {
 
 struct CaptureOptions {
   std::string scenario;
+  std::string scene;  ///< --scene FILE (.svg or .png); empty: none
   bool json = false;
 };
 
@@ -33,6 +36,10 @@ Json captureJson(const Scenario& scenario, const CaptureResult& result);
 void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);
 
 CLI::App* addCapture(CLI::App& app, CaptureOptions& options);
+/// The picture of the impact instant: one snapshot "impact" (the robot at its state, its
+/// contact point, the target; a free-floating target's contact point as the grasp point).
+SceneSnapshot impactSnapshot(const Scenario& scenario);
+
 void runCapture(const CaptureOptions& options, std::ostream& out);
 
 }  // namespace kdl_space::cli
