@@ -94,6 +94,8 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     g << "set terminal " << terminal << "\nset output " << quotedPath(out.tmp()) << "\n"
       << "set multiplot layout " << panels << ",1 title " << label(title) << "\n"
       << "set grid\nset key outside right\nset xlabel 'time [s]'\nset datafile missing 'NaN'\n";
+    if (samples.back().t > samples.front().t)  // every panel over the whole run
+      g << "set xrange [" << samples.front().t << ":" << samples.back().t << "]\n";
     if (std::isfinite(capture_time))  // an arrow of the graph: drawn on every panel
       g << "set arrow 1 from " << capture_time << ", graph 0 to " << capture_time << ", graph 1 nohead dt 2 lc rgb 'red'\n"
         << "set label 1 'capture' at " << capture_time << ", graph 0.95 offset 0.5,0 tc rgb 'red'\n";

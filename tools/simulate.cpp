@@ -16,6 +16,7 @@
 #include "detail/text.hpp"
 #include "motion_report.hpp"
 #include "plot_writer.hpp"
+#include "scene_writer.hpp"
 
 namespace kdl_space::cli {
 namespace {
@@ -194,6 +195,51 @@ std::optional<JoinedSystem> joined(const CaptureProblem& problem, const CaptureR
   return joinAtGrasp(problem.robot, capture.robot.after, body, after, grasp, problem.touch_tolerance);
 }
 
+/// The scene at the start, at the contact (the impact, at t_contact) and at the end of the run.
+std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const CaptureProblem& at_contact,
+                                          const std::optional<CaptureResult>& capture, bool joined,
+                                          const std::shared_ptr<const FloatingModel>& model, const SimulationState& end,
+                                          double t_contact) {
+  // The grasp point of an approach: fixed in the (rigid) target's frame.
+  const auto grasp = [&](const CaptureTarget& target) -> std::optional<Vector3d> {
+    const auto* rigid = std::get_if<RigidTarget>(&target);
+    if (!sc.approach || !rigid) return std::nullopt;
+    return toEigen(rigid->pose * sc.approach->grasp.p);
+  };
+  const auto at = [&](const CaptureProblem& problem, const char* label, double t) {
+    Scenario then = sc;
+    then.capture = problem;
+    SceneSnapshot snap = impactSnapshot(then);
+    if (!sc.impact) snap.target_body.reset();  // a plain motion: no target
+    if (const std::optional<Vector3d> g = grasp(problem.target)) snap.grasp_point = g;
+    snap.label = label;
+    snap.t = t;
+    return snap;
+  };
+  std::vector<SceneSnapshot> out;
+  if (sc.approach || !sc.impact) out.push_back(at(sc.capture, "start", 0.0));
+  if (sc.impact) out.push_back(at(at_contact, sc.approach ? "contact" : "impact", t_contact));
+  SceneSnapshot last;
+  last.label = "end";
+  last.t = end.t;
+  last.robot = model;  // the joined system, the robot with its payload, or the robot alone
+  last.robot_state = end.state;
+  last.robot_contact = joined ? Contact{-1, KDL::Vector::Zero()} : at_contact.robot.contact;
+  if (capture && model == at_contact.robot.model) {  // the target separated: a rigid one tumbles on
+    if (const auto* rigid = std::get_if<RigidTarget>(&at_contact.target)) {
+      RigidTarget after = *rigid;
+      after.twist = capture->target_twist_after;
+      RigidTarget later;
+      if (FreeRigidMotion(after).at(end.t - t_contact, later) == E_NOERROR) {
+        last.target_body = later.toWorld();
+        last.target_frame = later.pose;
+      }
+    }
+  }
+  out.push_back(last);
+  return out;
+}
+
 }  // namespace
 
 CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
@@ -207,6 +253,8 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
       ->type_name("FILE")->check(file_name);
   cmd->add_option("--plot", o.plot, "Draw base attitude, joint angles (and torques), momentum and energy balance (.svg or .png)")
       ->type_name("FILE")->check(file_name);
+  cmd->add_option("--scene", o.scene, "Draw the scene in 3-D at the start, at the contact and at the end (.svg or .png)")
+      ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   return cmd;
 }
@@ -214,16 +262,24 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
 void runSimulate(const SimulateOptions& o, std::ostream& out) {
   // Everything that can be refused without simulating is refused first.
   if (!o.plot.empty()) plotTerminal(o.plot);
-  if (!o.csv.empty()) checkOutputFile(o.csv, "--csv");
-  if (!o.plot.empty()) checkOutputFile(o.plot, "--plot");
+  if (!o.scene.empty()) sceneTerminal(o.scene, 3);
+  const std::pair<const char*, std::string> outputs[] = {{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}};
   std::error_code ec;
-  if (!o.csv.empty() && !o.plot.empty() && (o.csv == o.plot || fs::equivalent(o.csv, o.plot, ec)))
-    throw UsageError("--csv and --plot name the same file " + o.plot);
-  for (const auto& [option, path] : {std::pair{"--csv", o.csv}, std::pair{"--plot", o.plot}})
-    if (!path.empty() && fs::equivalent(path, o.scenario, ec))
+  for (const auto& [option, path] : outputs) {
+    if (path.empty()) continue;
+    checkOutputFile(path, option);
+    if (fs::equivalent(path, o.scenario, ec))
       throw UsageError(std::string(option) + " " + path + ": is the scenario file; it would be overwritten");
-  if (!o.plot.empty() && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
-    throw InputError("--plot " + o.plot + ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
+    for (const auto& [other, other_path] : outputs)
+      if (other != option && path == other_path)
+        throw UsageError(std::string(option) + " and " + other + " name the same file " + path);
+  }
+  if (!o.csv.empty() && !o.plot.empty() && fs::equivalent(o.csv, o.plot, ec))
+    throw UsageError("--csv and --plot name the same file " + o.plot);
+  for (const auto& [option, path] : outputs)
+    if (!path.empty() && std::string(option) != "--csv" && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
+      throw InputError(std::string(option) + " " + path +
+                       ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 
   const Scenario sc = loadScenario(o.scenario);
   const SimulationSpec& spec = sc.simulation;
@@ -363,15 +419,25 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     writePlot(*plot_file, all, joints, "kdl_space simulate " + fs::path(sc.file).filename().string(), torques || approach,
               sc.impact && approach ? t_capture : std::numeric_limits<double>::quiet_NaN());
   }
-  // Every output is complete: give them their names (a failed rename takes the other back).
+  std::unique_ptr<AtomicFile> scene_file;
+  if (!o.scene.empty()) {
+    scene_file = std::make_unique<AtomicFile>(o.scene, "--scene");
+    writeScene(*scene_file, sceneSnapshots(sc, problem, capture, joint.has_value(), model, s, t_capture),
+               "kdl_space simulate " + fs::path(sc.file).filename().string(), "--scene");
+  }
+  // Every output is complete: give them their names (a failed rename takes the others back).
   if (csv) csv->file().commit();
-  if (plot_file) {
+  try {
+    if (plot_file) plot_file->commit();
     try {
-      plot_file->commit();
+      if (scene_file) scene_file->commit();
     } catch (const InputError&) {
-      if (csv) csv->file().retract();
+      if (plot_file) plot_file->retract();
       throw;
     }
+  } catch (const InputError&) {
+    if (csv) csv->file().retract();
+    throw;
   }
 
   // Drift of the invariants over the run (no external force unless gravity is set).

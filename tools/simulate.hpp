@@ -12,7 +12,7 @@ namespace kdl_space::cli {
 struct SimulateOptions {
   std::string scenario;
   std::optional<double> duration;
-  std::string csv, plot;
+  std::string csv, plot, scene;
   bool json = false;
 };
 
