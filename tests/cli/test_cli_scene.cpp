@@ -169,6 +169,30 @@ TEST_F(Scene, CaptureDrawsAFreeFloatingTargetAsAStickFigure) {
   EXPECT_GE(segments(text, "target base box"), 12u);
 }
 
+TEST_F(Scene, SimulateDrawsTheStartTheContactAndTheEnd) {
+  const std::string svg = (dir / "operation.svg").string(), csv = (dir / "operation.csv").string();
+  const ToolRun r = kdlSpace("simulate " + kScenarios + "approach_tumbling_box.yaml --duration 1 --scene " + svg +
+                             " --csv " + csv + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"operation.csv", "operation.svg"})) << "no temporary left behind";
+  const std::string text = readFile(svg);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const double t_c = j.at("approach").at("t_contact").get<double>();
+  for (const char* panel : {">start, t = 0 s<", ">end, t = "}) EXPECT_NE(text.find(panel), std::string::npos) << panel;
+  std::ostringstream contact;
+  contact << ">contact, t = " << t_c << " s<";
+  EXPECT_NE(text.find(contact.str()), std::string::npos) << contact.str();
+  EXPECT_EQ(count(text, ">grasp point<"), 2u) << "at the start and at the contact";
+  const Scenario sc = loadScenario(kScenarios + "approach_tumbling_box.yaml");
+  // three stick figures of the arm, two boxes of the target (at the end it is the arm's payload)
+  EXPECT_GE(segments(text, "robot"), 3 * sc.capture.robot.model->bodies().size());
+  EXPECT_GE(segments(text, "target (box of inertia)"), 24u);
+  // --scene and --csv may not name the same file
+  const ToolRun same = kdlSpace("simulate " + kScenarios + "approach_tumbling_box.yaml --scene " + svg + " --csv " + svg);
+  EXPECT_EQ(same.rc, 2);
+  EXPECT_NE(same.err.find("name the same file " + svg), std::string::npos) << same.err;
+}
+
 TEST_F(Scene, JsonSaysNullWithoutAScene) {
   const ToolRun r = kdlSpace("capture " + kScenarios + "tumbling_box_capture.yaml --json");
   ASSERT_EQ(r.rc, 0) << r.err;
