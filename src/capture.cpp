@@ -4,6 +4,7 @@
 #include <string>
 
 #include "detail/text.hpp"
+#include "kdl_space/kinematics.hpp"
 
 namespace kdl_space {
 namespace {
@@ -69,6 +70,39 @@ RigidBody RigidTarget::toWorld() const {
   b.com = toEigen(pose * toKDL(com));
   b.twist = twist;
   return b;
+}
+
+RigidTarget rigidSubtree(const FloatingModel& model, const State& state, int body, const KDL::Twist& base_twist) {
+  const std::vector<Body>& bodies = model.bodies();
+  if (body < 0 || body >= static_cast<int>(bodies.size())) throw InputError("target: " + std::string(strError(E_BAD_CONTACT)));
+  Kinematics kin(model);
+  if (const int rc = forwardKinematics(model, state, kin)) throw InputError("target: the state: " + std::string(strError(rc)));
+  // The subtree: bodies come parents first, so one pass marks it.
+  std::vector<char> in(bodies.size(), 0);
+  in[body] = 1;
+  for (std::size_t j = body + 1; j < bodies.size(); ++j) in[j] = bodies[j].parent >= 0 && in[bodies[j].parent];
+  double m = 0.0;
+  Vector3d first_moment = Vector3d::Zero();
+  for (std::size_t j = 0; j < bodies.size(); ++j)
+    if (in[j]) m += bodies[j].mass, first_moment += bodies[j].mass * kin.com[j];
+  if (!(m > 0.0)) throw InputError("target: the links from " + detail::quoted(bodies[body].name) + " down have no mass");
+  const Vector3d c = first_moment / m;
+  Matrix3d I = Matrix3d::Zero();  // about c, world axes (parallel axes)
+  for (std::size_t j = 0; j < bodies.size(); ++j) {
+    if (!in[j]) continue;
+    const Vector3d r = kin.com[j] - c;
+    I += kin.I_com[j] + bodies[j].mass * (r.squaredNorm() * Matrix3d::Identity() - r * r.transpose());
+  }
+  RigidTarget t;
+  t.mass = m;
+  t.pose = kin.pose(body);
+  const Matrix3d R = toEigen(t.pose.M);
+  t.inertia = R.transpose() * I * R;
+  t.inertia = 0.5 * (t.inertia + t.inertia.transpose());
+  t.com = toEigen(t.pose.Inverse() * toKDL(c));
+  const Vector6d V = toEigen(base_twist);  // the whole moves as the base: v_c = v_o + w x (c - p_o)
+  t.twist << V.head<3>() + V.tail<3>().cross(c - kin.p_b), V.tail<3>();
+  return t;
 }
 
 CaptureResult solveCapture(const CaptureProblem& problem) {

@@ -80,7 +80,7 @@ double rotorInertia(const Field& f) {
 
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link"});
   FloatingSystem s;
   const Field urdf = f.at("urdf");
   urdf_path = urdf.text();
@@ -168,6 +168,29 @@ RigidTarget rigidTarget(const Field& f) {
   return b;
 }
 
+/// A target URDF read as one rigid body: a file without movable joints, or the links from
+/// `link` down (its joints held at `q`); placed and moved by `base` as a rigid body given by numbers.
+RigidTarget rigidUrdfTarget(const Field& f, const FloatingSystem& t) {
+  for (const char* key : {"contact", "place", "qdot", "mode", "locked", "armature"})
+    if (f.has(key))
+      f.at(key).fail(std::string("the target is read as one rigid body (") +
+                     (f.has("link") ? "the links from target.link down" : "its file has no movable joint") +
+                     "): the point hit is the robot's contact point, and it moves as a whole (give its pose and twist in "
+                     "target.base)");
+  int body = 0;
+  if (f.has("link")) {
+    const std::string link = f.at("link").text();
+    body = t.model->bodyIndex(link);
+    if (body < 0)
+      f.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*t.model)) + ")");
+  }
+  try {
+    return rigidSubtree(*t.model, t.state, body, t.velocity.base_twist);
+  } catch (const InputError& e) {
+    f.fail(e.what());
+  }
+}
+
 /// `place: touch`: the target's base moved (translated) so that its contact point is the robot's.
 void place(const Field& f, const FloatingSystem& robot, FloatingSystem& target) {
   if (f.text() != "touch") f.fail(echo(f.text()) + " is not touch (the target's base moved so that its contact point is the robot's)");
@@ -246,11 +269,15 @@ Scenario loadScenario(const std::string& path) {
   if (s.impact) {
     top.at("robot").at("contact");  // reports it missing: an impact needs the robot's contact point
     const Field target = top.at("target");
-    if (target.has("urdf")) target.at("contact");
     if (target.has("urdf")) {
       FloatingSystem t = system(target, folder, s.target_urdf);
-      if (target.has("place")) place(target.at("place"), s.capture.robot, t);
-      s.capture.target = std::move(t);
+      if (target.has("link") || t.model->nj() == 0) {
+        s.capture.target = rigidUrdfTarget(target, t);  // one rigid body: the robot's contact point is hit
+      } else {
+        if (!target.has("contact")) target.at("contact");  // reports it missing
+        if (target.has("place")) place(target.at("place"), s.capture.robot, t);
+        s.capture.target = std::move(t);
+      }
     } else {
       s.capture.target = rigidTarget(target);
     }
@@ -261,7 +288,7 @@ Scenario loadScenario(const std::string& path) {
   if (top.has("approach")) {
     const Field approach = top.at("approach");
     if (!s.impact) approach.fail("an approach reaches a target: give target and law too");
-    if (!s.target_urdf.empty())
+    if (std::holds_alternative<FloatingSystem>(s.capture.target))
       approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
     s.approach = sections::approach(approach, *s.capture.robot.model);
   }

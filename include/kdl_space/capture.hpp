@@ -26,6 +26,14 @@ struct RigidTarget {
   KDL_SPACE_EXPORT RigidBody toWorld() const;
 };
 
+/// \brief The rigid body that the links of `model` from body `body` down (its subtree; body 0: the
+/// whole model) make at `state`, every joint held where `state` puts it: the composite mass, CoM
+/// and inertia, given in the frame of `body` at its world pose, moving with the base's twist
+/// `base_twist` (v of the base frame's origin; w) as one rigid body. A set-up call: \throws
+/// InputError for a body out of range, a state that cannot be computed, or a subtree without mass.
+KDL_SPACE_EXPORT RigidTarget rigidSubtree(const FloatingModel& model, const State& state, int body,
+                                          const KDL::Twist& base_twist);
+
 /// What the robot meets: a rigid body, or another free-floating system (whose contact point must
 /// coincide with the robot's within `CaptureProblem::touch_tolerance`).
 using CaptureTarget = std::variant<RigidTarget, FloatingSystem>;

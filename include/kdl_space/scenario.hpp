@@ -35,7 +35,10 @@ struct SimulationSpec {
 struct Scenario {
   std::string file;         ///< the path it was read from
   std::string robot_urdf;   ///< the robot's URDF (resolved path)
-  std::string target_urdf;  ///< a free-floating target's URDF (resolved path); empty for a rigid target
+  /// The target's URDF (resolved path): a free-floating target, or a rigid one read from a file
+  /// (one without movable joints, or the links from `target.link` down); empty for a rigid target
+  /// given by numbers.
+  std::string target_urdf;
   /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot (whose
   /// `contact` may then be omitted: the base's origin).
   bool impact = true;

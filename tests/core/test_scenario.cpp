@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "kdl_space/scenario.hpp"
 #include "test_util.hpp"
@@ -180,6 +181,93 @@ TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
             kBroken + "locked_joint_moves.yaml:9: robot.locked[1]: joint 'joint2' is braked, so its rate "
                       "robot.qdot.joint2 must be 0, got 0.1");
   EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
+}
+
+
+// --- A rigid target read from a URDF ---------------------------------------------------------
+
+/// A copy of the tumbling-box scenario whose target is `target` (YAML lines), in a scratch folder.
+std::string withTarget(const std::string& name, const std::string& target) {
+  std::ifstream in(kShipped + "tumbling_box_capture.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::size_t from = s.find("target:\n"), to = s.find("law:\n");
+  s.replace(from, to - from, "target:\n" + target);
+  const std::size_t urdf = s.find("../urdf/");
+  s.replace(urdf, 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_rigid_urdf";
+  fs::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << s;
+  return path;
+}
+
+TEST(LoadScenario, ARigidTargetFromAUrdfIsTheSameBodyAsByNumbers) {
+  // satellite_panel.urdf: a 100 kg hub (10, 12, 14 kg m^2) and a 5 kg panel (1, 0.1, 1.1) fixed
+  // 1.5 m along y. By hand: CoM 1.5 * 5 / 105 along y; parallel axes about it on x and z:
+  // 100 (1.5/21)^2 + 5 (1.5 * 20/21)^2 = 4725/441.
+  const double shift = 4725.0 / 441.0;
+  const std::string base = "  base: {position: [-0.6, -2.9, 1.7], rpy: [0.3, -0.2, 0.5], twist: [0.03, -0.02, 0.01, 0.05, 0.08, -0.06]}\n";
+  const Scenario from_urdf = loadScenario(withTarget("satellite_urdf.yaml", "  urdf: " + dataDir() + "/rigid_target/satellite_panel.urdf\n" + base));
+  ASSERT_TRUE(std::holds_alternative<RigidTarget>(from_urdf.capture.target));
+  const RigidTarget& t = std::get<RigidTarget>(from_urdf.capture.target);
+  EXPECT_NEAR(t.mass, 105.0, 1e-12);
+  EXPECT_TRUE(near(t.com, Vector3d(0, 7.5 / 105.0, 0), 1e-12, 1e-14, "CoM in the hub's frame"));
+  EXPECT_TRUE(near(t.inertia, Vector3d(11.0 + shift, 12.1, 15.1 + shift).asDiagonal().toDenseMatrix(), 1e-12, 1e-12, "inertia"));
+  // the same body by numbers: the twist of the base origin moved to the CoM by hand
+  const KDL::Frame pose(KDL::Rotation::RPY(0.3, -0.2, 0.5), KDL::Vector(-0.6, -2.9, 1.7));
+  const Vector3d c = toEigen(pose * KDL::Vector(0, 7.5 / 105.0, 0));
+  const Vector3d w(0.05, 0.08, -0.06), v_o(0.03, -0.02, 0.01);
+  const Vector3d v_c = v_o + w.cross(c - Vector3d(-0.6, -2.9, 1.7));
+  std::ostringstream numbers;
+  numbers.precision(17);
+  numbers << "  mass: 105\n  inertia: [[" << 11.0 + shift << ", 0, 0], [0, 12.1, 0], [0, 0, " << 15.1 + shift << "]]\n"
+          << "  pose: {position: [-0.6, -2.9, 1.7], rpy: [0.3, -0.2, 0.5]}\n  com: [0, " << 7.5 / 105.0 << ", 0]\n"
+          << "  twist: [" << v_c.x() << ", " << v_c.y() << ", " << v_c.z() << ", 0.05, 0.08, -0.06]\n";
+  const Scenario by_numbers = loadScenario(withTarget("satellite_numbers.yaml", numbers.str()));
+  const CaptureResult a = solveCapture(from_urdf.capture), b = solveCapture(by_numbers.capture);
+  EXPECT_TRUE(near(a.impulse.F, b.impulse.F, 1e-10, 1e-14, "impulse"));
+  // (1e-10: the inertia summed in another order, through the capture's conditioning)
+  EXPECT_TRUE(near(a.robot.after.qdot.data, b.robot.after.qdot.data, 1e-10, 1e-14, "joint rates after"));
+  EXPECT_TRUE(near(a.target_twist_after, b.target_twist_after, 1e-10, 1e-14, "target after"));
+  EXPECT_NEAR(a.energyLost(), b.energyLost(), 1e-12 * a.energy_before);
+}
+
+TEST(LoadScenario, ALinkSubtreeOfAUrdfIsOneRigidBodyAtItsJointAngles) {
+  // boom.urdf: the boom (2 kg, CoM 0.5 m out, 0.01/0.2/0.2) and a 1 kg gripper fixed 1 m out.
+  // By hand, in the boom's frame: CoM 2/3 m out; I_yy = I_zz = 0.2 + 0.01 + 2 (1/6)^2 + 1 (1/3)^2.
+  const Scenario s = loadScenario(withTarget(
+      "boom.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: boom\n  q: {boom_joint: 0.3}\n"
+                   "  base: {position: [-0.6, -2.9, 1.7]}\n"));
+  const RigidTarget& t = std::get<RigidTarget>(s.capture.target);
+  EXPECT_NEAR(t.mass, 3.0, 1e-12);
+  EXPECT_TRUE(near(t.com, Vector3d(2.0 / 3.0, 0, 0), 1e-12, 1e-14, "CoM"));
+  const double I = 0.21 + 2.0 / 36.0 + 1.0 / 9.0;
+  EXPECT_TRUE(near(t.inertia, Vector3d(0.02, I, I).asDiagonal().toDenseMatrix(), 1e-12, 1e-14, "inertia"));
+  EXPECT_TRUE(near(toEigen(t.pose.M), toEigen(KDL::Rotation::RotZ(0.3)), 1e-14, 1e-14, "the boom's frame"));
+  EXPECT_TRUE(near(toEigen(t.pose.p), Vector3d(-0.6, -2.9, 2.2), 1e-14, 1e-14, "at the joint"));
+  // the links from a fixed one down: the gripper alone
+  const Scenario gripper = loadScenario(withTarget(
+      "gripper.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: gripper\n  q: {boom_joint: 0.3}\n"));
+  EXPECT_NEAR(std::get<RigidTarget>(gripper.capture.target).mass, 1.0, 1e-12);
+  // a rigid URDF target has no contact of its own; a link that is not in the file is named
+  try {
+    loadScenario(withTarget("contact.yaml", "  urdf: " + dataDir() + "/rigid_target/satellite_panel.urdf\n  contact: {link: hub}\n"));
+    ADD_FAILURE() << "a contact on a rigid URDF target accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("target.contact: the target is read as one rigid body (its file has no movable joint)"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    loadScenario(withTarget("nolink.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: antenna\n"));
+    ADD_FAILURE() << "an unknown link accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("target.link: the model has no link 'antenna' (its links: hub, boom, gripper)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
