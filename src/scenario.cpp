@@ -292,7 +292,11 @@ Scenario loadScenario(const std::string& path) {
       approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
     s.approach = sections::approach(approach, *s.capture.robot.model);
   }
-  if (top.has("simulation")) s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model);
+  if (top.has("simulation")) {
+    const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);
+    s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model,
+                                        s.impact && floating ? floating->model.get() : nullptr);
+  }
   return s;
 }
 

@@ -129,9 +129,10 @@ ScheduledWrench wrench(const Field& f, const FloatingModel& robot) {
 
 }  // namespace
 
-SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
+SimulationSpec simulation(const Field& f, const FloatingModel& robot, const FloatingModel* target) {
   f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "max_steps", "gravity",
-              "joints", "base", "limits", "effort_limits", "friction", "friction_velocity", "base_control", "wrenches"});
+              "joints", "base", "limits", "effort_limits", "friction", "friction_velocity", "base_control", "wrenches",
+              "target_joints"});
   SimulationSpec s;
   const auto positive = [&](const char* key, double& value) {
     if (!f.has(key)) return;
@@ -168,6 +169,10 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot) {
   if (f.has("effort_limits")) s.options.effort_limits = f.at("effort_limits").flag();
   if (f.has("friction")) s.options.joint_friction = f.at("friction").flag();
   if (f.has("joints")) s.joints = byJoint<JointControl>(f.at("joints"), robot, jointControl);
+  if (f.has("target_joints")) {  // a captured free-floating target's own joints, after the capture
+    if (!target) f.at("target_joints").fail("only a free-floating target (target.urdf with movable joints) has joints");
+    s.target_joints = byJoint<JointControl>(f.at("target_joints"), *target, jointControl);
+  }
   if (f.has("limits")) {
     const Field limits = f.at("limits");
     if (limits.isScalar()) {

@@ -42,6 +42,7 @@ std::vector<std::pair<unsigned int, T>> byJoint(const fields::Field& f, const Fl
 
 
 /// Reads and checks the `simulation` section for the robot `robot`; InputError naming the field.
-SimulationSpec simulation(const fields::Field& f, const FloatingModel& robot);
+/// `target`: a free-floating target's model (its joints' controls: target_joints), or null.
+SimulationSpec simulation(const fields::Field& f, const FloatingModel& robot, const FloatingModel* target = nullptr);
 
 }  // namespace kdl_space::sections

@@ -240,6 +240,15 @@ std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const CaptureProbl
   return out;
 }
 
+/// The target's joints in the joined model, by their name there, and the sign of their coordinate
+/// (-1: reversed by the re-rooting).
+Json targetSigns(const JoinedSystem& joint, const std::shared_ptr<const FloatingModel>& model) {
+  Json signs = Json::object();
+  for (std::size_t j = 0; j < joint.target_joints.size(); ++j)
+    signs[model->jointNames()[joint.target_joints[j]]] = joint.target_joint_sign[j];
+  return signs;
+}
+
 }  // namespace
 
 CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
@@ -345,13 +354,21 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   const std::vector<std::string>& joints = model->jointNames();
   s.state = joint ? joint->state : problem.robot.state;
   s.velocity = joint ? joint->velocity : capture ? capture->robot.after : problem.robot.velocity;
-  if (joint)  // the target's brakes stay on
+  if (joint)  // the target keeps its own joints' modes: its brakes, the controls of target_joints
     if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) {
       JointControl locked;
       locked.mode = JointControl::Mode::Locked;
       for (std::size_t j = 0; j < joint->target_joints.size(); ++j)
         if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
           sim.setJointControl(static_cast<unsigned int>(joint->target_joints[j]), locked);
+      for (auto [j, control] : spec.target_joints) {
+        control.set_point *= joint->target_joint_sign[j];  // a reversed joint's coordinate is negated
+        try {
+          sim.setJointControl(static_cast<unsigned int>(joint->target_joints[j]), control);
+        } catch (const ModelError& e) {
+          throw InputError(sc.file + ": simulation.target_joints: " + e.what());
+        }
+      }
     }
   if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
     std::ostringstream why;
@@ -470,6 +487,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
                            {"payload_attached", payload_attached},
                            {"target_joined", joint ? Json{{"grasp", joint->grasp == GraspJoint::Rigid ? "rigid" : "spherical"},
                                                           {"target_prefix", joint->target_prefix},
+                                                          {"target_joint_signs", targetSigns(*joint, model)},
                                                           {"min_chart_margin", chart_margin}}
                                                    : Json(nullptr)},
                            {"joint_names", joints},

@@ -27,6 +27,9 @@ struct SimulationSpec {
   /// keep the mode of the robot (locked for `mode: locked` and `robot.locked`, else free).
   std::vector<std::pair<unsigned int, JointControl>> joints;
   std::vector<std::pair<unsigned int, LimitMode>> limits;  ///< resolved as `joints`; default warn
+  /// `target_joints`: a captured free-floating target's joints after the capture, by the target's
+  /// joint index (its model order), resolved as `joints` (default: its own mode, free or braked).
+  std::vector<std::pair<unsigned int, JointControl>> target_joints;
   BaseControl base_control;
   std::vector<ScheduledWrench> wrenches;
 };

@@ -390,6 +390,20 @@ TEST(Operation, ACapturedFreeFloatingRobotMovesOnAsOneTree) {
   }
 }
 
+TEST(Operation, TheCapturedRobotKeepsItsOwnJointControlsInItsOwnCoordinates) {
+  // dual_arm_captures_robot: the target's joint1 servoed to 0.2 rad in the target's coordinate;
+  // the re-rooting at its hand reversed it (sign -1), so the joined model's coordinate goes to -0.2.
+  const json j = simulateJson(kScenarios + "dual_arm_captures_robot.yaml");
+  ASSERT_FALSE(j.is_null());
+  const json& sim = j.at("simulation");
+  EXPECT_EQ(sim.at("target_joined").at("target_joint_signs").at("joint1"), -1.0);
+  const std::vector<std::string> names = sim.at("joint_names");
+  const std::size_t k = std::find(names.begin(), names.end(), "joint1") - names.begin();
+  ASSERT_LT(k, names.size());
+  EXPECT_NEAR(sim.at("final").at("q")[k].get<double>(), -0.2, 1e-3);
+  EXPECT_LT(std::abs(sim.at("final").at("qdot")[k].get<double>()), 1e-3);
+}
+
 TEST(Operation, PlaceTouchPutsTheTargetsContactOnTheRobots) {
   // without `place: touch` the hand is 1.5 m or more away from the tool: refused, naming the distance
   const ToolRun r = kdlSpace("capture " + variant("dual_arm_captures_robot", "  place: touch", ""));

@@ -116,6 +116,8 @@ const std::vector<Broken>& corpus() {
        "{f}:18: approach.speed: unknown field (expected one of grasp, track, gain, damping, singular_threshold, "
        "rate_limits, servo_bandwidth, null_space, tolerance, max_duration)",
        false},
+      {"target_joints_rigid.yaml",
+       "{f}:21: simulation.target_joints: only a free-floating target (target.urdf with movable joints) has joints", false},
       {"place_touch_rigid.yaml",
        "{f}:10: target.place: a rigid target has no contact point of its own (the point hit is the robot's contact "
        "point): place it with pose",
