@@ -199,7 +199,7 @@ std::optional<JoinedSystem> joined(const CaptureProblem& problem, const CaptureR
 std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const CaptureProblem& at_contact,
                                           const std::optional<CaptureResult>& capture, bool joined,
                                           const std::shared_ptr<const FloatingModel>& model, const SimulationState& end,
-                                          double t_contact) {
+                                          double t_contact, const SimulationState* target_end) {
   // The grasp point of an approach: fixed in the (rigid) target's frame.
   const auto grasp = [&](const CaptureTarget& target) -> std::optional<Vector3d> {
     const auto* rigid = std::get_if<RigidTarget>(&target);
@@ -236,8 +236,53 @@ std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const CaptureProbl
       }
     }
   }
+  if (const auto* floating = std::get_if<FloatingSystem>(&at_contact.target); floating && target_end) {
+    last.target_robot = floating->model;  // separated after a point impact: where it went
+    last.target_state = target_end->state;
+  }
   out.push_back(last);
   return out;
+}
+
+/// A free-floating target that separates after a point impact moves on by itself: its motion
+/// from the impact (its own modes: braked joints stay braked; gravity as the robot's), to t_end.
+struct TargetMotion {
+  SimulationState end;
+  double dP = 0.0, dL = 0.0, T = 0.0;  ///< momentum drift over the run, kinetic energy after the impact
+};
+std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
+                                            const std::optional<CaptureResult>& capture, double t0, double t_end) {
+  const auto* target = std::get_if<FloatingSystem>(&problem.target);
+  if (!target || !capture || !capture->floating_target) return std::nullopt;
+  SimulationOptions options = sc.simulation.options;
+  options.grounded = target->response == Response::Grounded;
+  Simulator sim(target->model, options);
+  JointControl locked;
+  locked.mode = JointControl::Mode::Locked;
+  for (unsigned int j = 0; j < target->model->nj(); ++j)
+    if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
+      sim.setJointControl(j, locked);
+  TargetMotion m;
+  m.end.t = t0;
+  m.end.state = target->state;
+  m.end.velocity = capture->floating_target->after;
+  if (options.grounded) m.end.velocity.base_twist = KDL::Twist::Zero();
+  Vector6d h0 = Vector6d::Zero();
+  int observer_rc = E_NOERROR;
+  const auto observer = [&](const SimulationState& x) {
+    double T;
+    Vector6d h;
+    if (const int rc = sim.energyAndMomentum(x, T, h)) observer_rc = rc;
+    if (x.t == t0) h0 = h, m.T = T;
+    m.dP = std::max(m.dP, (h.head<3>() - h0.head<3>()).norm());
+    m.dL = std::max(m.dL, (h.tail<3>() - h0.tail<3>()).norm());
+  };
+  int rc = sim.engageBrakes(m.end);
+  if (rc == E_NOERROR) rc = sim.run(m.end, t_end, sc.simulation.output_step, observer);
+  if (rc || observer_rc)
+    throw InputError(sc.file + ": the target's motion after the impact failed at t = " + detail::number(m.end.t) +
+                     " s: " + strError(rc ? rc : observer_rc));
+  return m;
 }
 
 /// The target's joints in the joined model, by their name there, and the sign of their coordinate
@@ -416,6 +461,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   };
   const double t_capture = s.t;  // 0 without an approach
   const int rc = sim.run(s, t_capture + duration, spec.output_step, observer);
+  const std::optional<TargetMotion> target_motion =
+      rc || joint ? std::nullopt : separatedTarget(sc, problem, capture, t_capture, t_capture + duration);
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, stiffness))
     throw InputError(sc.file + ": simulation: " + strError(src));
@@ -439,7 +486,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   std::unique_ptr<AtomicFile> scene_file;
   if (!o.scene.empty()) {
     scene_file = std::make_unique<AtomicFile>(o.scene, "--scene");
-    writeScene(*scene_file, sceneSnapshots(sc, problem, capture, joint.has_value(), model, s, t_capture),
+    writeScene(*scene_file, sceneSnapshots(sc, problem, capture, joint.has_value(), model, s, t_capture,
+                                            target_motion ? &target_motion->end : nullptr),
                "kdl_space simulate " + fs::path(sc.file).filename().string(), "--scene");
   }
   // Every output is complete: give them their names (a failed rename takes the others back).
@@ -473,6 +521,23 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     Json j;
     j["capture"] = capture ? captureJson(sc, *capture) : Json(nullptr);
     j["approach"] = approach ? approachJson(sc, *approach) : Json(nullptr);
+    if (target_motion) {  // a free-floating target that separated: its own motion
+      const SimulationState& e = target_motion->end;
+      Eigen::Vector4d quat;
+      e.state.world_T_base.M.GetQuaternion(quat(0), quat(1), quat(2), quat(3));
+      j["target_motion"] = Json{{"final", Json{{"t", e.t},
+                                               {"base_position", toJson(toEigen(e.state.world_T_base.p))},
+                                               {"base_quaternion", toJson(quat)},
+                                               {"base_twist", toJson(toEigen(e.velocity.base_twist))},
+                                               {"q", toJson(e.state.q.data)},
+                                               {"qdot", toJson(e.velocity.qdot.data)}}},
+                                {"joint_names", std::get<FloatingSystem>(problem.target).model->jointNames()},
+                                {"energy", target_motion->T},
+                                {"max_linear_momentum_change", target_motion->dP},
+                                {"max_angular_momentum_change", target_motion->dL}};
+    } else {
+      j["target_motion"] = nullptr;
+    }
     Json final_state{{"t", last.t},
                      {"base_position", toJson(last.p)},
                      {"base_quaternion", toJson(last.quat)},
@@ -521,6 +586,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
         << (joint ? "the target joins the robot's tree at link '" + contact_link + "' by a " +
                         (joint->grasp == GraspJoint::Rigid ? "fixed joint" : "ball joint (grasp_rz, grasp_ry, grasp_rx)")
             : payload_attached ? "the target is attached to link '" + contact_link + "'"
+            : target_motion    ? std::string("the target separates; both move on")
                                : std::string("the target separates; the robot alone"));
   } else {
     out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
@@ -540,6 +606,10 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   out << "Largest change over the run: linear momentum " << dP << " N s, angular momentum " << dL
       << " N m s, kinetic energy " << dT << " J (of " << first.T << " J)\n";
   printMotionReport(out, record);
+  if (target_motion)
+    out << "The target after the impact: base at " << toEigen(target_motion->end.state.world_T_base.p).transpose()
+        << " m at t = " << target_motion->end.t << " s; its momentum changed by at most " << target_motion->dP
+        << " N s, " << target_motion->dL << " N m s\n";
   if (joint && joint->grasp == GraspJoint::Spherical && chart_margin < 0.1)
     out << "Warning: the ball joint came within " << chart_margin
         << " of its chart's singularity (|cos grasp_ry|): its angles are ill-conditioned there\n";

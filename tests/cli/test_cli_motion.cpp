@@ -404,6 +404,23 @@ TEST(Operation, TheCapturedRobotKeepsItsOwnJointControlsInItsOwnCoordinates) {
   EXPECT_LT(std::abs(sim.at("final").at("qdot")[k].get<double>()), 1e-3);
 }
 
+TEST(Operation, AfterAPointImpactBothFreeFloatingSystemsMoveOn) {
+  const json j = simulateJson(variant("dual_arm_captures_robot", "  type: capture",
+                                      "  type: point\n  normal: [0, 1, 0]\n  restitution: 0.5") + " --duration 3");
+  ASSERT_FALSE(j.is_null());
+  ASSERT_FALSE(j.at("target_motion").is_null());
+  const json& t = j.at("target_motion");
+  EXPECT_TRUE(j.at("simulation").at("target_joined").is_null());
+  EXPECT_EQ(t.at("final").at("t").get<double>(), 3.0);
+  EXPECT_EQ(t.at("joint_names"), json({"joint1", "joint2"}));
+  // each side starts from its state after the impact: their energies add up to the capture's
+  const double after = j.at("capture").at("energy_after").get<double>();
+  EXPECT_NEAR(t.at("energy").get<double>() + j.at("simulation").at("energy").get<double>(), after, 1e-10 * after);
+  EXPECT_LT(t.at("max_linear_momentum_change").get<double>(), 1e-14);
+  EXPECT_LT(t.at("max_angular_momentum_change").get<double>(), 1e-14);
+  EXPECT_GT(std::abs(t.at("final").at("q")[0].get<double>() - 0.4), 1e-3);  // it moved
+}
+
 TEST(Operation, PlaceTouchPutsTheTargetsContactOnTheRobots) {
   // without `place: touch` the hand is 1.5 m or more away from the tool: refused, naming the distance
   const ToolRun r = kdlSpace("capture " + variant("dual_arm_captures_robot", "  place: touch", ""));
