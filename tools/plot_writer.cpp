@@ -11,41 +11,11 @@
 
 #include <kdl/frames.hpp>
 
+#include "gnuplot_text.hpp"
+
 namespace kdl_space::cli {
-namespace {
 
 namespace fs = std::filesystem;
-
-/// A scratch file removed when it goes out of scope (gnuplot's data, script and log).
-class ScratchFile {
- public:
-  explicit ScratchFile(std::string path) : path_(std::move(path)) {}
-  ~ScratchFile() { std::remove(path_.c_str()); }
-  ScratchFile(const ScratchFile&) = delete;
-  ScratchFile& operator=(const ScratchFile&) = delete;
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-/// A text in gnuplot's single quotes (a quote inside doubled).
-std::string quotedPath(const std::string& p) {
-  std::string q = "'";
-  for (char c : p) q += c == '\'' ? std::string("''") : std::string(1, c);
-  return q + "'";
-}
-
-/// A label for gnuplot's enhanced text: '_' and '^' printed as themselves.
-std::string label(const std::string& text) {
-  std::string escaped;
-  for (char c : text) escaped += (c == '_' || c == '^' || c == '{' || c == '}' || c == '@' || c == '&')
-                                     ? std::string("\\") + c
-                                     : std::string(1, c);
-  return quotedPath(escaped);
-}
-
-}  // namespace
 
 /// The gnuplot terminal for a plot file name; throws UsageError for another extension.
 std::string plotTerminal(const std::string& path, std::size_t panels) {
@@ -91,8 +61,8 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
   }
   {
     std::ofstream g(script.path());
-    g << "set terminal " << terminal << "\nset output " << quotedPath(out.tmp()) << "\n"
-      << "set multiplot layout " << panels << ",1 title " << label(title) << "\n"
+    g << "set terminal " << terminal << "\nset output " << gnuplotQuoted(out.tmp()) << "\n"
+      << "set multiplot layout " << panels << ",1 title " << gnuplotLabel(title) << "\n"
       << "set grid\nset key outside right\nset xlabel 'time [s]'\nset datafile missing 'NaN'\n";
     if (samples.back().t > samples.front().t)  // every panel over the whole run
       g << "set xrange [" << samples.front().t << ":" << samples.back().t << "]\n";
@@ -101,7 +71,7 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
         << "set label 1 'capture' at " << capture_time << ", graph 0.95 offset 0.5,0 tc rgb 'red'\n";
     g
       << "set ylabel 'base attitude [deg]'\n"
-      << "plot " << quotedPath(data.path()) << " using 1:2 with lines title 'roll', '' using 1:3 with lines title 'pitch', "
+      << "plot " << gnuplotQuoted(data.path()) << " using 1:2 with lines title 'roll', '' using 1:3 with lines title 'pitch', "
       << "'' using 1:4 with lines title 'yaw'\n";
     // One panel per group of joints, columns from `first` on.
     const auto jointPanels = [&](const std::string& ylabel, std::size_t first) {
@@ -109,8 +79,8 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
         g << "set ylabel '" << ylabel << "'\nplot ";
         const std::size_t begin = group * kJointsPerPanel, end = std::min(joints.size(), begin + kJointsPerPanel);
         for (std::size_t j = begin; j < end; ++j)
-          g << (j > begin ? ", " : "") << quotedPath(data.path()) << " using 1:" << first + j << " with lines title "
-            << label(joints[j]);
+          g << (j > begin ? ", " : "") << gnuplotQuoted(data.path()) << " using 1:" << first + j << " with lines title "
+            << gnuplotLabel(joints[j]);
         if (joints.empty()) g << "0 title 'no joints'";
         g << "\n";
       }
@@ -119,17 +89,17 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     const std::size_t c = 5 + joints.size();
     if (torques) jointPanels("joint torque [N m or N]", c + 2);
     if (distance)
-      g << "set ylabel 'hand to grasp point [m]'\nplot " << quotedPath(data.path()) << " using 1:" << c + 2 + joints.size()
+      g << "set ylabel 'hand to grasp point [m]'\nplot " << gnuplotQuoted(data.path()) << " using 1:" << c + 2 + joints.size()
         << " with lines title 'distance'\n";
     g << "set ylabel 'change since the phase began (relative)'\nset logscale y\nset format y '10^{%L}'\n"
-      << "plot " << quotedPath(data.path()) << " using 1:" << c << " with lines title 'momentum |h - h_0 - impulse|', '' using 1:"
+      << "plot " << gnuplotQuoted(data.path()) << " using 1:" << c << " with lines title 'momentum |h - h_0 - impulse|', '' using 1:"
       << c + 1 << " with lines title 'energy |T - T_0 - work|'\n"
       << "unset multiplot\n";
     g.close();
     if (!g) throw InputError("--plot " + path + ": cannot write the plot's script next to it");
   }
   const int rc =
-      std::system(("gnuplot " + quotedPath(script.path()) + " >" + quotedPath(log.path()) + " 2>&1").c_str());
+      std::system(("gnuplot " + gnuplotQuoted(script.path()) + " >" + gnuplotQuoted(log.path()) + " 2>&1").c_str());
   std::ifstream l(log.path());
   std::stringstream why;
   why << l.rdbuf();

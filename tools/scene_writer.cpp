@@ -12,39 +12,13 @@
 
 #include "kdl_space/kinematics.hpp"
 
+#include "gnuplot_text.hpp"
+
 namespace kdl_space::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A scratch file removed when it goes out of scope (gnuplot's script and log).
-class ScratchFile {
- public:
-  explicit ScratchFile(std::string path) : path_(std::move(path)) {}
-  ~ScratchFile() { std::remove(path_.c_str()); }
-  ScratchFile(const ScratchFile&) = delete;
-  ScratchFile& operator=(const ScratchFile&) = delete;
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-/// A text in gnuplot's single quotes (a quote inside doubled).
-std::string gpQuoted(const std::string& p) {
-  std::string q = "'";
-  for (char c : p) q += c == '\'' ? std::string("''") : std::string(1, c);
-  return q + "'";
-}
-
-/// A label for gnuplot's enhanced text: '_', '^' and the like printed as themselves.
-std::string label(const std::string& text) {
-  std::string escaped;
-  for (char c : text)
-    escaped += (c == '_' || c == '^' || c == '{' || c == '}' || c == '@' || c == '&') ? std::string("\\") + c
-                                                                                      : std::string(1, c);
-  return gpQuoted(escaped);
-}
 
 /// A line segment from `a` along `d` (gnuplot's vectors: x y z dx dy dz), with a colour for
 /// the target frame's axes.
@@ -195,12 +169,12 @@ std::vector<std::string> clauses(std::ostream& g, const Panel& p, std::size_t in
     out.push_back(prefix + name + " using 1:2:3 with points " + style);
   };
   const auto figure = [&](const std::string& who, const Figure& f, const std::string& rgb, const std::string& what) {
-    segments(who + "boxes", f.boxes, "nohead lw 1 lc rgb '#c8c8c8' title " + label(what + " boxes of inertia"));
-    segments(who + "base", f.base_box, "nohead lw 1.5 lc rgb '#707070' title " + label(what + " base box"));
-    segments(who + "links", f.links, "nohead lw 3 lc rgb '" + rgb + "' title " + label(what));
+    segments(who + "boxes", f.boxes, "nohead lw 1 lc rgb '#c8c8c8' title " + gnuplotLabel(what + " boxes of inertia"));
+    segments(who + "base", f.base_box, "nohead lw 1.5 lc rgb '#707070' title " + gnuplotLabel(what + " base box"));
+    segments(who + "links", f.links, "nohead lw 3 lc rgb '" + rgb + "' title " + gnuplotLabel(what));
     points(who + "origins", f.origins, "pt 7 ps 0.6 lc rgb '" + rgb + "' notitle");
     segments(who + "axes", f.axes, head + " lw 1.5 lc rgb '#e377c2' title " +
-                                        label(what + " joint axes"));
+                                        gnuplotLabel(what + " joint axes"));
   };
   figure("r", p.robot, "#1f4e99", "robot");
   figure("t", p.target_robot, "#ff7f0e", "target");
@@ -262,10 +236,10 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
   {
     std::ofstream g(script.path());
     g << std::setprecision(12);
-    g << "set terminal " << terminal << "\nset output " << gpQuoted(file.tmp()) << "\n";
+    g << "set terminal " << terminal << "\nset output " << gnuplotQuoted(file.tmp()) << "\n";
     std::vector<std::vector<std::string>> plots;
     for (std::size_t i = 0; i < panels.size(); ++i) plots.push_back(clauses(g, panels[i], i, panels.size()));
-    g << "set multiplot layout 1," << panels.size() << " title " << label(title) << "\n"
+    g << "set multiplot layout 1," << panels.size() << " title " << gnuplotLabel(title) << "\n"
       << "set view equal xyz\nset view 62, 35\nset xyplane relative 0\nset grid\n"
       << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]' rotate parallel\n"
       << "set key below Left reverse horizontal maxcols 2 width 2 samplen 2 spacing 1 font ',9'\n"
@@ -274,7 +248,7 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
     for (int k = 0; k < 3; ++k)
       g << "set " << axis[k] << "range [" << centre(k) - half << ":" << centre(k) + half << "]\n";
     for (std::size_t i = 0; i < panels.size(); ++i) {
-      g << "set title " << label(panels[i].title) << "\nsplot ";
+      g << "set title " << gnuplotLabel(panels[i].title) << "\nsplot ";
       if (plots[i].empty()) g << "NaN notitle";
       for (std::size_t k = 0; k < plots[i].size(); ++k) g << (k ? ", \\\n  " : "") << plots[i][k];
       g << "\n";
@@ -283,7 +257,7 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
     g.close();
     if (!g) throw InputError(where + "cannot write the scene's script next to it");
   }
-  const int rc = std::system(("gnuplot " + gpQuoted(script.path()) + " >" + gpQuoted(log.path()) + " 2>&1").c_str());
+  const int rc = std::system(("gnuplot " + gnuplotQuoted(script.path()) + " >" + gnuplotQuoted(log.path()) + " 2>&1").c_str());
   std::ifstream l(log.path());
   std::stringstream why;
   why << l.rdbuf();
