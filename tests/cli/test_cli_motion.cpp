@@ -448,6 +448,9 @@ TEST(Operation, ATranslationalCaptureHangsTheTargetOnABallJoint) {
   for (const char* k : {"q_grasp_rz", "q_grasp_ry", "q_grasp_rx"}) turned = std::max(turned, std::abs(c.at(k).back()));
   EXPECT_GT(turned, 1e-3);
   EXPECT_EQ(c.at(std::string("q_grasp_rz")).front(), 0.0);  // the chart's centre at the capture
+  // no moment passes the grasp: the ball joint's torques are exactly zero at every row
+  for (const char* k : {"tau_grasp_rz", "tau_grasp_ry", "tau_grasp_rx"})
+    for (double tau : c.at(k)) EXPECT_EQ(tau, 0.0) << k;
 }
 
 }  // namespace

@@ -126,6 +126,7 @@ const std::vector<Broken>& corpus() {
        "{f}: target.contact: the target's contact point is 2 m from the robot's; they must touch (within 1 mm)", false},
       // The robot: its URDF, links, joints, mode, state.
       {"missing_urdf_file.yaml", "{f}:3: robot.urdf: {models}/no_such_robot.urdf: no such file", false},
+      {"target_urdf_missing.yaml", "{f}:10: target.urdf: {models}/no_such_target.urdf: no such file", false},
       {"urdf_is_folder.yaml", "{f}:3: robot.urdf: {models}: is a folder, not a URDF file", false},
       {"unknown_contact_link.yaml",
        "{f}:4: robot.contact.link: the model has no link 'gripper' (its links: base, link1, link2, hand)", false},

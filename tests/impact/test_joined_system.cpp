@@ -24,6 +24,7 @@
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/joined_system.hpp"
 #include "kdl_space/scenario.hpp"
+#include "kdl_space/simulation.hpp"
 #include "kdl_space/urdf_loader.hpp"
 #include "test_util.hpp"
 
@@ -119,6 +120,27 @@ TEST(JoinedSystem, RigidJoinIsTheHandWrittenUrdf) {
   EXPECT_TRUE(near(aj.base, ah.base, kRel, kRel * ah.base.norm(), "base acceleration"));
   const KDL::JntArray qdd = byName(*hand, ah.qddot, *js.model);
   EXPECT_TRUE(near(aj.qddot.data, qdd.data, kRel, kRel * qdd.data.norm(), "qddot"));
+
+  // The motion after the capture: 2 s of the joined model from the join, and of the hand-written
+  // URDF from the same state, end in the same state (free joints, dopri5 at rtol 1e-12).
+  SimulationOptions options;
+  options.rtol = 1e-12;
+  options.atol = 1e-14;
+  Simulator sim_j(js.model, options), sim_h(hand, options);
+  SimulationState xj, xh;
+  xj.state = js.state;
+  xj.velocity = js.velocity;
+  xh.state = State(*hand);
+  xh.state.world_T_base = js.state.world_T_base;
+  xh.state.q = byName(*js.model, js.state.q, *hand);
+  xh.velocity = FloatingVelocity(js.velocity.base_twist, byName(*js.model, js.velocity.qdot, *hand));
+  ASSERT_EQ(sim_j.run(xj, 2.0, 0.5, {}), 0);
+  ASSERT_EQ(sim_h.run(xh, 2.0, 0.5, {}), 0);
+  EXPECT_TRUE(near(byName(*hand, xh.state.q, *js.model).data, xj.state.q.data, 1e-9, 1e-10, "q after 2 s"));
+  EXPECT_TRUE(near(byName(*hand, xh.velocity.qdot, *js.model).data, xj.velocity.qdot.data, 1e-9, 1e-10, "qdot after 2 s"));
+  EXPECT_TRUE(near(toEigen(xh.state.world_T_base.p), toEigen(xj.state.world_T_base.p), 1e-9, 1e-10, "base after 2 s"));
+  EXPECT_TRUE(near(toEigen(xh.velocity.base_twist), toEigen(xj.velocity.base_twist), 1e-9, 1e-10, "base twist after 2 s"));
+  EXPECT_GT((xj.state.q.data - js.state.q.data).norm(), 1e-3);  // it moved
 }
 
 /// Twist of the origin of each body of `m` at (kin, v), by body name with `prefix`.
