@@ -177,6 +177,10 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
   const Scenario sc = loadScenario(o.scenario);
   if (!sc.impact)
     throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
+  if (sc.approach)
+    throw InputError(sc.file + ": approach: the contact instant comes from the approach's motion; run kdl_space "
+                     "simulate (it solves the capture then), or remove the approach section to solve the impact "
+                     "at the scenario's states");
   const CaptureResult result = inScenario(sc, [&] { return solveCapture(sc.capture); });
   if (!o.scene.empty()) {
     AtomicFile scene(o.scene, "--scene");

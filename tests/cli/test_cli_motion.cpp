@@ -347,6 +347,14 @@ TEST(Operation, ApproachReachesTheTumblingBoxAndTheCaptureStartsFromTheStatesThe
   EXPECT_LT(j.at("simulation").at("max_angular_momentum_change").get<double>(), 1e-12);
 }
 
+TEST(Operation, CaptureRefusesAnApproachScenarioWithAReason) {
+  const ToolRun r = kdlSpace("capture " + kScenarios + "approach_tumbling_box.yaml");
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find("approach: the contact instant comes from the approach's motion; run kdl_space simulate"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST(Operation, AnUnreachableGraspPointIsReportedWithTheClosestDistanceAndTheApproachWritten) {
   const std::string csv = scratch("unreachable.csv");
   const std::string path = variant("approach_tumbling_box", "grasp: {position: [0.141, 0.243, -0.105]",
