@@ -16,7 +16,6 @@ KDL::JntArray jointValues(const FloatingModel& model, py::handle obj, const char
     return jointsByName(model, values);  // ModelError naming an unknown joint
   }
   KDL::JntArray a(model.nj());
-  if (model.nj() == 0 && !obj.is_none() && py::len(obj) == 0) return a;
   a.data = fromNumpy(obj, name, model.nj());
   return a;
 }
