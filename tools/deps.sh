@@ -9,6 +9,7 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libexpat1-dev
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   gnuplot-nox
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
   "$@"
 )
 
