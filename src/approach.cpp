@@ -66,11 +66,16 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   if (const int rc = solver_.compute(s.state)) return rc;
   Vector6d PL_g;
   if (const int rc = solver_.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
-  if (const int rc = solver_.J_star(hand_, J_)) return rc;
   const KDL::JntArray still(n);
   KDL::Twist drift, t_h;
-  if (const int rc = solver_.handTwist(hand_, still, PL_g, drift)) return rc;  // eq. 4, qdot = 0
-  if (const int rc = solver_.handTwist(hand_, s.velocity.qdot, PL_g, t_h)) return rc;
+  if (grounded_) {  // the base held: t_h = J qdot
+    if (const int rc = solver_.J(hand_, J_)) return rc;
+    t_h = toTwist(J_.data * s.velocity.qdot.data);
+  } else {
+    if (const int rc = solver_.J_star(hand_, J_)) return rc;
+    if (const int rc = solver_.handTwist(hand_, still, PL_g, drift)) return rc;  // eq. 4, qdot = 0
+    if (const int rc = solver_.handTwist(hand_, s.velocity.qdot, PL_g, t_h)) return rc;
+  }
   KDL::Frame G;
   Vector6d grasp_twist;
   if (const int rc = grasp(s.t, G, grasp_twist)) return rc;
@@ -91,7 +96,7 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   const Eigen::MatrixXd X = (AAt + l2 * Eigen::MatrixXd::Identity(m, m)).inverse();
   const Eigen::MatrixXd pinv = A.transpose() * X;  // n x m
   Eigen::VectorXd qdot = pinv * b;
-  if (spec_.null_space == NullSpaceTask::Reaction && static_cast<int>(n) > m) {
+  if (spec_.null_space == NullSpaceTask::Reaction && !grounded_ && static_cast<int>(n) > m) {
     // Of qdot + N z (N = E - J+ J*: rates that leave the hand's twist alone), the one whose base
     // angular velocity w_b = A_w qdot + c (the base's J* and drift) is least.
     if (const int rc = solver_.J_star(Contact{0, KDL::Vector::Zero()}, J_base_)) return rc;
@@ -136,6 +141,7 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
     if (const int rc = sim.apparentInertia(s, j, m)) return rc;
     rec.kv[j] = spec.servo_bandwidth * m;
   }
+  controller.setGrounded(sim.options().grounded);
   const KDL::Rotation base_start = s.state.world_T_base.M;
   ApproachCommand stage, sample;
   int failure = E_NOERROR;

@@ -70,6 +70,9 @@ class KDL_SPACE_EXPORT ApproachController {
   int command(const SimulationState& s, ApproachCommand& out);
   /// The target's state at time t.
   int target(double t, RigidTarget& out) { return target_.at(t, out); }
+  /// A grounded base (held still): the fixed-base J and no drift instead of J* and the momentum's
+  /// term (runApproach sets it from the simulator's options); the reaction null space does nothing.
+  void setGrounded(bool grounded) { grounded_ = grounded; }
 
  private:
   std::shared_ptr<const FloatingModel> model_;
@@ -78,6 +81,7 @@ class KDL_SPACE_EXPORT ApproachController {
   FreeRigidMotion target_;
   FreeFloatingSolver solver_;
   KDL::Jacobian J_, J_base_;
+  bool grounded_ = false;
 };
 
 /// What an approach did.
