@@ -10,6 +10,7 @@ packages=(
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   gnuplot-nox
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
+  python3-pykdl                                                              # its PyKDL interop tests
   "$@"
 )
 

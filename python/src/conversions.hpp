@@ -38,7 +38,11 @@ inline void check(int code, const std::string& what) {
   if (code != 0) throw ComputeError(code, what + ": " + strError(code));
 }
 
-/// A float64 array of the given shape from any array-like; cols < 0: a vector (n,).
+/// A PyKDL object (Vector, Twist, Wrench, Rotation, Frame, JntArray) as nested lists of its
+/// numbers (a Frame: its 4x4 matrix; a Twist: (vel; rot)); anything else as it is (pykdl.cpp).
+py::object fromPyKDL(py::handle obj);
+
+/// A float64 array of the given shape from any array-like (PyKDL objects too); cols < 0: a vector (n,).
 /// \throws ValueError naming `name`, the expected and the given shape.
 Eigen::MatrixXd fromNumpy(py::handle obj, const char* name, long rows, long cols = -1);
 inline Vector6d vec6(py::handle obj, const char* name) { return fromNumpy(obj, name, 6); }

@@ -17,9 +17,10 @@ std::string shapeText(const std::vector<long>& shape) {
 }
 }  // namespace
 
-Eigen::MatrixXd fromNumpy(py::handle obj, const char* name, long rows, long cols) {
+Eigen::MatrixXd fromNumpy(py::handle given, const char* name, long rows, long cols) {
   const std::vector<long> expected = cols < 0 ? std::vector<long>{rows} : std::vector<long>{rows, cols};
   using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  const py::object obj = fromPyKDL(given);
   Array a;
   if (!obj.is_none()) a = Array::ensure(obj);
   if (!a) {
@@ -53,7 +54,8 @@ py::array_t<double> frameToNumpy(const KDL::Frame& f) {
   return toNumpy(T);
 }
 
-KDL::Frame frameFromPython(py::handle obj, const char* name) {
+KDL::Frame frameFromPython(py::handle given, const char* name) {
+  const py::object obj = fromPyKDL(given);  // a PyKDL.Frame: its 4x4 matrix
   if (py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) {
     py::sequence s = py::reinterpret_borrow<py::sequence>(obj);
     if (s.size() == 2) {
