@@ -1,7 +1,7 @@
 #include "kdl_space/approach.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <string>
 
@@ -20,6 +20,15 @@ struct CommandFailed {
 };
 }  // namespace
 
+std::vector<double> defaultRateLimits(const FloatingModel& model) {
+  std::vector<double> limits(model.nj(), std::numeric_limits<double>::infinity());
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const double v = model.jointProperties()[j].velocity;
+    if (std::isfinite(v) && v > 0.0) limits[j] = v;
+  }
+  return limits;
+}
+
 ApproachController::ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand,
                                        ApproachSpec spec, FreeRigidMotion target)
     : model_(std::move(model)), hand_(hand), spec_(std::move(spec)), target_(std::move(target)),
@@ -35,13 +44,7 @@ ApproachController::ApproachController(std::shared_ptr<const FloatingModel> mode
   positive(spec_.max_duration, "the longest approach");
   if (!(spec_.damping >= 0.0) || !std::isfinite(spec_.damping)) refuse("the damping must be finite and >= 0");
   if (!(spec_.speed_tolerance > 0.0)) refuse("the speed tolerance must be > 0");
-  if (spec_.rate_limits.empty()) {
-    spec_.rate_limits.assign(n, std::numeric_limits<double>::infinity());
-    for (unsigned int j = 0; j < n; ++j) {
-      const double v = model_->jointProperties()[j].velocity;
-      if (std::isfinite(v) && v > 0.0) spec_.rate_limits[j] = v;
-    }
-  }
+  if (spec_.rate_limits.empty()) spec_.rate_limits = defaultRateLimits(*model_);
   if (spec_.rate_limits.size() != n) refuse(std::to_string(spec_.rate_limits.size()) + " rate limits for " + std::to_string(n) + " joints");
   for (double v : spec_.rate_limits)
     if (!(v > 0.0)) refuse("a rate limit must be > 0");
@@ -93,16 +96,15 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   const double sigma = std::sqrt(std::max(eig.eigenvalues()(0), 0.0));
   const double ratio = sigma / spec_.threshold;
   const double l2 = ratio < 1.0 ? spec_.damping * spec_.damping * (1.0 - ratio * ratio) : 0.0;
-  const Eigen::MatrixXd X = (AAt + l2 * Eigen::MatrixXd::Identity(m, m)).inverse();
-  const Eigen::MatrixXd pinv = A.transpose() * X;  // n x m
-  Eigen::VectorXd qdot = pinv * b;
+  const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + l2 * Eigen::MatrixXd::Identity(m, m));  // J J^T + l^2 E
+  Eigen::VectorXd qdot = A.transpose() * damped.solve(b);
   if (spec_.null_space == NullSpaceTask::Reaction && !grounded_ && static_cast<int>(n) > m) {
     // Of qdot + N z (N = E - J+ J*: rates that leave the hand's twist alone), the one whose base
     // angular velocity w_b = A_w qdot + c (the base's J* and drift) is least.
     if (const int rc = solver_.J_star(Contact{0, KDL::Vector::Zero()}, J_base_)) return rc;
     KDL::Twist base_drift;
     if (const int rc = solver_.handTwist(Contact{0, KDL::Vector::Zero()}, still, PL_g, base_drift)) return rc;
-    const Eigen::MatrixXd N = Eigen::MatrixXd::Identity(n, n) - pinv * A;
+    const Eigen::MatrixXd N = Eigen::MatrixXd::Identity(n, n) - A.transpose() * damped.solve(A);  // E - J+ J
     const Eigen::MatrixXd B = J_base_.data.bottomRows(3) * N;
     const Vector3d w_b = J_base_.data.bottomRows(3) * qdot + toEigen(base_drift).tail<3>();
     // Damped (mu = 1% of |A_w|^2): where the null space hardly turns the base, it is not driven hard.

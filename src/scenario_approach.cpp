@@ -46,11 +46,7 @@ ApproachSpec approach(const Field& f, const FloatingModel& robot) {
     else f.at("null_space").fail(echo(task) + " is not one of none, reaction");
   }
   // Rate limits: the URDF's velocity limits, overridden by name or pattern (or "*").
-  a.rate_limits.assign(robot.nj(), std::numeric_limits<double>::infinity());
-  for (unsigned int j = 0; j < robot.nj(); ++j) {
-    const double v = robot.jointProperties()[j].velocity;
-    if (std::isfinite(v) && v > 0.0) a.rate_limits[j] = v;
-  }
+  a.rate_limits = defaultRateLimits(robot);
   if (f.has("rate_limits")) {
     const auto limit = [](const Field& e) {
       const double v = e.number();

@@ -93,11 +93,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     if (fs::equivalent(path, o.scenario, ec))
       throw UsageError(std::string(option) + " " + path + ": is the scenario file; it would be overwritten");
     for (const auto& [other, other_path] : outputs)
-      if (other != option && path == other_path)
+      if (other != option && !other_path.empty() && (path == other_path || fs::equivalent(path, other_path, ec)))
         throw UsageError(std::string(option) + " and " + other + " name the same file " + path);
   }
-  if (!o.csv.empty() && !o.plot.empty() && fs::equivalent(o.csv, o.plot, ec))
-    throw UsageError("--csv and --plot name the same file " + o.plot);
   for (const auto& [option, path] : outputs)
     if (!path.empty() && std::string(option) != "--csv" && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
       throw InputError(std::string(option) + " " + path +

@@ -41,6 +41,10 @@ struct ApproachSpec {
   double max_duration = 60.0;  ///< [s]: no contact by then: the approach failed
 };
 
+/// The URDF's velocity limits per joint (model order), infinity where a joint has none: the
+/// approach's rate limits unless the spec gives its own.
+KDL_SPACE_EXPORT std::vector<double> defaultRateLimits(const FloatingModel& model);
+
 /// The controller's view of one instant.
 struct ApproachCommand {
   KDL::JntArray qdot;        ///< the commanded joint rates
