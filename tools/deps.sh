@@ -11,6 +11,8 @@ packages=(
   gnuplot-nox
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
   python3-pykdl                                                              # its PyKDL interop tests
+  python3-matplotlib                                                         # examples/notebook.py
+  python3-distributed python3-dask                                           # studies on Dask (kdl_space.study)
   "$@"
 )
 
