@@ -1,5 +1,6 @@
 #include "kdl_space/capture.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -34,15 +35,14 @@ Vector3d contactPoint(const FloatingSide& side, const std::string& who) {
   return p;
 }
 
-FloatingSideResult sideResult(const FloatingSide& side) {
-  FloatingSideResult r;
+/// A side's state before and after, written over r (no allocation once r has the sizes).
+void sideResult(const FloatingSide& side, FloatingSideResult& r) {
   r.before = side.before();
   r.after = side.after();
   r.contact_twist_before = side.contactTwistBefore();
   r.contact_twist_after = side.contactTwistAfter();
   r.centroid_twist_before = side.centroidTwistBefore();
   r.centroid_twist_after = side.centroidTwistAfter();
-  return r;
 }
 
 /// collide()'s refusal in the words of the part that refused.
@@ -106,56 +106,83 @@ RigidTarget rigidSubtree(const FloatingModel& model, const State& state, int bod
 }
 
 CaptureResult solveCapture(const CaptureProblem& problem) {
+  CaptureSolver solver;
+  return solver.solve(problem);
+}
+
+CaptureSolver::CaptureSolver() = default;
+CaptureSolver::~CaptureSolver() = default;
+
+bool CaptureSolver::reusable(const CaptureProblem& problem) const {
+  const FloatingSystem& r = problem.robot;
+  if (!robot_ || robot_->sharedModel() != r.model || method_ != problem.method || robot_->response() != r.response)
+    return false;
+  const Contact& h = robot_->contact();
+  if (h.body != r.contact.body || h.offset.x() != r.contact.offset.x() || h.offset.y() != r.contact.offset.y() ||
+      h.offset.z() != r.contact.offset.z())
+    return false;
+  const std::vector<bool>& kept = robot_->locked();  // size nj(), all false for none
+  if (r.locked.empty()) return std::find(kept.begin(), kept.end(), true) == kept.end();
+  return r.locked == kept;
+}
+
+const CaptureResult& CaptureSolver::solve(const CaptureProblem& problem) {
   if (!(problem.touch_tolerance >= 0.0) || !std::isfinite(problem.touch_tolerance))
     throw InputError("target.contact: the touch tolerance must be a finite length >= 0, got " +
                      detail::number(problem.touch_tolerance));
-  CaptureResult result;
-  const std::unique_ptr<FloatingSide> robot = floatingSide(problem.robot, problem.method, "robot");
-  result.contact_point = contactPoint(*robot, "robot");
-  result.contact_body_pose = robot->kinematics().pose(problem.robot.contact.body);
+  CaptureResult& result = result_;
+  // The kept side, reset; a new one (whose refusal names the problem) when it cannot be.
+  if (!reusable(problem) || robot_->reset(problem.robot.state, problem.robot.velocity) != E_NOERROR) {
+    robot_.reset();
+    robot_ = floatingSide(problem.robot, problem.method, "robot");
+    method_ = problem.method;
+  }
+  FloatingSide& robot = *robot_;
+  result.contact_point = contactPoint(robot, "robot");
+  result.contact_body_pose = robot.kinematics().pose(problem.robot.contact.body);
 
-  std::unique_ptr<ImpactSide> target;
-  const FloatingSide* floating_target = nullptr;
-  const RigidBodySide* rigid_target = nullptr;
+  std::unique_ptr<FloatingSide> floating_target;
+  std::optional<RigidBodySide> rigid_target;
+  ImpactSide* target = nullptr;
   if (const RigidTarget* rigid = std::get_if<RigidTarget>(&problem.target)) {
     try {
-      auto side = std::make_unique<RigidBodySide>(rigid->toWorld(), result.contact_point);
-      rigid_target = side.get();
-      target = std::move(side);
+      target = &rigid_target.emplace(rigid->toWorld(), result.contact_point);
     } catch (const ModelError& e) {
       throw InputError(e.what());  // "target: ..."
     }
   } else {
-    auto side = floatingSide(std::get<FloatingSystem>(problem.target), problem.method, "target");
-    const double gap = (contactPoint(*side, "target") - result.contact_point).norm();
+    floating_target = floatingSide(std::get<FloatingSystem>(problem.target), problem.method, "target");
+    const double gap = (contactPoint(*floating_target, "target") - result.contact_point).norm();
     if (gap > problem.touch_tolerance)
       throw InputError("target.contact: the target's contact point is " + detail::number(gap) +
                        " m from the robot's; they must touch (within " + detail::number(1e3 * problem.touch_tolerance) +
                        " mm)");
-    floating_target = side.get();
-    target = std::move(side);
+    target = floating_target.get();
   }
 
   ImpactFault fault = ImpactFault::None;
-  if (const int rc = collide(*robot, *target, problem.law, result.impulse, &fault)) refuseImpact(fault, rc);
+  if (const int rc = collide(robot, *target, problem.law, result.impulse, &fault)) refuseImpact(fault, rc);
 
-  result.robot = sideResult(*robot);
+  sideResult(robot, result.robot);
   if (rigid_target) {
+    result.floating_target.reset();
     result.target_twist_before = rigid_target->twistBefore();
     result.target_twist_after = rigid_target->twistAfter();
   } else {
     // Another free-floating system: its locked twist at its CoM, and its whole state.
-    result.floating_target = sideResult(*floating_target);
+    if (!result.floating_target) result.floating_target.emplace();
+    sideResult(*floating_target, *result.floating_target);
     result.target_twist_before = floating_target->centroidTwistBefore();
     result.target_twist_after = floating_target->centroidTwistAfter();
   }
-  result.G_robot = robot->G();
+  result.G_robot = robot.G();
   result.G_target = target->G();
-  result.momentum_before = robot->momentumBefore() + target->momentumBefore();
-  result.momentum_after = robot->momentumAfter() + target->momentumAfter();
-  result.energy_before = robot->energyBefore() + target->energyBefore();
-  result.energy_after = robot->energyAfter() + target->energyAfter();
+  result.momentum_before = robot.momentumBefore() + target->momentumBefore();
+  result.momentum_after = robot.momentumAfter() + target->momentumAfter();
+  result.energy_before = robot.energyBefore() + target->energyBefore();
+  result.energy_after = robot.energyAfter() + target->energyAfter();
   double m_v = 0.0;
+  result.virtual_mass.reset();
   if (problem.has_normal && virtualMass(result.G_robot, problem.law.normal, m_v) == E_NOERROR) result.virtual_mass = m_v;
   return result;
 }

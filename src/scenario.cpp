@@ -233,28 +233,12 @@ ImpactLaw law(const Field& f, bool& has_normal) {
   return l;
 }
 
-/// The file's YAML (or JSON, which YAML reads), or an InputError saying why not.
-YAML::Node parse(const std::string& file) {
-  checkInputFile(file, "scenario file (YAML or JSON)");
-  try {
-    return YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw InputError(file + ": cannot open the file");
-  } catch (const YAML::Exception& e) {
-    std::string msg;  // yaml-cpp quotes the offending byte: keep it printable
-    for (const char c : e.msg) msg += static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f ? c : '?';
-    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML or JSON: " + msg);
-  } catch (const std::exception& e) {
-    throw InputError(file + ": cannot read the file: " + e.what());
-  }
-}
-
 }  // namespace
 
 Scenario loadScenario(const std::string& path) {
   Scenario s;
   s.file = path;
-  const YAML::Node root = parse(path);
+  const YAML::Node root = fields::parseFile(path, "scenario file (YAML or JSON)");
   const Field top(root, "", &s.file);
   if (root.IsNull())
     throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law (or robot and simulation)");

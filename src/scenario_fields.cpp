@@ -17,6 +17,21 @@ std::string echo(const std::string& text) {
   return "'" + shown + (text.size() > 40 ? "...'" : "'");
 }
 
+YAML::Node parseFile(const std::string& file, const std::string& kind) {
+  checkInputFile(file, kind);
+  try {
+    return YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw InputError(file + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    std::string msg;  // yaml-cpp quotes the offending byte: keep it printable
+    for (const char c : e.msg) msg += static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f ? c : '?';
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML or JSON: " + msg);
+  } catch (const std::exception& e) {
+    throw InputError(file + ": cannot read the file: " + e.what());
+  }
+}
+
 std::string kindOf(const YAML::Node& node) {
   if (!node.IsDefined() || node.IsNull()) return "no value";
   if (node.IsSequence()) return "a list of " + std::to_string(node.size());

@@ -17,6 +17,10 @@ namespace kdl_space::fields {
 /// ASCII shown as '?' (a binary file must not flood the terminal).
 std::string echo(const std::string& text);
 
+/// A file's YAML (or JSON, which YAML reads), or an InputError "FILE[:LINE]: what is wrong";
+/// `kind` names what the file should be ("scenario file (YAML or JSON)").
+YAML::Node parseFile(const std::string& file, const std::string& kind);
+
 /// What a YAML node is, for messages ("no value", "a list of 2", "a mapping", or its text).
 std::string kindOf(const YAML::Node& node);
 

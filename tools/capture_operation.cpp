@@ -12,36 +12,6 @@ unsigned int jointIn(const FloatingModel& model, const FloatingModel& robot, uns
   return static_cast<unsigned int>(model.jointIndex(robot.jointNames()[j]));
 }
 
-/// The simulator as the scenario says: the robot's mode holds through the motion (a grounded base
-/// stays grounded, braked joints stay braked) unless the simulation section changes it. For the
-/// approach (`approach`), the joints are left free for its velocity servo (the simulation
-/// section's joint controls act after the capture).
-namespace {
-std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
-                                         bool approach) {
-  const SimulationSpec& spec = sc.simulation;
-  const FloatingSystem& robot = sc.capture.robot;
-  SimulationOptions options = spec.options;
-  options.grounded = spec.grounded.value_or(robot.response == Response::Grounded);
-  auto sim = std::make_unique<Simulator>(model, options);
-  JointControl locked;
-  locked.mode = JointControl::Mode::Locked;
-  for (unsigned int j = 0; j < robot.model->nj(); ++j)
-    if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j]))
-      sim->setJointControl(jointIn(*model, *robot.model, j), locked);
-  if (!approach)
-    for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(*model, *robot.model, joint), control);
-  for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(*model, *robot.model, joint), mode);
-  sim->setBaseControl(spec.base_control);
-  for (ScheduledWrench w : spec.wrenches) {
-    w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
-    sim->addWrench(w);
-  }
-  return sim;
-}
-
-}  // namespace
-
 /// One output row from a state of the run of `sim`.
 Sample sampleOf(Simulator& sim, const SimulationState& x, int& rc) {
   Sample smp;

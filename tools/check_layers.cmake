@@ -16,7 +16,8 @@ function(layer_of name out)
     "impact,impact_friction,collision=4"
     "capture,joined_system=5"
     "forward_dynamics,dense_forward_dynamics,simulation,simulation_events,simulation_stiff,simulation_layout,actuation,approach,rigid_motion=6"
-    "urdf_loader,urdf_check,urdf_xml,urdf_graph,urdf_numbers,urdf_summary,scenario,scenario_fields,scenario_sections,scenario_approach,input_file=7")
+    "urdf_loader,urdf_check,urdf_xml,urdf_graph,urdf_numbers,urdf_summary,scenario,scenario_fields,scenario_sections,scenario_approach,scenario_simulator,input_file=7"
+    "study,study_loader,study_run,study_sampling,study_self_motion,study_summary=8")
   foreach(row IN LISTS table)
     string(REGEX REPLACE ".*=" "" rank "${row}")
     string(REGEX REPLACE "=.*" "" names "${row}")

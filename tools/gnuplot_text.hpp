@@ -1,9 +1,15 @@
 // What the gnuplot writers of the tool (plot_writer, scene_writer) share: scratch files that
-// remove themselves, and texts quoted for gnuplot's scripts.
+// remove themselves, texts quoted for gnuplot's scripts, and gnuplot run on a script.
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+
+#include "cli_common.hpp"
 
 namespace kdl_space::cli {
 
@@ -34,6 +40,19 @@ inline std::string gnuplotLabel(const std::string& text) {
     escaped += (c == '_' || c == '^' || c == '{' || c == '}' || c == '@' || c == '&') ? std::string("\\") + c
                                                                                       : std::string(1, c);
   return gnuplotQuoted(escaped);
+}
+
+/// \brief Runs gnuplot on `script`, which draws into `output`; throws InputError "WHERE gnuplot
+/// failed: its log" if gnuplot fails or draws nothing (`where` names the output: "--plot FILE: ").
+inline void runGnuplot(const std::string& script, const std::string& output, const std::string& where) {
+  const ScratchFile log(script + ".log");
+  const int rc = std::system(("gnuplot " + gnuplotQuoted(script) + " >" + gnuplotQuoted(log.path()) + " 2>&1").c_str());
+  std::ifstream l(log.path());
+  std::stringstream why;
+  why << l.rdbuf();
+  std::error_code ec;
+  if (rc != 0 || !std::filesystem::is_regular_file(output, ec) || std::filesystem::file_size(output, ec) == 0)
+    throw InputError(where + "gnuplot failed" + (why.str().empty() ? std::string() : ": " + why.str()));
 }
 
 }  // namespace kdl_space::cli

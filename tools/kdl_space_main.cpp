@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "inspect.hpp"
 #include "simulate.hpp"
+#include "study.hpp"
 
 int main(int argc, char** argv) {
   using namespace kdl_space::cli;
@@ -21,6 +22,8 @@ int main(int argc, char** argv) {
   CLI::App* simulate = addSimulate(app, simulate_options);
   CheckOptions check_options;
   CLI::App* check = addCheck(app, check_options);
+  StudyOptions study_options;
+  CLI::App* study = addStudy(app, study_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -43,6 +46,7 @@ int main(int argc, char** argv) {
     if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
     if (capture->parsed()) runCapture(capture_options, std::cout);
     if (simulate->parsed()) runSimulate(simulate_options, std::cout);
+    if (study->parsed()) runStudyCommand(study_options, std::cout);
     const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
     if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
       std::cerr << "kdl_space: cannot write the output to stdout\n";

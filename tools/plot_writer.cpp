@@ -36,7 +36,7 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
   for (const Sample& s : samples) distance = distance || !std::isnan(s.grasp_distance);
   const std::size_t panels = 2 + groups * (torques ? 2 : 1) + (distance ? 1 : 0);
   const std::string terminal = plotTerminal(path, panels);
-  const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp"), log(out.tmp() + ".log");
+  const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
   {
     std::ofstream d(data.path());
     d << std::setprecision(12);
@@ -98,14 +98,7 @@ void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const 
     g.close();
     if (!g) throw InputError("--plot " + path + ": cannot write the plot's script next to it");
   }
-  const int rc =
-      std::system(("gnuplot " + gnuplotQuoted(script.path()) + " >" + gnuplotQuoted(log.path()) + " 2>&1").c_str());
-  std::ifstream l(log.path());
-  std::stringstream why;
-  why << l.rdbuf();
-  std::error_code ec;
-  if (rc != 0 || !fs::is_regular_file(out.tmp(), ec) || fs::file_size(out.tmp(), ec) == 0)
-    throw InputError("--plot " + path + ": gnuplot failed" + (why.str().empty() ? std::string() : ": " + why.str()));
+  runGnuplot(script.path(), out.tmp(), "--plot " + path + ": ");
 }
 
 }  // namespace kdl_space::cli

@@ -232,7 +232,7 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
   const Vector3d centre = 0.5 * (lo + hi);
   const double half = std::max(0.55 * (hi - lo).maxCoeff(), 0.1);
 
-  const ScratchFile script(file.tmp() + ".gp"), log(file.tmp() + ".log");
+  const ScratchFile script(file.tmp() + ".gp");
   {
     std::ofstream g(script.path());
     g << std::setprecision(12);
@@ -257,13 +257,7 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
     g.close();
     if (!g) throw InputError(where + "cannot write the scene's script next to it");
   }
-  const int rc = std::system(("gnuplot " + gnuplotQuoted(script.path()) + " >" + gnuplotQuoted(log.path()) + " 2>&1").c_str());
-  std::ifstream l(log.path());
-  std::stringstream why;
-  why << l.rdbuf();
-  std::error_code ec;
-  if (rc != 0 || !fs::is_regular_file(file.tmp(), ec) || fs::file_size(file.tmp(), ec) == 0)
-    throw InputError(where + "gnuplot failed" + (why.str().empty() ? std::string() : ": " + why.str()));
+  runGnuplot(script.path(), file.tmp(), where);
 }
 
 }  // namespace kdl_space::cli

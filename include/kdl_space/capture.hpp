@@ -86,6 +86,28 @@ struct CaptureResult {
 /// part concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
 KDL_SPACE_EXPORT CaptureResult solveCapture(const CaptureProblem& problem);
 
+/// \brief solveCapture for many problems of one robot (a study, a sweep): the robot's side, its
+/// solvers and workspaces, is kept and reset to each problem's state while the model, contact,
+/// response, method and braked joints stay those of the last problem. A capture of a rigid target
+/// then allocates nothing; the result is solveCapture's, bit for bit. One per thread.
+class KDL_SPACE_EXPORT CaptureSolver {
+ public:
+  CaptureSolver();
+  ~CaptureSolver();
+  CaptureSolver(const CaptureSolver&) = delete;
+  CaptureSolver& operator=(const CaptureSolver&) = delete;
+  /// \brief Solves `problem` (see solveCapture); the result stays valid until the next call.
+  /// \throws InputError as solveCapture.
+  const CaptureResult& solve(const CaptureProblem& problem);
+
+ private:
+  /// The kept side answers for `problem`'s robot after a reset (same set-up).
+  bool reusable(const CaptureProblem& problem) const;
+  std::unique_ptr<FloatingSide> robot_;
+  ExIITMethod method_ = ExIITMethod::Recursive;
+  CaptureResult result_;
+};
+
 /// \brief The model that moves on after the impact solved by `result = solveCapture(problem)`:
 /// after a rigid capture of a rigid target, the robot with the target merged into its contact
 /// link (the target's inertia in that link's frame at the impact, result.contact_body_pose);

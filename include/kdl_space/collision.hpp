@@ -165,13 +165,6 @@ class KDL_SPACE_EXPORT RigidBodySide : public ImpactSide {
   /// symmetric positive definite, or an input is not finite. The message starts with "target: ".
   RigidBodySide(const RigidBody& body, const Vector3d& contact_point);
 
-  /// \brief The same side at another state and velocity (same model, contact, response and
-  /// method), reusing its solvers and workspaces: a compute call, allocation-free, that never
-  /// throws. \return 0, or the code of the part that refused (E_SIZE_MISMATCH, E_NOT_FINITE,
-  /// E_NOT_POSITIVE_DEFINITE...); on an error the side answers nothing (applyImpulse returns
-  /// E_NOT_COMPUTED) until a successful reset.
-  int reset(const State& state, const FloatingVelocity& before);
-
   const Matrix6d& G() const override { return G_; }
   const Vector6d& contactTwistBefore() const override { return t_before_; }
   Vector6d contactTwistAfter() const override;

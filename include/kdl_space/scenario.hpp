@@ -3,6 +3,7 @@
 // `kdl_space capture` and `simulate` read; a library user can build the same types in code.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -60,5 +61,14 @@ struct Scenario {
 /// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
 /// be > 0 kg, got -3") for every problem, the file's own (missing, empty, not YAML) included.
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
+
+/// \brief The simulator as the scenario says, for `model` (the robot's, or the robot with a
+/// captured payload, or a joined system: the robot's joints are found by name). The robot's mode
+/// holds through the motion (a grounded base stays grounded, braked joints stay braked) unless the
+/// simulation section changes it. For an approach (`approach`) the joints are left free for its
+/// velocity servo (the section's joint controls act after the capture).
+/// \throws ModelError as the Simulator's set-up calls.
+KDL_SPACE_EXPORT std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                                          bool approach);
 
 }  // namespace kdl_space

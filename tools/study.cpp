@@ -1,0 +1,241 @@
+#include "study.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <map>
+#include <thread>
+
+#include "plot_writer.hpp"
+#include "study_plot.hpp"
+#include "study_table.hpp"
+
+namespace kdl_space::cli {
+namespace fs = std::filesystem;
+
+CLI::App* addStudy(CLI::App& app, StudyOptions& o) {
+  CLI::App* cmd = app.add_subcommand("study", "Run a capture study: a scenario's capture over distributions of its inputs");
+  cmd->add_option("STUDY", o.study, "Study file (YAML or JSON): scenario, samples, seed, inputs (docs/studies.md)")->required();
+  cmd->add_option("-o,--table", o.table, "The table (CSV); default STEM.csv, or STEM.part-i-of-N.csv for a shard")
+      ->type_name("FILE");
+  cmd->add_option("--threads", o.threads, "Threads (default 0: all cores)")->check(CLI::Range(0u, 4096u));
+  cmd->add_option("--shard", o.shard, "Compute shard i of N (1 <= i <= N) only, for a batch scheduler's job array")
+      ->type_name("i/N");
+  cmd->add_option("--merge", o.merge, "Join the tables of shards (or any parts) into the whole table")->type_name("PART...");
+  cmd->add_option("--chunk-size", o.chunk_size, "Samples per chunk kept on disk while the run goes (default: the study's)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{100000000}));
+  cmd->add_option("--plot", o.plot, "Draw a histogram of each outcome (.svg or .png)")->type_name("FILE");
+  cmd->add_option("--heat-map", o.heat_map, "Draw the study's heat_map (.svg or .png)")->type_name("FILE");
+  cmd->add_option("--summary", o.summary, "Write the summary as JSON")->type_name("FILE");
+  cmd->add_flag("--json", o.json, "Print the summary as one JSON object instead of text");
+  return cmd;
+}
+
+namespace {
+
+/// "i/N" -> rows [floor((i-1) S / N), floor(i S / N)).
+std::pair<std::uint64_t, std::uint64_t> shardRange(const std::string& text, std::uint64_t samples, std::uint64_t& i,
+                                                   std::uint64_t& n) {
+  unsigned long long a = 0, b = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%llu/%llu%c", &a, &b, &tail) != 2 || text[0] == '-' || b == 0 || a < 1 || a > b)
+    throw UsageError("--shard " + text + ": expected i/N with 1 <= i <= N (e.g. 2/8)");
+  if (b > samples)
+    throw UsageError("--shard " + text + ": " + std::to_string(b) + " shards of " + std::to_string(samples) +
+                     " samples would leave some empty");
+  i = a, n = b;
+  const auto cut = [&](std::uint64_t k) {
+    return k * samples / n;  // <= 1e18: no overflow (samples <= 1e9)
+  };
+  return {cut(i - 1), cut(i)};
+}
+
+Json quantiles(const OutcomeSummary& o) {
+  return Json{{"min", o.min}, {"q05", o.q05}, {"q25", o.q25}, {"median", o.median}, {"q75", o.q75},
+              {"q95", o.q95}, {"max", o.max}, {"mean", o.mean}};
+}
+
+Json digests(const std::vector<SampleDigest>& list) {
+  Json a = Json::array();
+  for (const SampleDigest& d : list) {
+    Json inputs = Json::object();
+    for (const auto& [name, value] : d.inputs) inputs[name] = value;
+    a.push_back(Json{{"sample", d.sample}, {"objective", d.objective}, {"inputs", inputs}});
+  }
+  return a;
+}
+
+void printSummary(std::ostream& out, const Study& st, const StudySummary& s, const std::string& table) {
+  out << st.file << ": " << s.samples << " captures (" << s.failed << " could not be computed), seed " << st.seed
+      << "; table " << table << "\n\n";
+  out << std::left << std::setw(28) << "outcome" << std::right;
+  for (const char* h : {"min", "5%", "25%", "median", "75%", "95%", "max"}) out << std::setw(12) << h;
+  out << "\n" << std::setprecision(4);
+  for (const OutcomeSummary& o : s.outcomes) {
+    out << std::left << std::setw(28) << o.name << std::right;
+    for (const double v : {o.min, o.q05, o.q25, o.median, o.q75, o.q95, o.max}) out << std::setw(12) << v;
+    out << "\n";
+  }
+  if (!s.probabilities.empty()) out << "\n";
+  for (const auto& [name, p] : s.probabilities) out << "P(" << name << ") = " << p << "\n";
+  const auto list = [&](const char* title, const std::vector<SampleDigest>& ds) {
+    out << "\n" << title << " by " << st.objective << ":\n";
+    for (const SampleDigest& d : ds) {
+      out << "  sample " << d.sample << ": " << d.objective << "  (";
+      for (std::size_t k = 0; k < d.inputs.size(); ++k) out << (k ? ", " : "") << d.inputs[k].first << " = " << d.inputs[k].second;
+      out << ")\n";
+    }
+  };
+  list("best (smallest)", s.best);
+  list("worst (largest)", s.worst);
+}
+
+/// The whole table from parts that must cover [0, samples) once.
+std::vector<double> mergeParts(const std::vector<std::string>& paths, const Study& st, const std::vector<std::string>& columns) {
+  std::map<std::uint64_t, std::pair<StudyPart, std::string>> by_begin;
+  for (const std::string& p : paths) {
+    StudyPart part = readStudyPart(p, st, columns);
+    const std::uint64_t b = part.begin;
+    if (!by_begin.emplace(b, std::make_pair(std::move(part), p)).second)
+      throw InputError("--merge: " + p + " and " + by_begin[b].second + " both hold the rows from " + std::to_string(b));
+  }
+  std::vector<double> rows;
+  rows.reserve(static_cast<std::size_t>(st.samples) * columns.size());
+  std::uint64_t next = 0;
+  for (const auto& [b, entry] : by_begin) {
+    if (b != next)
+      throw InputError("--merge: " + std::string(b < next ? "the rows from " + std::to_string(b) + " (" + entry.second +
+                                                                ") are also in another part"
+                                                          : "rows " + std::to_string(next) + "-" + std::to_string(b) +
+                                                                " are in no part (a shard is missing)"));
+    rows.insert(rows.end(), entry.first.rows.begin(), entry.first.rows.end());
+    next = entry.first.end;
+  }
+  if (next != st.samples)
+    throw InputError("--merge: rows " + std::to_string(next) + "-" + std::to_string(st.samples) + " are in no part (a shard is missing)");
+  return rows;
+}
+
+}  // namespace
+
+Json studySummaryJson(const Study& st, const StudySummary& s, const std::string& table) {
+  char fp[17];
+  std::snprintf(fp, sizeof fp, "%016llx", static_cast<unsigned long long>(st.fingerprint));
+  Json outcomes = Json::object(), probabilities = Json::object();
+  for (const OutcomeSummary& o : s.outcomes) outcomes[o.name] = quantiles(o);
+  for (const auto& [name, p] : s.probabilities) probabilities[name] = p;
+  return Json{{"study", st.file},       {"fingerprint", fp},          {"table", table},
+              {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
+              {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
+              {"best", digests(s.best)}, {"worst", digests(s.worst)}};
+}
+
+void runStudyCommand(const StudyOptions& o, std::ostream& out) {
+  if (!o.shard.empty() && !o.merge.empty()) throw UsageError("--shard and --merge: a run computes a shard or merges them, not both");
+  if (!o.plot.empty()) plotTerminal(o.plot);
+  if (!o.heat_map.empty() && !(o.heat_map.size() > 4 && (o.heat_map.substr(o.heat_map.size() - 4) == ".svg" ||
+                                                          o.heat_map.substr(o.heat_map.size() - 4) == ".png")))
+    throw UsageError("--heat-map " + o.heat_map + ": the file name must end in .svg or .png");
+  const auto study = std::make_shared<const Study>(loadStudy(o.study));
+  const Study& st = *study;
+  if (!o.heat_map.empty() && !st.heat_map)
+    throw UsageError("--heat-map " + o.heat_map + ": the study names no heat_map (x, y, outcome) in " + st.file);
+  const std::vector<std::string> columns = studyColumns(st);
+  std::uint64_t begin = 0, end = st.samples, shard_i = 0, shard_n = 0;
+  if (!o.shard.empty()) std::tie(begin, end) = shardRange(o.shard, st.samples, shard_i, shard_n);
+  std::string table = o.table;
+  if (table.empty())
+    table = fs::path(st.file).stem().string() +
+            (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
+  const std::pair<const char*, std::string> outputs[] = {
+      {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}};
+  std::error_code ec;
+  for (const auto& [option, path] : outputs) {
+    if (path.empty()) continue;
+    checkOutputFile(path, option);
+    if (fs::equivalent(path, o.study, ec)) throw UsageError(std::string(option) + " " + path + ": is the study file");
+    for (const std::string& part : o.merge)
+      if (fs::equivalent(path, part, ec)) throw UsageError(std::string(option) + " " + path + ": is one of the parts merged");
+  }
+  if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
+    throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
+
+  std::vector<double> rows;
+  std::string how;
+  if (!o.merge.empty()) {
+    rows = mergeParts(o.merge, st, columns);
+    how = std::to_string(o.merge.size()) + " parts merged";
+  } else {
+    // Chunks already on disk (an interrupted run of this study) are kept; the rest computed.
+    const fs::path parts = table + ".parts";
+    const std::uint64_t chunk = o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
+    const std::vector<StudyChunk> chunks = studyChunks(begin, end, chunk);
+    const std::size_t m = columns.size();
+    rows.assign(static_cast<std::size_t>(end - begin) * m, 0.0);
+    const auto chunkFile = [&](const StudyChunk& c) {
+      return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
+    };
+    std::vector<StudyChunk> todo;
+    for (const StudyChunk& c : chunks) {
+      try {
+        if (!fs::exists(chunkFile(c), ec)) throw InputError("");
+        const StudyPart p = readStudyPart(chunkFile(c), st, columns);
+        std::copy(p.rows.begin(), p.rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
+      } catch (const InputError&) {
+        todo.push_back(c);  // missing, or of another version of the study: computed again
+      }
+    }
+    fs::create_directories(parts, ec);
+    if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
+    const auto t0 = std::chrono::steady_clock::now();
+    const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+    kdl_space::runStudy(study, todo, threads, [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
+      writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
+      std::copy(chunk_rows.begin(), chunk_rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
+    });
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::uint64_t computed = 0;
+    for (const StudyChunk& c : todo) computed += c.end - c.begin;
+    std::ostringstream h;
+    h << computed << " computed on " << threads << " thread" << (threads > 1 ? "s" : "") << " in " << std::setprecision(3)
+      << seconds << " s";
+    if (computed < end - begin) h << ", " << (end - begin - computed) << " resumed from " << parts.string();
+    how = h.str();
+  }
+  writeStudyPart(table, "--table", st, columns, begin, end, rows.data());
+  if (o.merge.empty()) fs::remove_all(table + ".parts", ec);
+
+  if (shard_n) {  // a part: its rows only; the summary is the merged table's
+    out << st.file << ": shard " << shard_i << "/" << shard_n << ", samples " << begin << "-" << end << " (" << how
+        << ") written to " << table << "; join the shards with: kdl_space study " << st.file << " --merge PART...\n";
+    return;
+  }
+  const StudySummary summary = summarizeStudy(st, rows);
+  const Json json = studySummaryJson(st, summary, table);
+  if (!o.summary.empty()) {
+    AtomicFile f(o.summary, "--summary");
+    std::ofstream s(f.tmp());
+    s << json.dump(2) << "\n";
+    s.close();
+    if (!s) throw InputError("--summary " + o.summary + ": cannot write the file");
+    f.commit();
+  }
+  if (!o.plot.empty()) {
+    AtomicFile f(o.plot, "--plot");
+    writeStudyHistograms(f, st, columns, rows);
+    f.commit();
+  }
+  if (!o.heat_map.empty()) {
+    AtomicFile f(o.heat_map, "--heat-map");
+    writeStudyHeatMap(f, st, columns, rows);
+    f.commit();
+  }
+  if (o.json) {
+    out << json.dump(2) << "\n";
+  } else {
+    printSummary(out, st, summary, table);
+    out << "\n(" << how << ")\n";
+  }
+}
+
+}  // namespace kdl_space::cli

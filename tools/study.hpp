@@ -1,0 +1,36 @@
+// `kdl_space study STUDY [-o TABLE.csv] [--threads N] [--shard i/N] [--merge PART...] [--plot FILE]
+// [--heat-map FILE] [--summary FILE] [--json]`: a capture study (the library's loadStudy and
+// runStudy) on this machine's cores, or one shard of it, or its shards merged; the table, its
+// summary and plots. A run keeps each finished chunk in TABLE.csv.parts/ until the table is
+// whole, so an interrupted run resumes where it stopped.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "kdl_space/study.hpp"
+
+namespace kdl_space::cli {
+
+struct StudyOptions {
+  std::string study;
+  std::string table;              ///< -o; default STEM.csv (a shard: STEM.part-i-of-N.csv)
+  unsigned threads = 0;           ///< 0: all cores
+  std::string shard;              ///< "i/N", 1 <= i <= N
+  std::vector<std::string> merge;
+  std::uint64_t chunk_size = 0;   ///< 0: defaultChunkSize()
+  std::string plot, heat_map, summary;
+  bool json = false;
+};
+
+CLI::App* addStudy(CLI::App& app, StudyOptions& options);
+void runStudyCommand(const StudyOptions& options, std::ostream& out);
+
+/// The summary JSON (`--json`, `--summary`; the keys are a contract: see docs/studies.md).
+Json studySummaryJson(const Study& study, const StudySummary& summary, const std::string& table);
+
+}  // namespace kdl_space::cli
