@@ -8,7 +8,8 @@
 #
 # Plain Python with `# %%` cells (VS Code, Jupyter's jupytext, Spyder run them one by one);
 # `python3 examples/notebook.py` runs it all. The figures go to `$KDL_SPACE_FIGURES`
-# (default: `figures/` here). Needs `PYTHONPATH=build/python` (README, "Python").
+# (default: `figures/` here); `$KDL_SPACE_DURATION` is the motion's length [s] (default 10). Needs
+# `PYTHONPATH=build/python` (README, "Python").
 
 # %%
 import os

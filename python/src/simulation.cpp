@@ -101,7 +101,8 @@ Grid gridOf(double output_dt, double period) {
 
 [[noreturn]] void raiseRunError(int rc, const SimulationState& s, double t0, double t_end, py::object partial) {
   std::ostringstream what;
-  what << "Simulator.run: " << strError(rc) << " at t = " << s.t << " s (the run was from " << t0 << " to " << t_end << " s)";
+  what << "Simulator.run: " << strError(rc) << " at t = " << s.t << " s (the run was from " << t0 << " to " << t_end
+       << " s)";
   const py::object type = py::module_::import("kdl_space._kdl_space").attr("ComputeError");
   py::object e = type(what.str());
   e.attr("code") = rc;
@@ -222,7 +223,8 @@ std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model
     w->sim->setBaseControl(spec.base_control);
     for (ScheduledWrench x : spec.wrenches) {
       const int b = model.ptr->bodyIndex(robot.model->bodies()[x.body].name);
-      if (b < 0) throw py::value_error("model: has no link '" + robot.model->bodies()[x.body].name + "' of the scenario's robot");
+      if (b < 0)
+        throw py::value_error("model: has no link '" + robot.model->bodies()[x.body].name + "' of the scenario's robot");
       x.body = static_cast<unsigned int>(b);
       w->sim->addWrench(x);
     }

@@ -57,7 +57,8 @@ void bindSimulationResults(py::module_& m) {
                              "How long the base control was limited [s].")
       .def_property_readonly("joints", [](const PyStats& x) {
         py::dict d;
-        for (std::size_t j = 0; j < x.joint_names.size() && j < x.stats.joints.size(); ++j) d[py::str(x.joint_names[j])] = x.stats.joints[j];
+        for (std::size_t j = 0; j < x.joint_names.size() && j < x.stats.joints.size(); ++j)
+          d[py::str(x.joint_names[j])] = x.stats.joints[j];
         return d;
       }, "Joint name -> JointRecord.")
       .def("__repr__", [](const PyStats& x) {

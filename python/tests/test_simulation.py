@@ -4,6 +4,7 @@ scenario, and drives a Python controller at a control rate (zero-order hold); er
 names and reference counts."""
 import gc
 import json
+import resource
 import subprocess
 import sys
 import threading
@@ -67,7 +68,7 @@ def test_forward_dynamics_routes_agree(arm):
     assert e.value.code == kdl_space.E_BAD_ARGUMENT
 
 
-def advance(state, accelerations, dt):
+def advance(model, state, accelerations, dt):
     """The state dt later to second order in dt (positions) and first order (velocities)."""
     a, qdd = accelerations
     T = state.base_pose
@@ -75,21 +76,13 @@ def advance(state, accelerations, dt):
     pose = np.eye(4)
     pose[:3, 3] = T[:3, 3] + v * dt + 0.5 * a[:3] * dt * dt
     pose[:3, :3] = rotation(w * dt + 0.5 * a[3:] * dt * dt) @ T[:3, :3]
-    return kdl_space.State(state_model(state), q=state.q + state.qdot * dt + 0.5 * qdd * dt * dt, base_pose=pose,
+    return kdl_space.State(model, q=state.q + state.qdot * dt + 0.5 * qdd * dt * dt, base_pose=pose,
                            base_twist=state.base_twist + a * dt, qdot=state.qdot + qdd * dt)
-
-
-_models = {}
-
-
-def state_model(state):
-    return _models[tuple(state.joint_names)]
 
 
 @pytest.mark.parametrize("solver_class", ["ForwardDynamicsSolver", "DenseForwardDynamicsSolver"])
 def test_accelerations_reproduce_the_momentum_balance(arm, solver_class):
     """The accelerations from joint torques keep (P; L) still; a wrench changes it at its own rate."""
-    _models[tuple(arm.joint_names)] = arm
     fd = getattr(kdl_space, solver_class)(arm)
     sim = kdl_space.Simulator(arm)
     state = moving(arm)
@@ -97,8 +90,8 @@ def test_accelerations_reproduce_the_momentum_balance(arm, solver_class):
     f = np.array([2.0, -1.0, 0.5, 0.3, -0.2, 0.1])
 
     def rate(acc, dt=1e-5):
-        hp = sim.energy_and_momentum(advance(state, acc, dt))[1]
-        hm = sim.energy_and_momentum(advance(state, acc, -dt))[1]
+        hp = sim.energy_and_momentum(advance(arm, state, acc, dt))[1]
+        hm = sim.energy_and_momentum(advance(arm, state, acc, -dt))[1]
         return (hp - hm) / (2 * dt)
 
     acc = fd.accelerations(state, tau=tau)
@@ -399,9 +392,12 @@ def test_no_reference_leaks(arm):
     refs = sys.getrefcount(arm), sys.getrefcount(controller), sys.getrefcount(state)
     tracemalloc.start()
     first = tracemalloc.get_traced_memory()[0]
-    loop(2000)
+    loop(3000)
     gc.collect()
     grown = tracemalloc.get_traced_memory()[0] - first
     tracemalloc.stop()
     assert grown < 100_000, grown
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # and the C++ allocations: kB
+    loop(3000)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak < 8 * 1024
     assert (sys.getrefcount(arm), sys.getrefcount(controller), sys.getrefcount(state)) == refs
