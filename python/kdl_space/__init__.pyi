@@ -204,7 +204,15 @@ class ForwardDynamicsSolver:
     def accelerations(self, state: State, tau: Optional[JointValues] = None,
                       wrenches: Optional[Wrenches] = None) -> Tuple[Array, Array]: ...
 
-class DenseForwardDynamicsSolver(ForwardDynamicsSolver): ...
+class DenseForwardDynamicsSolver:
+    def __init__(self, model: Model, *, gravity: Optional[ArrayLike] = None, grounded: bool = False,
+                 locked: Optional[Sequence[Union[str, int, bool]]] = None) -> None: ...
+    joint_names: list[str]
+    gravity: Array
+    grounded: bool
+    locked: list[str]
+    def accelerations(self, state: State, tau: Optional[JointValues] = None,
+                      wrenches: Optional[Wrenches] = None) -> Tuple[Array, Array]: ...
 
 class Integrator(enum.Enum):
     RK4 = ...
