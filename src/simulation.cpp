@@ -153,6 +153,22 @@ int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& 
   return E_NOERROR;
 }
 
+int Simulator::actuation(SimulationState& s) {
+  const unsigned int n = model().nj();
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!std::isfinite(s.t)) return E_NOT_FINITE;
+  double T;
+  Vector6d h_O;
+  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
+  pack(s, h_O, x_tmp_);  // x_tmp_: a stage's workspace, free between steps
+  if (const int rc = unpack(x_tmp_, s.t, scratch_)) return rc;
+  if (const int rc = actuate(s.t, x_tmp_)) return rc;
+  if (s.tau.rows() != n) s.tau = KDL::JntArray(n);
+  s.tau.data = scratch_.tau.data;
+  s.base_wrench = scratch_.base_wrench;
+  return E_NOERROR;
+}
+
 void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const {
   const detail::StateLayout L(model().nj());
   const KDL::Frame& T = s.state.world_T_base;

@@ -190,6 +190,11 @@ class KDL_SPACE_EXPORT Simulator {
   /// Kinetic energy and momentum (P; L about the world origin) of a state, in O(n). \return 0 or
   /// the code of forwardKinematics / MomentumSolver::compute; T and h_O untouched on an error.
   int energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O);
+  /// The joint torques (controls limited, plus friction) and the base control's wrench that act
+  /// at s, into s.tau and s.base_wrench as run() reports them at an output (the torque callback
+  /// is called). For an observer whose callback changes at that instant (a sampled controller).
+  /// \return 0, E_SIZE_MISMATCH, E_NOT_FINITE or a code of the dynamics; s untouched on an error.
+  int actuation(SimulationState& s);
 
   /// The servos' fastest rate at a state (O(n^2): one articulated-body pass per PD joint).
   /// \return 0 or a code of the dynamics.

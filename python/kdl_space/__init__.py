@@ -1,6 +1,7 @@
 """kdl_space: free-floating space manipulator dynamics (Yoshida et al.) from Python.
 
-The C++ library's models, solvers (J*, H*, G*), impact laws and captures, NumPy in and out:
+The C++ library's models, solvers (J*, H*, G*), impact laws, captures, forward dynamics and the
+simulator (with a Python controller at a control rate), NumPy in and out:
 every vector and matrix in the world frame, twists (v; w), wrenches (f; n); 6x6 matrices as
 (6, 6) float64 arrays, vectors as (n,) arrays; joint-indexed values in ``joint_names`` order.
 
@@ -9,6 +10,10 @@ every vector and matrix in the world frame, twists (v; w), wrenches (f; n); 6x6 
     solver = kdl_space.FreeFloatingSolver(model)
     solver.compute(kdl_space.State(model, q={"joint2": 0.7}))
     G = solver.G_star(model.contact("end_effector"))
+    sim = kdl_space.Simulator(model, integrator="dopri5")
+    run = sim.run(kdl_space.State(model), t_end=2.0, output_dt=0.01,
+                  controller=lambda t, q, qdot, pose, twist: -5.0 * qdot, control_rate=100)
+    run.q, run.momentum                                        # (k, nj), (k, 6) arrays
 
 Errors: ModelError and InputError (the library's message), ComputeError (``.code``, the
 return code of a compute call: E_NOT_FINITE for NaN inputs, ...), ValueError for an argument of
@@ -20,14 +25,18 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     CaptureResult,
     ComputeError,
     Contact,
+    DenseForwardDynamicsSolver,
     Diagnostic,
     ElementType,
     Error,
     Finding,
+    ForwardDynamicsSolver,
     FreeFloatingSolver,
     ImpactLaw,
     Impulse,
     InputError,
+    Integrator,
+    JointRecord,
     Model,
     ModelError,
     RecursiveExIITSolver,
@@ -35,7 +44,12 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     Scenario,
     Severity,
     SideResult,
+    SimulationResult,
+    SimulationStats,
+    Simulator,
     State,
+    Stiffness,
+    attach_target,
     check_urdf,
     codes,
     load_scenario,
@@ -56,10 +70,12 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
 )
 
 __all__ = [
-    "CaptureProblem", "CaptureResult", "ComputeError", "Contact", "Diagnostic", "ElementType", "Error",
-    "Finding", "FreeFloatingSolver", "ImpactLaw", "Impulse", "InputError", "Model", "ModelError",
-    "RecursiveExIITSolver", "RigidTarget", "Scenario", "Severity", "SideResult", "State", "check_urdf",
-    "codes", "load_scenario", "load_urdf", "solve_capture", "solve_impact", "str_error", "virtual_mass",
+    "CaptureProblem", "CaptureResult", "ComputeError", "Contact", "DenseForwardDynamicsSolver",
+    "Diagnostic", "ElementType", "Error", "Finding", "ForwardDynamicsSolver", "FreeFloatingSolver",
+    "ImpactLaw", "Impulse", "InputError", "Integrator", "JointRecord", "Model", "ModelError",
+    "RecursiveExIITSolver", "RigidTarget", "Scenario", "Severity", "SideResult", "SimulationResult",
+    "SimulationStats", "Simulator", "State", "Stiffness", "attach_target", "check_urdf", "codes",
+    "load_scenario", "load_urdf", "solve_capture", "solve_impact", "str_error", "virtual_mass",
     "E_NOERROR", "E_SIZE_MISMATCH", "E_NOT_COMPUTED", "E_NOT_FINITE", "E_NOT_POSITIVE_DEFINITE",
     "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW",
 ]

@@ -2,7 +2,7 @@
 
 import enum
 from types import ModuleType
-from typing import Mapping, Optional, Sequence, Tuple, Union, overload
+from typing import Callable, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -140,6 +140,7 @@ class RigidTarget:
     twist: Array
 
 class CaptureProblem:
+    state: State
     def __init__(self, state: State, contact: Contact, target: RigidTarget, law: ImpactLaw,
                  response: str = "free", method: str = "recursive") -> None: ...
     joint_names: list[str]
@@ -153,6 +154,8 @@ class Scenario:
     impact: bool
     robot: Model
     problem: CaptureProblem
+    duration: float
+    output_step: float
 
 class SideResult:
     joint_names: list[str]
@@ -184,3 +187,103 @@ class CaptureResult:
 
 def load_scenario(path: str) -> Scenario: ...
 def solve_capture(scenario_or_problem: Union[Scenario, CaptureProblem]) -> CaptureResult: ...
+@overload
+def attach_target(scenario_or_problem: Scenario, result: CaptureResult) -> Model: ...
+@overload
+def attach_target(scenario_or_problem: CaptureProblem, result: CaptureResult) -> Model: ...
+
+Wrenches = Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]
+
+class ForwardDynamicsSolver:
+    def __init__(self, model: Model, *, gravity: Optional[ArrayLike] = None, grounded: bool = False,
+                 locked: Optional[Sequence[Union[str, int, bool]]] = None) -> None: ...
+    joint_names: list[str]
+    gravity: Array
+    grounded: bool
+    locked: list[str]
+    def accelerations(self, state: State, tau: Optional[JointValues] = None,
+                      wrenches: Optional[Wrenches] = None) -> Tuple[Array, Array]: ...
+
+class DenseForwardDynamicsSolver:
+    def __init__(self, model: Model, *, gravity: Optional[ArrayLike] = None, grounded: bool = False,
+                 locked: Optional[Sequence[Union[str, int, bool]]] = None) -> None: ...
+    joint_names: list[str]
+    gravity: Array
+    grounded: bool
+    locked: list[str]
+    def accelerations(self, state: State, tau: Optional[JointValues] = None,
+                      wrenches: Optional[Wrenches] = None) -> Tuple[Array, Array]: ...
+
+class Integrator(enum.Enum):
+    RK4 = ...
+    DormandPrince54 = ...
+    Rosenbrock = ...
+
+class JointRecord:
+    limit_first_time: float
+    limit_worst: float
+    stops: int
+    saturation_first_time: float
+    saturation_time: float
+
+class SimulationStats:
+    accepted_steps: int
+    rejected_steps: int
+    min_step: float
+    max_step: float
+    base_saturation_time: float
+    joints: dict[str, JointRecord]
+
+class Stiffness:
+    fastest_rate: float
+    fastest_joint: Optional[str]
+    explicit_step: float
+
+class SimulationResult:
+    joint_names: list[str]
+    t: Array
+    base_position: Array
+    base_quaternion: Array
+    base_twist: Array
+    q: Array
+    qdot: Array
+    tau: Array
+    base_wrench: Array
+    momentum: Array
+    energy: Array
+    work: dict[str, Array]
+    impulse: Array
+    final_state: State
+    final_t: float
+    stats: SimulationStats
+    def __len__(self) -> int: ...
+
+# controller(t, q, qdot, base_pose (4, 4), base_twist (6,)) -> tau (nj,) or {joint name: torque}
+Controller = Callable[[float, Array, Array, Array, Array], JointValues]
+
+class Simulator:
+    def __init__(self, model: Model, *, integrator: Union[str, Integrator] = "dopri5", step: float = 1e-3,
+                 rtol: float = 1e-10, atol: float = 1e-12, max_step: float = 0.05, max_steps: int = 1000000,
+                 gravity: Optional[ArrayLike] = None, grounded: bool = False, effort_limits: bool = True,
+                 joint_friction: bool = True, friction_velocity: float = 1e-3, friction_rate: float = 1e3) -> None: ...
+    @staticmethod
+    def from_scenario(scenario: Scenario, model: Optional[Model] = None) -> Simulator: ...
+    model: Model
+    joint_names: list[str]
+    options: dict[str, object]
+    joint_controls: dict[str, dict[str, object]]
+    limit_modes: dict[str, str]
+    friction_velocities: Array
+    def set_joint_control(self, joint: Union[str, int], mode: str, *, kp: float = 0.0, kd: float = 0.0,
+                          set_point: float = 0.0) -> None: ...
+    def set_limit_mode(self, joint: Union[str, int], mode: str) -> None: ...
+    def set_base_control(self, *, attitude: Optional[Mapping[str, object]] = None,
+                         position: Optional[Mapping[str, object]] = None) -> None: ...
+    def add_wrench(self, link: Union[str, int], wrench: ArrayLike, *, point: Optional[ArrayLike] = None,
+                   body_axes: bool = False, start: float = 0.0, end: float = ...) -> None: ...
+    def engage_brakes(self, state: State) -> State: ...
+    def energy_and_momentum(self, state: State) -> Tuple[float, Array]: ...
+    def stiffness(self, state: State) -> Stiffness: ...
+    def apparent_inertia(self, state: State, joint: Union[str, int]) -> float: ...
+    def run(self, state: State, t_end: float, output_dt: float, *, controller: Optional[Controller] = None,
+            control_rate: Optional[float] = None, t0: float = 0.0) -> SimulationResult: ...

@@ -3,34 +3,13 @@
 #include <sstream>
 
 #include "conversions.hpp"
+#include "capture_types.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/capture.hpp"
 #include "kdl_space/scenario.hpp"
 
 namespace kdl_space::python {
 namespace {
-
-/// A capture problem and the models' files (for repr and the results' joint names).
-struct PyProblem {
-  CaptureProblem problem;
-  std::string robot_source;
-};
-
-struct PyScenario {
-  Scenario scenario;
-};
-
-/// One free-floating side of a result, with its joint names.
-struct PySide {
-  FloatingSideResult side;
-  std::vector<std::string> joint_names;
-};
-
-struct PyResult {
-  CaptureResult r;
-  PySide robot;
-  std::optional<PySide> floating_target;
-};
 
 PyResult solve(const CaptureProblem& p) {
   CaptureResult r;
@@ -105,7 +84,11 @@ void bindCapture(py::module_& m) {
                              "The impact law.")
       .def_property_readonly("floating_target", [](const PyProblem& p) {
         return std::holds_alternative<FloatingSystem>(p.problem.target);
-      }, "Whether the target is another free-floating system.");
+      }, "Whether the target is another free-floating system.")
+      .def_property_readonly("state", [](const PyProblem& p) {
+        const FloatingSystem& r = p.problem.robot;
+        return PyState{r.model, r.state, r.velocity};
+      }, "The robot's State before the impact.");
 
   py::class_<PyScenario>(m, "Scenario", "A scenario file, read and checked (load_scenario).")
       .def_property_readonly("file", [](const PyScenario& s) { return s.scenario.file; }, "The path it was read from.")
@@ -118,6 +101,10 @@ void bindCapture(py::module_& m) {
                              "The robot's Model.")
       .def_property_readonly("problem", [](const PyScenario& s) { return PyProblem{s.scenario.capture, s.scenario.robot_urdf}; },
                              "The CaptureProblem it holds.")
+      .def_property_readonly("duration", [](const PyScenario& s) { return s.scenario.simulation.duration; },
+                             "simulation.duration [s]: the motion's length.")
+      .def_property_readonly("output_step", [](const PyScenario& s) { return s.scenario.simulation.output_step; },
+                             "simulation.output_step [s]: the samples' spacing.")
       .def("__repr__", [](const PyScenario& s) { return "<kdl_space.Scenario '" + s.scenario.file + "'>"; });
 
   py::class_<PySide>(m, "SideResult", "One free-floating side before and after an impact (world frame).")
@@ -166,6 +153,16 @@ void bindCapture(py::module_& m) {
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError naming the part.");
   m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
+  const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
+    return Model{attachTarget(p, r.r), source};  // InputError naming the part
+  };
+  m.def("attach_target", [attach](const PyScenario& s, const PyResult& r) { return attach(s.scenario.capture, r, s.scenario.robot_urdf); },
+        py::arg("scenario_or_problem"), py::arg("result"),
+        "The Model that moves on after the impact solved by `result`: after a rigid capture of a rigid target, the "
+        "robot with the target merged into its contact link (the same joints); after a point impact, the robot's "
+        "own. InputError for a translational capture or a free-floating target.");
+  m.def("attach_target", [attach](const PyProblem& p, const PyResult& r) { return attach(p.problem, r, p.robot_source); },
+        py::arg("scenario_or_problem"), py::arg("result"), "The same for a CaptureProblem.");
 }
 
 }  // namespace kdl_space::python

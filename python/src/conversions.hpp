@@ -96,5 +96,7 @@ void bindModel(py::module_& m);
 void bindSolvers(py::module_& m);
 void bindImpact(py::module_& m);
 void bindCapture(py::module_& m);
+void bindForwardDynamics(py::module_& m);
+void bindSimulation(py::module_& m);
 
 }  // namespace kdl_space::python

@@ -23,7 +23,7 @@ Eigen::MatrixXd fromNumpy(py::handle given, const char* name, long rows, long co
   const py::object obj = fromPyKDL(given);
   Array a;
   if (!obj.is_none()) a = Array::ensure(obj);
-  if (!a) {
+  if (obj.is_none() || !a) {  // a default array_t is an empty array, not a null one
     PyErr_Clear();
     throw py::value_error(std::string(name) + ": expected an array of numbers of shape " + shapeText(expected) +
                           ", got " + std::string(py::str(py::type::handle_of(obj).attr("__name__"))));

@@ -1,0 +1,37 @@
+// The capture's Python-side types, shared by capture.cpp and simulation.cpp (the motion after a
+// capture starts from them).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "conversions.hpp"
+#include "kdl_space/capture.hpp"
+#include "kdl_space/scenario.hpp"
+
+namespace kdl_space::python {
+
+/// A capture problem and the models' files (for repr and the results' joint names).
+struct PyProblem {
+  CaptureProblem problem;
+  std::string robot_source;
+};
+
+struct PyScenario {
+  Scenario scenario;
+};
+
+/// One free-floating side of a result, with its joint names.
+struct PySide {
+  FloatingSideResult side;
+  std::vector<std::string> joint_names;
+};
+
+struct PyResult {
+  CaptureResult r;
+  PySide robot;
+  std::optional<PySide> floating_target;
+};
+
+}  // namespace kdl_space::python
