@@ -1,0 +1,229 @@
+// Studies through the public API (study.hpp): each row is the capture of the problem its inputs
+// describe (checked against solveCapture by the paper's dense route, the problem built here by
+// hand), the rows do not depend on threads or chunks, the summary's statistics, the loader's
+// refusals naming the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "kdl_space/study.hpp"
+#include "test_util.hpp"
+
+namespace kdl_space {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+
+/// A study file in the test's temporary folder.
+std::string studyFile(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_study_tests";
+  fs::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::size_t column(const std::vector<std::string>& columns, const std::string& name) {
+  const auto it = std::find(columns.begin(), columns.end(), name);
+  EXPECT_NE(it, columns.end()) << name;
+  return static_cast<std::size_t>(it - columns.begin());
+}
+
+const char* kMixed = R"(scenario: SCENARIO
+samples: 24
+seed: 11
+inputs:
+  robot.q.joint2: {uniform: [0.5, 0.9]}
+  robot.qdot.joint1: {normal: {mean: 0.02, std: 0.01}}
+  target.mass: {uniform: [20, 80]}
+  target.twist.wz: {uniform: [-0.1, 0.1]}
+  target.grasp.y: {uniform: [-0.05, 0.05]}
+  timing: {uniform: [0, 3]}
+limits: {joint_rate: 0.1, base_rate: 0.0015}
+)";
+
+std::string mixedStudy() {
+  std::string text = kMixed;
+  text.replace(text.find("SCENARIO"), 8, kScenarios + "tumbling_box_capture.yaml");
+  return studyFile("mixed.yaml", text);
+}
+
+TEST(Study, EachRowIsTheCaptureItsInputsDescribe) {
+  const auto st = std::make_shared<const Study>(loadStudy(mixedStudy()));
+  const std::vector<std::string> columns = studyColumns(*st);
+  StudyEvaluator evaluator(st);
+  std::vector<double> row(columns.size());
+  const Scenario& sc = st->scenario;
+  const FloatingSystem& r0 = sc.capture.robot;
+  FreeFloatingSolver dense(r0.model);
+  const auto hand = [&](const State& s) {  // the contact frame, by the dense solver's poses
+    EXPECT_EQ(dense.compute(s), 0);
+    const KDL::Frame b = dense.bodyPose(r0.contact.body);
+    return KDL::Frame(b.M, b * r0.contact.offset);
+  };
+  const KDL::Frame F0 = hand(r0.state);
+  const RigidTarget& t0 = std::get<RigidTarget>(sc.capture.target);
+  for (std::uint64_t i = 0; i < st->samples; ++i) {
+    evaluator.evaluate(i, row.data());
+    ASSERT_EQ(row[column(columns, "status")], 0.0) << i;
+    ASSERT_EQ(row[0], static_cast<double>(i));
+    // The problem, by hand.
+    CaptureProblem p = sc.capture;
+    p.method = ExIITMethod::Dense;
+    p.robot.state.q(1) = row[column(columns, "robot.q.joint2")];
+    p.robot.velocity.qdot(0) = row[column(columns, "robot.qdot.joint1")];
+    RigidTarget t = t0;
+    const double m = row[column(columns, "target.mass")];
+    t.inertia = t0.inertia * (m / t0.mass);
+    t.mass = m;
+    t.twist(5) = row[column(columns, "target.twist.wz")];
+    FreeRigidMotion tumble(t);
+    ASSERT_EQ(tumble.at(row[column(columns, "timing")], t), 0);
+    const KDL::Frame F = hand(p.robot.state);
+    const KDL::Vector grasp = t0.pose.Inverse() * F0.p + KDL::Vector(0, row[column(columns, "target.grasp.y")], 0);
+    t.pose.M = F.M * F0.M.Inverse() * t.pose.M;
+    t.pose.p = F.p - t.pose.M * grasp;
+    p.target = t;
+    const CaptureResult c = solveCapture(p);
+    // The row, against it (the recursive route against the dense one: 1e-9).
+    for (int k = 0; k < 6; ++k) {
+      const char* names[] = {"impulse.fx", "impulse.fy", "impulse.fz", "impulse.nx", "impulse.ny", "impulse.nz"};
+      EXPECT_NEAR(row[column(columns, names[k])], c.impulse.F(k), 1e-9 * c.impulse.F.norm()) << i << " " << names[k];
+    }
+    const Vector6d base = toEigen(c.robot.after.base_twist);
+    EXPECT_NEAR(row[column(columns, "base.wz")], base(5), 1e-9 * base.norm()) << i;
+    EXPECT_NEAR(row[column(columns, "base_rate")], base.tail<3>().norm(), 1e-9 * base.norm()) << i;
+    const double jump7 = c.robot.after.qdot(6) - c.robot.before.qdot(6);
+    EXPECT_NEAR(row[column(columns, "dqdot.joint7")], jump7, 1e-9 * (c.robot.after.qdot.data.norm() + 1e-12)) << i;
+    EXPECT_NEAR(row[column(columns, "energy_lost")], c.energyLost(), 1e-9 * c.energy_before) << i;
+    // The limits, from the row's own numbers.
+    double fastest = 0.0;
+    for (unsigned j = 0; j < 7; ++j) fastest = std::max(fastest, std::abs(c.robot.after.qdot(j)));
+    EXPECT_EQ(row[column(columns, "exceeds.joint_rate")], fastest > 0.1 ? 1.0 : 0.0) << i;
+    EXPECT_EQ(row[column(columns, "exceeds.base_rate")], base.tail<3>().norm() > 0.0015 ? 1.0 : 0.0) << i;
+  }
+}
+
+TEST(Study, RowsAreTheSameOnAnyThreadsAndChunks) {
+  const auto st = std::make_shared<const Study>(loadStudy(kScenarios + "study_grasp_configuration.yaml"));
+  const std::size_t m = studyColumns(*st).size();
+  const auto run = [&](unsigned threads, std::uint64_t chunk) {
+    std::vector<double> all(static_cast<std::size_t>(st->samples) * m);
+    runStudy(st, studyChunks(0, st->samples, chunk), threads, [&](const StudyChunk& c, const std::vector<double>& rows) {
+      std::copy(rows.begin(), rows.end(), all.begin() + static_cast<std::ptrdiff_t>(c.begin * m));
+    });
+    return all;
+  };
+  const std::vector<double> one = run(1, 400), two = run(2, 7), three = run(3, 64);
+  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(one.data(), three.data(), one.size() * sizeof(double)), 0);
+  // A chunk grid is the same from any start: the chunks of [130, 400) are those of [0, 400) cut.
+  const std::vector<StudyChunk> cut = studyChunks(130, 400, 64);
+  ASSERT_EQ(cut.size(), 5u);
+  EXPECT_EQ(cut[0].begin, 130u);
+  EXPECT_EQ(cut[0].end, 192u);
+  EXPECT_EQ(cut[4].begin, 384u);
+  EXPECT_EQ(cut[4].end, 400u);
+}
+
+TEST(Study, ACancelledRunStopsAndAThrowingReportPropagates) {
+  const auto st = std::make_shared<const Study>(loadStudy(kScenarios + "study_grasp_configuration.yaml"));
+  std::atomic<bool> cancel{true};
+  int reports = 0;
+  runStudy(st, studyChunks(0, st->samples, 10), 2, [&](const StudyChunk&, const std::vector<double>&) { ++reports; }, &cancel);
+  EXPECT_EQ(reports, 0);
+  EXPECT_THROW(runStudy(st, studyChunks(0, st->samples, 10), 2,
+                        [&](const StudyChunk&, const std::vector<double>&) { throw InputError("disk full"); }),
+               InputError);
+}
+
+TEST(Study, SummaryQuantilesProbabilitiesAndRanks) {
+  const Study st = loadStudy(mixedStudy());
+  const std::vector<std::string> columns = studyColumns(st);
+  const std::size_t m = columns.size(), rate = column(columns, "base_rate"), any = column(columns, "exceeds.any");
+  // 11 computed samples with base_rate 0, 1, ..., 10 (in reverse order) and one that failed.
+  std::vector<double> rows(12 * m, 0.0);
+  for (std::size_t r = 0; r < 11; ++r) {
+    rows[r * m] = static_cast<double>(r);
+    rows[r * m + rate] = static_cast<double>(10 - r);
+    rows[r * m + any] = r < 3 ? 1.0 : 0.0;
+  }
+  rows[11 * m] = 11, rows[11 * m + 1] = E_BAD_ARGUMENT, rows[11 * m + rate] = NAN;
+  const StudySummary s = summarizeStudy(st, rows);
+  EXPECT_EQ(s.samples, 12u);
+  EXPECT_EQ(s.failed, 1u);
+  const auto o = std::find_if(s.outcomes.begin(), s.outcomes.end(), [](const OutcomeSummary& x) { return x.name == "base_rate"; });
+  ASSERT_NE(o, s.outcomes.end());
+  EXPECT_EQ(o->min, 0.0);
+  EXPECT_EQ(o->max, 10.0);
+  EXPECT_DOUBLE_EQ(o->median, 5.0);
+  EXPECT_DOUBLE_EQ(o->q05, 0.5);   // 0.05 * 10 between order statistics 0 and 1
+  EXPECT_DOUBLE_EQ(o->q25, 2.5);
+  EXPECT_DOUBLE_EQ(o->q95, 9.5);
+  EXPECT_DOUBLE_EQ(o->mean, 5.0);
+  const auto p = std::find_if(s.probabilities.begin(), s.probabilities.end(), [](const auto& x) { return x.first == "exceeds.any"; });
+  ASSERT_NE(p, s.probabilities.end());
+  EXPECT_DOUBLE_EQ(p->second, 3.0 / 11.0);
+  ASSERT_EQ(s.best.size(), 5u);
+  EXPECT_EQ(s.best[0].sample, 10u);  // base_rate 0
+  EXPECT_EQ(s.worst[0].sample, 0u);  // base_rate 10
+  EXPECT_EQ(s.best[0].inputs.size(), 6u);
+  EXPECT_EQ(s.best[0].inputs[0].first, "robot.q.joint2");
+}
+
+/// The message of loadStudy for a study file, or "" if it loads.
+std::string refusal(const std::string& name, const std::string& text) {
+  try {
+    loadStudy(studyFile(name, text));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
+  const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\n";
+  struct Case {
+    std::string text, expect;
+  } cases[] = {
+      {head + "samples: 10\nseed: 1\ninputs: {target.spin: {uniform: [0, 1]}}\n", "inputs.target.spin: is no input of a study"},
+      {head + "samples: 10\nseed: 1\ninputs: {robot.q.elbow: {uniform: [0, 1]}}\n", "no movable joint 'elbow'"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {uniform: [3, 3]}}\n", "inputs.target.mass.uniform: is an empty range"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {uniform: [-3, 3]}}\n", "inputs.target.mass: takes values >= 0"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 1, std: 0}}}\n", "inputs.timing.normal.std: must be > 0"},
+      {head + "samples: 0\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n", "samples: must be >= 1, got 0"},
+      {head + "samples: 1000000000000\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n", "samples: must be at most 1e9"},
+      {head + "samples: 10\nseed: 1.5\ninputs: {timing: {uniform: [0, 1]}}\n", "seed: must be a whole number"},
+      {head + "samples: 10\nseed: -3\ninputs: {timing: {uniform: [0, 1]}}\n", "seed: must be a whole number"},
+      {head + "samples: 10\nseed: abc\ninputs: {timing: {uniform: [0, 1]}}\n", "seed: must be a whole number"},
+      {head + "samples: 10\ninputs: {timing: {uniform: [0, 1]}}\n", "seed: missing"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {grid: [0, 1, 0]}}\n", "must be >= 1 point"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1], normal: {mean: 0, std: 1}}}\n", "give one distribution"},
+      {head + "samples: 10\nseed: 1\ninputs: {}\n", "inputs: a study varies at least one input"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\nobjective: spin\n", "objective: is no outcome"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\nlimits: {joint_torque: 5}\n",
+       "limits.joint_torque: the torques are those of the motion"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\nsampling: sobol\n", "sampling: 'sobol' is not one of"},
+      {"scenario: missing.yaml\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n", "missing.yaml"},
+      {"scenario: " + kScenarios + "approach_tumbling_box.yaml\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n",
+       "scenario: has an approach"},
+      {"scenario: " + kScenarios + "robot_to_robot_capture.yaml\nsamples: 10\nseed: 1\ninputs: {target.mass: {uniform: [1, 2]}}\n",
+       "the target is a free-floating system"},
+      {"scenario: " + kScenarios + "robot_to_robot_capture.yaml\nsamples: 10\nseed: 1\ninputs: {robot.q.joint2: {uniform: [0, 0.1]}}\n"
+       "motion: {duration: 1}\n", "motion: no motion follows"},
+  };
+  int k = 0;
+  for (const Case& c : cases) {
+    const std::string name = "broken_" + std::to_string(k++) + ".yaml";
+    const std::string why = refusal(name, c.text);
+    EXPECT_NE(why.find(c.expect), std::string::npos) << name << ": expected '" << c.expect << "' in '" << why << "'";
+    EXPECT_NE(why.find(name), std::string::npos) << "the file is named: " << why;
+  }
+}
+
+}  // namespace
+}  // namespace kdl_space

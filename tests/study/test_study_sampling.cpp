@@ -1,0 +1,176 @@
+// The study's draws (src/study_sampling, private): uniform numbers, the permutation behind the
+// Latin hypercube, the normal quantile, grids; and the self-motion of the redundant arm.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "kdl_space/scenario.hpp"
+#include "study_sampling.hpp"
+#include "study_self_motion.hpp"
+
+namespace kdl_space {
+namespace {
+
+TEST(StudySampling, UnitIsInsideTheOpenIntervalWithTheUniformMoments) {
+  const int n = 200000;
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double u = sampling::unit(42, static_cast<std::uint64_t>(i), 3);
+    ASSERT_GT(u, 0.0);
+    ASSERT_LT(u, 1.0);
+    sum += u, sum2 += u * u;
+  }
+  const double mean = sum / n, var = sum2 / n - mean * mean;
+  EXPECT_NEAR(mean, 0.5, 5.0 * std::sqrt(1.0 / 12.0 / n));  // 5 sigma
+  EXPECT_NEAR(var, 1.0 / 12.0, 5.0 * std::sqrt(1.0 / 180.0 / n));
+  // Another seed, sample or stream gives another number.
+  EXPECT_NE(sampling::unit(42, 7, 3), sampling::unit(43, 7, 3));
+  EXPECT_NE(sampling::unit(42, 7, 3), sampling::unit(42, 8, 3));
+  EXPECT_NE(sampling::unit(42, 7, 3), sampling::unit(42, 7, 4));
+}
+
+TEST(StudySampling, PermuteIsABijectionOfEveryRange) {
+  for (const std::uint64_t n : {1ULL, 2ULL, 3ULL, 17ULL, 1000ULL, 4097ULL}) {
+    std::set<std::uint64_t> images;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const std::uint64_t k = sampling::permute(i, n, 9, 2);
+      ASSERT_LT(k, n);
+      images.insert(k);
+    }
+    EXPECT_EQ(images.size(), n) << "n = " << n;
+  }
+  // Not the identity, and keyed: another stream permutes otherwise.
+  int moved = 0, differ = 0;
+  for (std::uint64_t i = 0; i < 1000; ++i) {
+    moved += sampling::permute(i, 1000, 9, 2) != i;
+    differ += sampling::permute(i, 1000, 9, 2) != sampling::permute(i, 1000, 9, 6);
+  }
+  EXPECT_GT(moved, 900);
+  EXPECT_GT(differ, 900);
+}
+
+TEST(StudySampling, NormalQuantileInvertsTheNormalDistribution) {
+  // Known values (Abramowitz and Stegun 26.2; to 16 digits from the series of erfc).
+  EXPECT_EQ(sampling::normalQuantile(0.5), 0.0);
+  EXPECT_NEAR(sampling::normalQuantile(0.975), 1.959963984540054, 1e-15);
+  EXPECT_NEAR(sampling::normalQuantile(0.8413447460685429), 1.0, 1e-14);
+  EXPECT_NEAR(sampling::normalQuantile(1e-10), -6.361340902404056, 1e-13);
+  for (double p = 1e-12; p < 1.0; p = p < 0.01 ? p * 10.0 : p + 0.01) {
+    const double x = sampling::normalQuantile(p);
+    const double back = 0.5 * std::erfc(-x / std::sqrt(2.0));
+    EXPECT_NEAR(back, p, 4e-16 * std::max(p, 1e-300) + 1e-17) << "p = " << p;
+  }
+}
+
+Study twoInputs(bool lhs) {
+  Study st;
+  st.seed = 5;
+  st.samples = 97;
+  st.latin_hypercube = lhs;
+  StudyInput a, b;
+  a.name = "a", a.distribution = {Distribution::Kind::Uniform, -1.0, 3.0, 0};
+  b.name = "b", b.distribution = {Distribution::Kind::Normal, 2.0, 0.5, 0};
+  st.inputs = {a, b};
+  return st;
+}
+
+TEST(StudySampling, LatinHypercubePutsOneSampleInEveryStratumOfEveryInput) {
+  const Study st = twoInputs(true);
+  std::vector<int> strata_a(st.samples, 0), strata_b(st.samples, 0);
+  double v[2];
+  for (std::uint64_t i = 0; i < st.samples; ++i) {
+    sampling::draw(st, i, v);
+    const double u_a = (v[0] + 1.0) / 4.0;
+    const double u_b = 0.5 * std::erfc(-(v[1] - 2.0) / 0.5 / std::sqrt(2.0));  // back to (0, 1)
+    ++strata_a[static_cast<std::size_t>(u_a * st.samples)];
+    ++strata_b[static_cast<std::size_t>(u_b * st.samples + 1e-9)];
+  }
+  EXPECT_EQ(std::count(strata_a.begin(), strata_a.end(), 1), static_cast<long>(st.samples));
+  EXPECT_EQ(std::count(strata_b.begin(), strata_b.end(), 1), static_cast<long>(st.samples));
+  // Independent draws do not (97 samples in 97 strata leave about 36 empty).
+  const Study random = twoInputs(false);
+  std::set<std::size_t> hit;
+  for (std::uint64_t i = 0; i < random.samples; ++i) {
+    sampling::draw(random, i, v);
+    hit.insert(static_cast<std::size_t>((v[0] + 1.0) / 4.0 * random.samples));
+  }
+  EXPECT_LT(hit.size(), random.samples - 10);
+}
+
+TEST(StudySampling, SampleIDependsOnlyOnSeedAndI) {
+  const Study st = twoInputs(true);
+  double forward[2], again[2];
+  sampling::draw(st, 40, forward);
+  for (std::uint64_t i = 96; i > 0; --i) sampling::draw(st, i, again);  // any other draws in between
+  sampling::draw(st, 40, again);
+  EXPECT_EQ(forward[0], again[0]);
+  EXPECT_EQ(forward[1], again[1]);
+}
+
+TEST(StudySampling, AGridVisitsEveryPointOnceTheLastInputFastest) {
+  Study st;
+  StudyInput a, b;
+  a.name = "a", a.distribution = {Distribution::Kind::Grid, 0.0, 1.0, 3};
+  b.name = "b", b.distribution = {Distribution::Kind::Grid, -2.0, 2.0, 5};
+  st.inputs = {a, b};
+  st.samples = 30;
+  ASSERT_EQ(sampling::gridSize(st), 15u);
+  std::set<std::pair<double, double>> points;
+  double v[2];
+  for (std::uint64_t i = 0; i < 15; ++i) {
+    sampling::draw(st, i, v);
+    EXPECT_EQ(v[0], 0.5 * static_cast<double>(i / 5)) << i;
+    EXPECT_EQ(v[1], -2.0 + static_cast<double>(i % 5)) << i;
+    points.insert({v[0], v[1]});
+  }
+  EXPECT_EQ(points.size(), 15u);
+  sampling::draw(st, 15 + 7, v);  // the grid repeats
+  EXPECT_EQ(v[0], 0.5);
+  EXPECT_EQ(v[1], 0.0);
+}
+
+TEST(StudySelfMotion, HoldsTheHandAndMovesTheArmAlongJsNullSpace) {
+  const Scenario sc = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml");
+  const FloatingSystem& r = sc.capture.robot;
+  SelfMotion motion(r.model, r.contact, r.state);
+  FreeFloatingSolver solver(r.model);
+  const auto hand = [&](const State& s) {
+    EXPECT_EQ(solver.compute(s), 0);
+    const KDL::Frame b = solver.bodyPose(r.contact.body);
+    return KDL::Frame(b.M, b * r.contact.offset);
+  };
+  const KDL::Frame F0 = hand(r.state);
+  for (const double s : {1e-4, 0.3, -0.7, 1.2}) {
+    State moved = r.state;
+    ASSERT_EQ(motion.move(moved, s), 0) << s;
+    const KDL::Twist e = KDL::diff(hand(moved), F0);
+    EXPECT_LT(e.vel.Norm() + e.rot.Norm(), 1e-10) << s;
+    const double chord = (moved.q.data - r.state.q.data).norm();
+    EXPECT_LE(chord, std::abs(s) * (1.0 + 1e-9)) << s;  // a chord of an arc of length |s|
+    EXPECT_GT(chord, 0.8 * std::abs(s)) << s;
+    // A short step is along J's null space (to first order in s).
+    if (std::abs(s) < 0.05) {
+      KDL::Jacobian J(r.model->nj());
+      ASSERT_EQ(solver.compute(r.state), 0);
+      ASSERT_EQ(solver.J(r.contact, J), 0);
+      const Eigen::VectorXd dq = (moved.q.data - r.state.q.data) / s;
+      EXPECT_LT((J.data * dq).norm(), 1e-3 * dq.norm());
+    }
+  }
+}
+
+TEST(StudySelfMotion, RefusesAnArmThatIsNotOnceRedundant) {
+  const Scenario sc = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/spacedyn_twolink_pd.yaml");
+  const FloatingSystem& r = sc.capture.robot;
+  try {
+    SelfMotion motion(r.model, r.contact, r.state);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("one-parameter family only for 7"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace kdl_space
