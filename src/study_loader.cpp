@@ -1,4 +1,5 @@
 // loadStudy: the study file's fields, each checked where it is read, in the words of the file.
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -203,8 +204,9 @@ Study loadStudy(const std::string& path) {
     if (st.samples == 0) top.at("samples").fail("must be >= 1, got 0");
     if (st.samples > Study::max_samples)
       top.at("samples").fail("must be at most 1e9 (split a larger study into several), got " + top.at("samples").text());
-  } else if (grid > 1) {
-    st.samples = grid;
+  } else if (std::any_of(st.inputs.begin(), st.inputs.end(),
+                         [](const StudyInput& in) { return in.distribution.kind == Distribution::Kind::Grid; })) {
+    st.samples = grid;  // one sample per grid point
   } else {
     top.at("samples");  // reports it missing
   }

@@ -1,0 +1,214 @@
+// `kdl_space study` end to end: the same table on any threads, from shards merged, after a
+// resume; its summary JSON; the nominal sample's motion against `simulate`; plots; bad inputs
+// refused with the field named and nothing written.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli_runner.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using kdl_space::test::kdlSpace;
+using kdl_space::test::ToolRun;
+
+const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+const std::string kGrasp = kScenarios + "study_grasp_configuration.yaml";
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_cli_study";
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path = scratch(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(StudyCommand, TheTableIsTheSameOnOneThreadOnTwoAndFromThreeShardsMerged) {
+  const std::string one = scratch("one.csv"), two = scratch("two.csv"), merged = scratch("merged.csv");
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --threads 1 -o " + one).rc, 0);
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --threads 2 --chunk-size 7 -o " + two).rc, 0);
+  EXPECT_EQ(slurp(one), slurp(two));
+  std::string parts;
+  for (int i = 1; i <= 3; ++i) {
+    const std::string part = scratch("part" + std::to_string(i) + ".csv");
+    const ToolRun r = kdlSpace("study " + kGrasp + " --shard " + std::to_string(i) + "/3 -o " + part);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("shard " + std::to_string(i) + "/3"), std::string::npos) << r.out;
+    parts += " " + part;
+  }
+  const ToolRun m = kdlSpace("study " + kGrasp + " --merge" + parts + " -o " + merged);
+  ASSERT_EQ(m.rc, 0) << m.err;
+  EXPECT_EQ(slurp(merged), slurp(one));
+  // The table: a comment line naming the study's version and rows, the header, 400 rows.
+  std::istringstream lines(slurp(one));
+  std::string head, header, row;
+  std::getline(lines, head);
+  std::getline(lines, header);
+  EXPECT_EQ(head.rfind("# kdl_space study; fingerprint ", 0), 0u) << head;
+  EXPECT_NE(head.find("; samples 400; rows 0-400"), std::string::npos) << head;
+  EXPECT_EQ(header.rfind("sample,status,robot.self_motion,target.tumble,target.tumble.axis_x", 0), 0u) << header;
+  int rows = 0;
+  while (std::getline(lines, row)) ++rows;
+  EXPECT_EQ(rows, 400);
+}
+
+TEST(StudyCommand, AnInterruptedRunResumesFromTheChunksOnDisk) {
+  const std::string whole = scratch("whole.csv"), resumed = scratch("resumed.csv");
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --chunk-size 100 -o " + whole).rc, 0);
+  // What an interrupted run leaves: finished chunks in TABLE.parts (here: rows 100-200 from a
+  // shard of the same grid, and a chunk cut short, which is computed again).
+  const fs::path parts = resumed + ".parts";
+  fs::remove_all(parts);
+  fs::create_directories(parts);
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --shard 2/4 -o " + (parts / "rows-100-200.csv").string()).rc, 0);
+  const std::string full = slurp((parts / "rows-100-200.csv").string());
+  std::string cut = full.substr(0, full.size() / 2);
+  cut.replace(cut.find("rows 100-200"), 12, "rows 200-300");
+  std::ofstream((parts / "rows-200-300.csv").string()) << cut;
+  const ToolRun r = kdlSpace("study " + kGrasp + " --chunk-size 100 -o " + resumed);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("300 computed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("100 resumed from"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(resumed), slurp(whole));
+  EXPECT_FALSE(fs::exists(parts)) << "the chunks are removed once the table is whole";
+}
+
+TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
+  const std::string table = scratch("s.csv"), plot = scratch("s.svg"), map = scratch("s_map.svg"), summary = scratch("s.json");
+  const ToolRun r = kdlSpace("study " + kGrasp + " -o " + table + " --plot " + plot + " --heat-map " + map + " --summary " +
+                             summary + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j, json::parse(slurp(summary)));
+  for (const char* key : {"study", "fingerprint", "table", "samples", "failed", "seed", "outcomes", "probabilities",
+                          "objective", "best", "worst"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["samples"], 400);
+  EXPECT_EQ(j["failed"], 0);
+  EXPECT_EQ(j["objective"], "base_rate");
+  const json& q = j["outcomes"]["base_rate"];
+  EXPECT_LE(q["min"].get<double>(), q["q05"].get<double>());
+  EXPECT_LE(q["q05"].get<double>(), q["median"].get<double>());
+  EXPECT_LE(q["median"].get<double>(), q["max"].get<double>());
+  EXPECT_EQ(j["best"][0]["objective"], q["min"]);
+  EXPECT_EQ(j["worst"][0]["objective"], q["max"]);
+  EXPECT_TRUE(j["best"][0]["inputs"].contains("robot.self_motion"));
+  EXPECT_TRUE(j["probabilities"].contains("exceeds.any"));
+  EXPECT_GT(fs::file_size(plot), 1000u);
+  EXPECT_GT(fs::file_size(map), 1000u);
+  EXPECT_NE(slurp(map).find("<svg"), std::string::npos);
+}
+
+TEST(StudyCommand, TheNominalSamplesMotionIsSimulates) {
+  // One sample at the scenario's own inputs (a one-point grid), a second of motion after it: its
+  // peaks are those of `simulate` of the scenario (whose servos hold the capture configuration).
+  const std::string study = write("nominal.yaml", "scenario: " + kScenarios + "tumbling_box_capture.yaml\nseed: 1\n"
+                                  "inputs: {robot.q.joint2: {grid: [0.7, 0.7, 1]}}\n"
+                                  "motion: {duration: 1.0, output_step: 0.05}\nlimits: {joint_torque: 50}\n");
+  const std::string table = scratch("nominal.csv"), csv = scratch("nominal_motion.csv");
+  ASSERT_EQ(kdlSpace("study " + study + " -o " + table + " --json").rc, 0);
+  ASSERT_EQ(kdlSpace("simulate " + kScenarios + "tumbling_box_capture.yaml --duration 1 --csv " + csv).rc, 0);
+  std::istringstream t(slurp(table)), m(slurp(csv));
+  std::string line, header;
+  std::getline(t, line);
+  std::getline(t, header);
+  std::getline(t, line);
+  const auto split = [](const std::string& s) {
+    std::vector<std::string> cells;
+    std::stringstream ss(s);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    return cells;
+  };
+  const std::vector<std::string> names = split(header), values = split(line);
+  std::getline(m, header);
+  const std::vector<std::string> motion_names = split(header);
+  std::vector<double> peak(7, 0.0);
+  const std::size_t phase = static_cast<std::size_t>(std::find(motion_names.begin(), motion_names.end(), "phase") - motion_names.begin());
+  int post = 0;
+  while (std::getline(m, line)) {
+    const std::vector<std::string> cells = split(line);
+    ASSERT_LT(phase, cells.size());
+    if (cells[phase] != "post") continue;  // the rows after the capture
+    ++post;
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      for (int j = 0; j < 7; ++j)
+        if (motion_names[c] == "tau_joint" + std::to_string(j + 1)) peak[j] = std::max(peak[j], std::abs(std::stod(cells[c])));
+  }
+  EXPECT_EQ(post, 21);
+  for (int j = 0; j < 7; ++j) {
+    const auto at = std::find(names.begin(), names.end(), "peak_torque.joint" + std::to_string(j + 1));
+    ASSERT_NE(at, names.end());
+    const double study_peak = std::stod(values[static_cast<std::size_t>(at - names.begin())]);
+    EXPECT_NEAR(study_peak, peak[j], 1e-9 * std::max(peak[j], 1e-6)) << "joint" << j + 1;
+  }
+  EXPECT_GT(peak[0] + peak[1], 0.0);
+}
+
+TEST(StudyCommand, BadInputsNameTheFieldAndWriteNothing) {
+  const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\n";
+  struct Case {
+    std::string args, expect;
+    int rc;
+  } cases[] = {
+      {write("unknown.yaml", head + "samples: 5\nseed: 1\ninputs: {target.spin: {uniform: [0, 1]}}\n"),
+       "inputs.target.spin: is no input of a study", 3},
+      {write("empty_range.yaml", head + "samples: 5\nseed: 1\ninputs: {timing: {uniform: [1, 1]}}\n"),
+       "inputs.timing.uniform: is an empty range", 3},
+      {write("zero.yaml", head + "samples: 0\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n"), "samples: must be >= 1", 3},
+      {write("huge.yaml", head + "samples: 1000000000000\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n"),
+       "samples: must be at most 1e9", 3},
+      {write("seed.yaml", head + "samples: 5\nseed: 0.5\ninputs: {timing: {uniform: [0, 1]}}\n"), "seed: must be a whole number", 3},
+      {kGrasp + " --shard 0/3", "--shard 0/3: expected i/N with 1 <= i <= N", 2},
+      {kGrasp + " --shard 4/3", "--shard 4/3: expected i/N", 2},
+      {kGrasp + " --shard 1/3 --merge x.csv", "--shard and --merge", 2},
+      {kGrasp + " --heat-map map.txt", "--heat-map map.txt: the file name must end in .svg or .png", 2},
+  };
+  for (const Case& c : cases) {
+    const std::string table = scratch("never.csv");
+    fs::remove(table);
+    const ToolRun r = kdlSpace("study " + c.args + " -o " + table);
+    EXPECT_EQ(r.rc, c.rc) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(table)) << c.args;
+    EXPECT_EQ(r.err.find("terminate"), std::string::npos);
+  }
+  // Merging: a missing shard, a part of another study (another seed), a part given twice.
+  const std::string a = scratch("m1.csv"), b = scratch("m2.csv"), other = scratch("other.csv");
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --shard 1/2 -o " + a).rc, 0);
+  ASSERT_EQ(kdlSpace("study " + kGrasp + " --shard 2/2 -o " + b).rc, 0);
+  std::string text = slurp(kGrasp);
+  text.replace(text.find("seed: 20261123"), 14, "seed: 20261124");
+  text.replace(text.find("scenario: tumbling_box_capture.yaml"), 35, "scenario: " + kScenarios + "tumbling_box_capture.yaml");
+  const std::string reseeded = write("reseeded.yaml", text);
+  ASSERT_EQ(kdlSpace("study " + reseeded + " --shard 2/2 -o " + other).rc, 0);
+  const std::string out = scratch("m.csv");
+  fs::remove(out);
+  ToolRun r = kdlSpace("study " + kGrasp + " --merge " + a + " -o " + out);
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find("rows 200-400 are in no part (a shard is missing)"), std::string::npos) << r.err;
+  r = kdlSpace("study " + kGrasp + " --merge " + a + " " + other + " -o " + out);
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find(other + ": holds rows of another study"), std::string::npos) << r.err;
+  r = kdlSpace("study " + kGrasp + " --merge " + a + " " + a + " " + b + " -o " + out);
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find("both hold the rows from 0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
