@@ -30,6 +30,7 @@
 #include "kdl_space/forward_dynamics.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
+#include "kdl_space/study.hpp"
 #include "kdl_space/urdf_loader.hpp"
 
 #ifdef KDL_SPACE_WITH_DART
@@ -294,6 +295,38 @@ bool checkRoutes() {
   return ok;
 }
 
+/// Samples per runStudy call of the study benchmarks.
+constexpr std::uint64_t kStudyBatch = 4096;
+
+/// The study of the benchmark's capture: the robot at its state, the 50 kg box of
+/// ours_capture_end_to_end at the hand, tumbling at 0.05 to 0.2 rad/s about a random axis, its CoM
+/// drifting at -0.05 to 0.05 m/s along x.
+Study captureStudy(const Case& c) {
+  Study st;
+  st.file = "benchmark";
+  st.samples = Study::max_samples;
+  st.seed = 1;
+  FloatingSystem& robot = st.scenario.capture.robot;
+  robot.model = c.model;
+  robot.state = c.state;
+  robot.velocity = c.velocity;
+  robot.contact = c.contact;
+  Kinematics kin(*c.model);
+  forwardKinematics(*c.model, c.state, kin);
+  RigidTarget box;
+  box.mass = 50.0;
+  box.inertia = Matrix3d::Identity() * 2.0;
+  box.pose = KDL::Frame(toKDL(Vector3d(kin.point(c.contact) + Vector3d(0.2, 0.1, -0.1))));
+  st.scenario.capture.target = box;
+  StudyInput tumble, drift;
+  tumble.name = "target.tumble", tumble.field = StudyInput::Field::TargetTumble;
+  tumble.distribution = {Distribution::Kind::Uniform, 0.05, 0.2, 0};
+  drift.name = "target.twist.vx", drift.field = StudyInput::Field::TargetTwist, drift.index = 0;
+  drift.distribution = {Distribution::Kind::Uniform, -0.05, 0.05, 0};
+  st.inputs = {tumble, drift};
+  return st;
+}
+
 void registerCase(const Case& c) {
   const std::string n = c.name;
   const Case* cp = &c;
@@ -376,6 +409,30 @@ void registerCase(const Case& c) {
       benchmark::DoNotOptimize(target.twistAfter().data());
     }
   });
+  // A study of captures of this robot (the box of ours_capture_end_to_end tumbling about a random
+  // axis, its speed drawn too): the time per sample, drawing and the whole row included, on one
+  // core; and the wall time per sample of runStudy on 1 and 2 threads (chunks of 256).
+  const auto study = std::make_shared<const Study>(captureStudy(*cp));
+  benchmark::RegisterBenchmark((n + "/ours_study_sample").c_str(), [study](benchmark::State& st) {
+    StudyEvaluator evaluator(study);
+    std::vector<double> row(evaluator.columns());
+    std::uint64_t i = 0;
+    for (auto _ : st) {
+      evaluator.evaluate(i++, row.data());
+      benchmark::DoNotOptimize(row.data());
+    }
+  });
+  for (const unsigned threads : {1u, 2u})
+    benchmark::RegisterBenchmark((n + "/ours_study_" + std::to_string(threads) + "_threads_wall").c_str(),
+                                 [study, threads](benchmark::State& st) {
+                                   const std::vector<StudyChunk> chunks = studyChunks(0, kStudyBatch, 256);
+                                   for (auto _ : st)
+                                     runStudy(study, chunks, threads, [](const StudyChunk&, const std::vector<double>& rows) {
+                                       benchmark::DoNotOptimize(rows.data());
+                                     });
+                                 })
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
   // Forward dynamics: base and joint accelerations from state, velocity and torques, forward
   // kinematics included, by three routes (checked equal in checkRoutes()).
   benchmark::RegisterBenchmark((n + "/ours_forward_dynamics").c_str(), [cp](benchmark::State& st) {
@@ -490,7 +547,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (r.run_type == Run::RT_Aggregate && !median) continue;
       if (median) name = name.substr(0, name.rfind('_'));
       if (r.run_type == Run::RT_Iteration && ns.count(name) && repetitions_) continue;
-      ns[name] = r.GetAdjustedCPUTime() * (r.time_unit == benchmark::kNanosecond ? 1.0
+      // A study on several threads: wall time (the CPU time of the main thread is a share of it).
+      const double t = name.find("_wall") != std::string::npos ? r.GetAdjustedRealTime() : r.GetAdjustedCPUTime();
+      ns[name] = t * (r.time_unit == benchmark::kNanosecond ? 1.0
                                             : r.time_unit == benchmark::kMicrosecond ? 1e3
                                             : r.time_unit == benchmark::kMillisecond ? 1e6 : 1e9);
       if (median) repetitions_ = true;
@@ -638,6 +697,21 @@ int main(int argc, char** argv) {
     if (time(c.name, "ours_capture_end_to_end") > 0.0)
       table << "| " << c.name << " (" << c.model->nj() << " joints) | " << fmt(time(c.name, "ours_capture_end_to_end"))
             << " |\n";
+
+  // Studies.
+  table << "\n### Capture studies (per sample: the draws, the capture and the row; a study of the box above "
+           "tumbling about a random axis)\n\n| model | one sample, one core | / capture end to end | runStudy 1 thread "
+           "(wall, per sample) | 2 threads | captures per second on 2 threads | scaling |\n|---|---|---|---|---|---|---|\n";
+  for (const Case& c : cases()) {
+    const double one = time(c.name, "ours_study_sample"), capture = time(c.name, "ours_capture_end_to_end");
+    const double t1 = time(c.name, "ours_study_1_threads_wall/real_time") / kStudyBatch,
+                 t2 = time(c.name, "ours_study_2_threads_wall/real_time") / kStudyBatch;
+    if (one < 0.0 || t1 < 0.0 || t2 < 0.0) continue;
+    std::ostringstream rate;
+    rate << std::fixed << std::setprecision(0) << 1e9 / t2;
+    table << "| " << c.name << " (" << c.model->nj() << " joints) | " << fmt(one) << " | " << ratio(one, capture)
+          << " | " << fmt(t1) << " | " << fmt(t2) << " | " << rate.str() << " | " << ratio(t1, t2) << " |\n";
+  }
 
   // The simulations.
   if (!simulations().empty()) {
