@@ -18,7 +18,7 @@ using kdl_space::test::kdlSpace;
 using kdl_space::test::ToolRun;
 
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
-const std::string kGrasp = kScenarios + "study_grasp_configuration.yaml";
+const std::string kShippedStudy = kScenarios + "study_grasp_configuration.yaml";
 
 std::string scratch(const std::string& name) {
   const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_cli_study";
@@ -38,6 +38,14 @@ std::string write(const std::string& name, const std::string& text) {
   std::ofstream(path) << text;
   return path;
 }
+
+/// A study of 400 captures: a grid over the self-motion, a Latin hypercube over the tumble.
+const std::string kGrasp = write("grasp.yaml", "scenario: " + kScenarios + "tumbling_box_capture.yaml\n"
+                                 "samples: 400\nseed: 20261123\nsampling: latin_hypercube\n"
+                                 "inputs:\n  robot.self_motion: {grid: [-1.2, 1.2, 25]}\n"
+                                 "  target.tumble: {uniform: [0.05, 0.16]}\n"
+                                 "limits: {joint_rate: urdf, base_rate: 0.0015}\nobjective: base_rate\n"
+                                 "heat_map: {x: robot.self_motion, y: target.tumble, outcome: base_rate}\n");
 
 TEST(StudyCommand, TheTableIsTheSameOnOneThreadOnTwoAndFromThreeShardsMerged) {
   const std::string one = scratch("one.csv"), two = scratch("two.csv"), merged = scratch("merged.csv");
@@ -91,7 +99,7 @@ TEST(StudyCommand, AnInterruptedRunResumesFromTheChunksOnDisk) {
 
 TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
   const std::string table = scratch("s.csv"), plot = scratch("s.svg"), map = scratch("s_map.svg"), summary = scratch("s.json");
-  const ToolRun r = kdlSpace("study " + kGrasp + " -o " + table + " --plot " + plot + " --heat-map " + map + " --summary " +
+  const ToolRun r = kdlSpace("study " + kShippedStudy + " -o " + table + " --plot " + plot + " --heat-map " + map + " --summary " +
                              summary + " --json");
   ASSERT_EQ(r.rc, 0) << r.err;
   const json j = json::parse(r.out);
@@ -99,7 +107,7 @@ TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
   for (const char* key : {"study", "fingerprint", "table", "samples", "failed", "seed", "outcomes", "probabilities",
                           "objective", "best", "worst"})
     EXPECT_TRUE(j.contains(key)) << key;
-  EXPECT_EQ(j["samples"], 400);
+  EXPECT_EQ(j["samples"], 31 * 13);  // its grid
   EXPECT_EQ(j["failed"], 0);
   EXPECT_EQ(j["objective"], "base_rate");
   const json& q = j["outcomes"]["base_rate"];
@@ -194,7 +202,6 @@ TEST(StudyCommand, BadInputsNameTheFieldAndWriteNothing) {
   ASSERT_EQ(kdlSpace("study " + kGrasp + " --shard 2/2 -o " + b).rc, 0);
   std::string text = slurp(kGrasp);
   text.replace(text.find("seed: 20261123"), 14, "seed: 20261124");
-  text.replace(text.find("scenario: tumbling_box_capture.yaml"), 35, "scenario: " + kScenarios + "tumbling_box_capture.yaml");
   const std::string reseeded = write("reseeded.yaml", text);
   ASSERT_EQ(kdlSpace("study " + reseeded + " --shard 2/2 -o " + other).rc, 0);
   const std::string out = scratch("m.csv");
