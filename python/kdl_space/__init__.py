@@ -1,7 +1,8 @@
 """kdl_space: free-floating space manipulator dynamics (Yoshida et al.) from Python.
 
-The C++ library's models, solvers (J*, H*, G*), impact laws, captures, forward dynamics and the
-simulator (with a Python controller at a control rate), NumPy in and out:
+The C++ library's models, solvers (J*, H*, G*), impact laws, captures, forward dynamics, the
+simulator (with a Python controller at a control rate) and capture studies (on this machine's
+threads or a Dask cluster), NumPy in and out:
 every vector and matrix in the world frame, twists (v; w), wrenches (f; n); 6x6 matrices as
 (6, 6) float64 arrays, vectors as (n,) arrays; joint-indexed values in ``joint_names`` order.
 
@@ -14,6 +15,8 @@ every vector and matrix in the world frame, twists (v; w), wrenches (f; n); 6x6 
     run = sim.run(kdl_space.State(model), t_end=2.0, output_dt=0.01,
                   controller=lambda t, q, qdot, pose, twist: -5.0 * qdot, control_rate=100)
     run.q, run.momentum                                        # (k, nj), (k, 6) arrays
+    result = kdl_space.study("scenarios/study_grasp_configuration.yaml")  # or engine="dask"
+    result["base_rate"], result.summary["probabilities"]      # a column, the summary
 
 Errors: ModelError and InputError (the library's message), ComputeError (``.code``, the
 return code of a compute call: E_NOT_FINITE for NaN inputs, ...), ValueError for an argument of
@@ -49,10 +52,12 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     Simulator,
     State,
     Stiffness,
+    Study,
     attach_target,
     check_urdf,
     codes,
     load_scenario,
+    load_study,
     load_urdf,
     solve_capture,
     solve_impact,
@@ -68,14 +73,16 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     E_BAD_ARGUMENT,
     E_STEP_UNDERFLOW,
 )
+from .study import StudyResult, study  # noqa: F401  (the engines: threads, Dask)
 
 __all__ = [
     "CaptureProblem", "CaptureResult", "ComputeError", "Contact", "DenseForwardDynamicsSolver",
     "Diagnostic", "ElementType", "Error", "Finding", "ForwardDynamicsSolver", "FreeFloatingSolver",
     "ImpactLaw", "Impulse", "InputError", "Integrator", "JointRecord", "Model", "ModelError",
     "RecursiveExIITSolver", "RigidTarget", "Scenario", "Severity", "SideResult", "SimulationResult",
-    "SimulationStats", "Simulator", "State", "Stiffness", "attach_target", "check_urdf", "codes",
-    "load_scenario", "load_urdf", "solve_capture", "solve_impact", "str_error", "virtual_mass",
+    "SimulationStats", "Simulator", "State", "Stiffness", "Study", "StudyResult", "attach_target",
+    "check_urdf", "codes", "load_scenario", "load_study", "load_urdf", "solve_capture", "solve_impact",
+    "str_error", "study", "virtual_mass",
     "E_NOERROR", "E_SIZE_MISMATCH", "E_NOT_COMPUTED", "E_NOT_FINITE", "E_NOT_POSITIVE_DEFINITE",
     "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW",
 ]

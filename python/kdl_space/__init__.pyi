@@ -2,7 +2,8 @@
 
 import enum
 from types import ModuleType
-from typing import Callable, Mapping, Optional, Sequence, Tuple, Union, overload
+import os
+from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -287,3 +288,41 @@ class Simulator:
     def apparent_inertia(self, state: State, joint: Union[str, int]) -> float: ...
     def run(self, state: State, t_end: float, output_dt: float, *, controller: Optional[Controller] = None,
             control_rate: Optional[float] = None, t0: float = 0.0) -> SimulationResult: ...
+
+class Study:
+    file: str
+    fingerprint: int
+    samples: int
+    seed: int
+    latin_hypercube: bool
+    inputs: list[str]
+    distributions: dict[str, dict[str, Union[str, float, int]]]
+    columns: list[str]
+    objective: str
+    scenario: Scenario
+    motion_duration: float
+    heat_map: Optional[Tuple[str, str, str]]
+    default_chunk_size: int
+    def chunks(self, chunk_size: int = 0, begin: int = 0, end: Optional[int] = None) -> list[Tuple[int, int]]: ...
+    def rows(self, begin: int, end: int, threads: int = 1) -> Array: ...
+    def summary(self, rows: ArrayLike) -> dict[str, Any]: ...
+
+def load_study(path: str) -> Study: ...
+
+class StudyResult:
+    study: Study
+    columns: list[str]
+    table: Array
+    def __init__(self, study: Study, table: ArrayLike) -> None: ...
+    def __len__(self) -> int: ...
+    def __getitem__(self, name: str) -> Array: ...
+    @property
+    def summary(self) -> dict[str, Any]: ...
+    @property
+    def failed(self) -> int: ...
+    def to_csv(self, path: Union[str, os.PathLike[str]]) -> None: ...
+    def to_npz(self, path: Union[str, os.PathLike[str]]) -> None: ...
+
+def study(study: Union[str, os.PathLike[str], Study], *, engine: Literal["threads", "dask"] = "threads",
+          threads: int = 0, client: Optional[Any] = None, scheduler: Optional[str] = None,
+          chunk_size: Optional[int] = None, timeout: float = 10.0) -> StudyResult: ...

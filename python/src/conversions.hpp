@@ -98,5 +98,6 @@ void bindImpact(py::module_& m);
 void bindCapture(py::module_& m);
 void bindForwardDynamics(py::module_& m);
 void bindSimulation(py::module_& m);
+void bindStudy(py::module_& m);
 
 }  // namespace kdl_space::python

@@ -1,11 +1,11 @@
 // The extension module kdl_space._kdl_space: one binding file per concept (errors, model and
-// state, solvers, impact laws, capture, forward dynamics, simulation); the package kdl_space
+// state, solvers, impact laws, capture, forward dynamics, simulation, studies); the package kdl_space
 // (python/kdl_space) re-exports it.
 #include "conversions.hpp"
 
 PYBIND11_MODULE(_kdl_space, m) {
   m.doc() = "Free-floating space manipulator dynamics (kdl_space, Yoshida et al.): the C++ library's "
-            "models, solvers (J*, H*, G*), impact laws, captures, forward dynamics and the simulator, "
+            "models, solvers (J*, H*, G*), impact laws, captures, forward dynamics, the simulator and capture studies, "
             "NumPy in and out, world frame, twist (v; w), wrench (f; n).";
   using namespace kdl_space::python;
   bindErrors(m);
@@ -15,4 +15,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindCapture(m);
   bindForwardDynamics(m);
   bindSimulation(m);
+  bindStudy(m);
 }

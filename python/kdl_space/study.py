@@ -1,0 +1,220 @@
+"""Capture studies from Python: ``kdl_space.study(...)`` runs a study file's samples on this
+machine's threads (the C++ engine, as ``kdl_space study``) or as Dask tasks on a cluster, and
+returns a :class:`StudyResult` (the table as a NumPy array, its summary, CSV and ``.npz`` output).
+
+Sample i depends only on (seed, i): the rows are bit-identical whatever engine, threads, workers or
+chunks computed them, and equal to the command-line tool's table (its ``--shard`` parts merged too).
+
+Dask: each task is one chunk of samples (the study's grid of chunks, as the command-line tool cuts
+them). A task loads the study **from its path on the worker** and computes its rows there, so the
+workers must see the same files at the same absolute path (the study, its scenario, the URDFs: a
+cluster's shared file system, or the same checkout on every machine); a worker whose files differ
+(another fingerprint) fails the task with InputError rather than compute another study's rows.
+"""
+
+import math
+import os
+import threading
+
+import numpy as np
+
+from ._kdl_space import InputError, Study, load_study
+
+__all__ = ["study", "StudyResult"]
+
+_ENGINES = ("threads", "dask")
+
+
+def _resolve(study_or_path):
+    if isinstance(study_or_path, Study):
+        return study_or_path
+    if isinstance(study_or_path, (str, os.PathLike)):
+        return load_study(os.fspath(study_or_path))
+    raise TypeError(f"study: expected a path or a kdl_space.Study, got {type(study_or_path).__name__}")
+
+
+# A worker's studies, by (path, fingerprint): loaded once per worker process, not once per task.
+_worker_studies = {}
+_worker_lock = threading.Lock()
+
+
+def _worker_study(path, fingerprint):
+    key = (path, fingerprint)
+    with _worker_lock:
+        found = _worker_studies.get(key)
+    if found is not None:
+        return found
+    loaded = load_study(path)
+    if loaded.fingerprint != fingerprint:
+        raise InputError(f"{path}: the worker's study files differ from the client's (fingerprint "
+                         f"{loaded.fingerprint:016x}, the client's {fingerprint:016x}): the workers need the same "
+                         "files at the same path")
+    with _worker_lock:
+        if len(_worker_studies) >= 8:
+            _worker_studies.clear()
+        _worker_studies[key] = loaded
+    return loaded
+
+
+def study_chunk_rows(path, fingerprint, begin, end):
+    """A Dask task: rows [begin, end) of the study at `path` (on the worker), which must have
+    `fingerprint`; (end - begin, columns) float64. Module-level so that it pickles by name."""
+    return _worker_study(path, fingerprint).rows(begin, end, threads=1)
+
+
+def _count(value, name, low):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+        raise ValueError(f"{name}: expected a whole number >= {low}, got {value!r}")
+    return int(value)
+
+
+def _connect(scheduler, timeout):
+    from dask.distributed import Client
+    try:
+        return Client(scheduler, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as e:  # asyncio/ distributed timeouts are OSError or TimeoutError
+        raise InputError(f"scheduler {scheduler}: cannot connect within {timeout:g} s ({type(e).__name__}: {e})") from None
+
+
+def _run_dask(s, client, scheduler, threads, chunk_size, timeout):
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError as e:  # pragma: no cover - the Debian package python3-distributed
+        raise ImportError("engine='dask' needs dask.distributed (Debian: python3-distributed)") from e
+    path = os.path.abspath(s.file)
+    chunks = s.chunks(chunk_size)
+    owned = []  # what this call started, closed at its end
+    try:
+        if client is None and scheduler is not None:
+            client = _connect(scheduler, timeout)
+            owned.append(client)
+        elif client is None:
+            workers = threads or os.cpu_count() or 1
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=False,
+                                   dashboard_address=None)
+            owned.append(cluster)
+            client = Client(cluster, set_as_default=False)
+            owned.insert(0, client)
+        futures = client.map(study_chunk_rows, [path] * len(chunks), [s.fingerprint] * len(chunks),
+                             [b for b, _ in chunks], [e for _, e in chunks], pure=False)
+        try:
+            parts = client.gather(futures)
+        finally:
+            for f in futures:
+                f.release()
+    finally:
+        for x in owned:
+            x.close()
+    if not parts:
+        return np.empty((0, len(s.columns)))
+    return np.concatenate(parts, axis=0)
+
+
+def study(study, *, engine="threads", threads=0, client=None, scheduler=None, chunk_size=None, timeout=10.0):
+    """Runs a capture study and returns its :class:`StudyResult` (all samples, in order).
+
+    study: a study file's path, or a :class:`Study` (``load_study``).
+    engine: ``"threads"``: the C++ engine on this process's threads (``threads``; 0: all cores).
+      ``"dask"``: chunks of samples as tasks on a ``dask.distributed`` cluster, gathered in order:
+      ``client`` (a ``dask.distributed.Client``, left open), or ``scheduler`` (its address, e.g.
+      ``"tcp://10.0.0.5:8786"``: connected within ``timeout`` seconds, else InputError naming it),
+      or neither: a ``LocalCluster`` of ``threads`` (0: all cores) single-threaded workers in this
+      process, started and closed by the call. The workers load the study from its absolute path:
+      they need the same files at the same path (a shared file system).
+    chunk_size: samples per Dask task (default: the study's ``default_chunk_size``, the command-line
+      tool's chunks); the rows do not depend on it.
+    """
+    if engine not in _ENGINES:
+        raise ValueError(f"engine: expected 'threads' or 'dask', got {engine!r}")
+    threads = _count(threads, "threads", 0)
+    if chunk_size is not None:
+        chunk_size = _count(chunk_size, "chunk_size", 1)
+    if not (isinstance(timeout, (int, float)) and timeout > 0 and math.isfinite(timeout)):
+        raise ValueError(f"timeout: expected a number of seconds > 0, got {timeout!r}")
+    if engine == "threads" and (client is not None or scheduler is not None):
+        raise ValueError("client, scheduler: only for engine='dask'")
+    if client is not None and scheduler is not None:
+        raise ValueError("client, scheduler: give one (a Client, or the address of a scheduler to connect to)")
+    s = _resolve(study)
+    if engine == "threads":
+        table = s.rows(0, s.samples, threads=threads)
+    else:
+        table = _run_dask(s, client, scheduler, threads, chunk_size or 0, float(timeout))
+    return StudyResult(s, table)
+
+
+def _c_double(x):
+    """x as C's printf("%.17g") writes it (glibc): Python's %-formatting agrees, but for NaN's sign."""
+    if x != x:
+        return "-nan" if math.copysign(1.0, x) < 0 else "nan"
+    return "%.17g" % x
+
+
+class StudyResult:
+    """The rows of a study: ``table`` (samples, len(columns)) float64, one row per sample in order,
+    column 0 ``sample``, column 1 ``status`` (0: computed; else an error code, outcomes NaN)."""
+
+    def __init__(self, study, table):
+        table = np.asarray(table, dtype=np.float64)
+        if table.ndim != 2 or table.shape[1] != len(study.columns):
+            raise ValueError(f"table: expected shape (n, {len(study.columns)}), got {table.shape}")
+        self.study = study
+        self.columns = list(study.columns)
+        self.table = table
+        self._summary = None
+
+    def __len__(self):
+        return self.table.shape[0]
+
+    def __getitem__(self, name):
+        """The column `name` as an array (a view of the table)."""
+        try:
+            return self.table[:, self.columns.index(name)]
+        except ValueError:
+            raise KeyError(f"{name!r} is no column of this study (its columns: {', '.join(self.columns)})") from None
+
+    @property
+    def summary(self):
+        """The summary as ``kdl_space study --json`` prints it (without its "table" file name)."""
+        if self._summary is None:
+            self._summary = self.study.summary(self.table)
+        return self._summary
+
+    @property
+    def failed(self):
+        """How many samples could not be computed (status != 0)."""
+        return int(np.count_nonzero(self.table[:, 1] != 0.0))
+
+    def to_csv(self, path):
+        """Writes the table as ``kdl_space study -o`` does, byte for byte: so the command-line tool
+        can merge it (``--merge``), resume from it, plot it."""
+        s, n = self.study, self.table.shape[0]
+        lines = [f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{n}",
+                 ",".join(self.columns)]
+        row_format = "%.0f,%.0f" + ",%.17g" * (len(self.columns) - 2)
+        negative_nan = np.isnan(self.table) & np.signbit(self.table)
+        for r, row in enumerate(self.table.tolist()):
+            if negative_nan[r].any():
+                lines.append("%.0f,%.0f" % (row[0], row[1]) + "".join("," + _c_double(x) for x in row[2:]))
+            else:
+                lines.append(row_format % tuple(row))
+        tmp = f"{path}.tmp{os.getpid()}"
+        with open(tmp, "w", encoding="ascii", newline="\n") as f:
+            f.write("\n".join(lines) + "\n")
+        os.replace(tmp, path)
+
+    def to_npz(self, path):
+        """Writes the table with np.savez: one array per column (by its name), plus ``columns``
+        (their names, in order), ``fingerprint``, ``seed`` and ``samples`` (uint64) and ``study`` (its file)."""
+        arrays = {name: self.table[:, k] for k, name in enumerate(self.columns)}
+        meta = {"columns": np.array(self.columns), "fingerprint": np.uint64(self.study.fingerprint),
+                "seed": np.uint64(self.study.seed), "samples": np.uint64(self.study.samples),
+                "study": np.array(self.study.file)}
+        clash = set(arrays) & set(meta)
+        if clash:  # pragma: no cover - no study column has these names
+            raise ValueError(f"to_npz: columns named {sorted(clash)} clash with the file's metadata")
+        np.savez(path, **arrays, **meta)
+
+    def __repr__(self):
+        return (f"<kdl_space.StudyResult '{self.study.file}' {self.table.shape[0]} samples "
+                f"({self.failed} failed), table {self.table.shape}>")

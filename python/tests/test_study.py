@@ -1,0 +1,282 @@
+"""Capture studies from Python: Study.rows equals the command-line tool's table bit for bit (the
+same rows whatever computes them: threads, a Dask LocalCluster of 2 workers, 3 shards merged);
+the result's CSV is the tool's file byte for byte, its .npz round-trips, its summary is the tool's
+--json; an unreachable scheduler, a missing or wrong study file and bad arguments are errors that
+name what is wrong."""
+import ctypes
+import json
+import math
+import os
+import struct
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import kdl_space
+from conftest import CAPTURE_SCENARIO, SOURCE_DIR
+from kdl_space.study import _c_double, study_chunk_rows
+
+GRASP_STUDY = SOURCE_DIR / "scenarios" / "study_grasp_configuration.yaml"
+
+SMALL_STUDY = f"""\
+scenario: {CAPTURE_SCENARIO}
+samples: 60
+seed: 4242
+inputs:
+  target.tumble: {{uniform: [0.02, 0.2]}}
+  robot.q.joint2: {{normal: {{mean: 0.7, std: 0.05}}}}
+limits:
+  joint_rate: 0.05
+  base_rate: 0.004
+objective: base_rate
+"""
+
+
+def run_cli(cli, *args, cwd):
+    return subprocess.run([cli, "study", *map(str, args)], check=True, capture_output=True, text=True, cwd=cwd)
+
+
+def read_table(path):
+    """A table the tool wrote: (first line, columns, rows as float64)."""
+    with open(path) as f:
+        head, header = f.readline().rstrip("\n"), f.readline().rstrip("\n").split(",")
+        rows = [[float(x) for x in line.rstrip("\n").split(",")] for line in f]
+    return head, header, np.array(rows, dtype=np.float64).reshape(len(rows), len(header))
+
+
+def bit_identical(a, b):
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    path = tmp_path_factory.mktemp("study") / "small_study.yaml"
+    path.write_text(SMALL_STUDY)
+    return path
+
+
+@pytest.fixture(scope="module")
+def small_tool(cli, small):
+    """The tool's whole table and --json summary of the small study."""
+    out = run_cli(cli, small, "-o", small.parent / "all.csv", "--threads", "2", "--json", cwd=small.parent)
+    return small.parent / "all.csv", json.loads(out.stdout)
+
+
+@pytest.fixture(scope="module")
+def grasp_tool(cli, tmp_path_factory):
+    d = tmp_path_factory.mktemp("grasp")
+    out = run_cli(cli, GRASP_STUDY, "-o", d / "grasp.csv", "--json", cwd=d)
+    return d / "grasp.csv", json.loads(out.stdout)
+
+
+def test_load_study_properties(small):
+    s = kdl_space.load_study(str(small))
+    assert s.file == str(small) and s.samples == 60 and s.seed == 4242 and not s.latin_hypercube
+    assert s.inputs == ["target.tumble", "robot.q.joint2"]
+    assert s.columns[:6] == ["sample", "status", "target.tumble", "target.tumble.axis_x", "target.tumble.axis_y",
+                             "target.tumble.axis_z"]
+    assert s.columns[-3:] == ["exceeds.joint_rate", "exceeds.base_rate", "exceeds.any"]
+    assert s.distributions["robot.q.joint2"] == {"kind": "normal", "a": 0.7, "b": 0.05}
+    assert s.objective == "base_rate" and s.heat_map is None and s.motion_duration == 0.0
+    assert isinstance(s.scenario, kdl_space.Scenario) and s.scenario.file == str(CAPTURE_SCENARIO)
+    assert 0 <= s.fingerprint < 2**64 and s.default_chunk_size == 16
+    assert s.chunks() == [(0, 16), (16, 32), (32, 48), (48, 60)]
+    assert s.chunks(25, 10, 55) == [(10, 25), (25, 50), (50, 55)]
+    assert repr(s).startswith(f"<kdl_space.Study '{small}' 60 samples, inputs [target.tumble, robot.q.joint2], columns (")
+    g = kdl_space.load_study(str(GRASP_STUDY))
+    assert g.latin_hypercube and g.heat_map == ("robot.self_motion", "target.tumble", "base_rate")
+    assert g.distributions["robot.self_motion"] == {"kind": "grid", "a": -1.2, "b": 1.2, "count": 25}
+
+
+def test_rows_equal_the_tool_table(grasp_tool):
+    table, _ = grasp_tool
+    head, header, expected = read_table(table)
+    s = kdl_space.load_study(str(GRASP_STUDY))
+    assert header == s.columns
+    assert head == f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{s.samples}"
+    rows = s.rows(0, s.samples, threads=2)
+    assert rows.shape == (400, len(s.columns)) and rows.dtype == np.float64
+    assert np.all(rows[:, 1] == 0.0) and np.all(rows[:, 0] == np.arange(400))
+    assert bit_identical(rows, expected)
+    assert bit_identical(s.rows(0, s.samples), rows)                       # 1 thread
+    assert bit_identical(s.rows(0, s.samples, threads=0), rows)            # all cores
+    assert bit_identical(s.rows(123, 301, threads=2), rows[123:301])      # any range
+    assert s.rows(7, 7).shape == (0, len(s.columns))
+
+
+def test_rows_release_the_gil():
+    s = kdl_space.load_study(str(GRASP_STUDY))
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (s.rows(0, s.samples, threads=1), done.set()))
+    ticks = 0
+    worker.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0)
+    worker.join()
+    assert ticks > 100  # this thread ran while rows() computed
+
+
+@pytest.mark.filterwarnings("ignore:make_current is deprecated:DeprecationWarning")  # tornado, in distributed
+def test_dask_and_shards_give_the_same_rows(cli, small, small_tool):
+    from dask.distributed import Client, LocalCluster
+
+    s = kdl_space.load_study(str(small))
+    embedded = s.rows(0, s.samples, threads=2)
+    _, _, whole = read_table(small_tool[0])
+    assert bit_identical(embedded, whole)
+
+    parts = [small.parent / f"part{i}.csv" for i in (1, 2, 3)]
+    for i, part in enumerate(parts, 1):
+        run_cli(cli, small, "--shard", f"{i}/3", "-o", part, "--threads", "1", cwd=small.parent)
+    run_cli(cli, small, "--merge", *parts, "-o", small.parent / "merged.csv", cwd=small.parent)
+    _, _, merged = read_table(small.parent / "merged.csv")
+    assert bit_identical(merged, embedded)
+
+    # 2 worker processes on loopback: the task loads the study on the worker (PYTHONPATH inherited)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        r = kdl_space.study(str(small), engine="dask", client=client)
+        assert bit_identical(r.table, embedded)
+        r7 = kdl_space.study(s, engine="dask", client=client, chunk_size=7)  # 9 tasks
+        assert bit_identical(r7.table, embedded)
+        assert client.status == "running"  # the user's client is left open
+        # a worker whose files differ refuses the task
+        with pytest.raises(kdl_space.InputError, match="fingerprint"):
+            client.submit(study_chunk_rows, str(small), s.fingerprint ^ 1, 0, 5).result()
+
+    # neither client nor scheduler: a LocalCluster of the call's own
+    r = kdl_space.study(small, engine="dask", threads=2)
+    assert bit_identical(r.table, embedded)
+    assert bit_identical(kdl_space.study(small, threads=2).table, embedded)
+
+
+def test_to_csv_is_the_tool_table(small, small_tool, grasp_tool, tmp_path):
+    for study_file, (table, _) in ((small, small_tool), (GRASP_STUDY, grasp_tool)):
+        r = kdl_space.study(str(study_file), threads=2)
+        r.to_csv(tmp_path / "mine.csv")
+        assert (tmp_path / "mine.csv").read_bytes() == table.read_bytes()
+    assert sorted(os.listdir(tmp_path)) == ["mine.csv"]
+
+
+def test_to_csv_formats_doubles_as_c_does():
+    libc = ctypes.CDLL(None)
+    buf = ctypes.create_string_buffer(64)
+
+    def c(x):
+        libc.snprintf(buf, 64, b"%.17g", ctypes.c_double(x))
+        return buf.value.decode()
+
+    rng = np.random.default_rng(5)
+    values = [0.0, -0.0, 1.0, -1.5, 1e16, 1e17, 123456789012345678.0, 1e-5, 1e-4, 5e-324, 2.2250738585072014e-308,
+              1.7976931348623157e308, math.inf, -math.inf, math.nan, -math.nan, 0.1, 1 / 3, 2.5e-7]
+    values += [struct.unpack("<d", struct.pack("<Q", int(b)))[0] for b in rng.integers(0, 2**64, 3000, dtype=np.uint64)]
+    values += list(rng.normal(size=2000) * 10.0 ** rng.integers(-30, 30, 2000))
+    for x in values:
+        assert _c_double(x) == c(x), x
+    assert _c_double(-math.nan) == "-nan" and _c_double(math.nan) == "nan"
+
+
+def test_to_npz_round_trips(small, tmp_path):
+    r = kdl_space.study(str(small), threads=2)
+    r.to_npz(tmp_path / "t.npz")
+    with np.load(tmp_path / "t.npz") as z:
+        assert list(z["columns"]) == r.columns
+        assert int(z["fingerprint"]) == r.study.fingerprint and int(z["seed"]) == 4242 and int(z["samples"]) == 60
+        assert str(z["study"]) == str(small)
+        table = np.column_stack([z[name] for name in z["columns"]])
+        assert bit_identical(table, r.table)
+        for name in r.columns:
+            assert bit_identical(z[name], r[name])
+
+
+def same(actual, expected, where):
+    """Equal keys, equal strings and integers, numbers to 1e-12 (relative)."""
+    if isinstance(expected, dict):
+        assert isinstance(actual, dict) and sorted(actual) == sorted(expected), where
+        for k in expected:
+            same(actual[k], expected[k], f"{where}.{k}")
+    elif isinstance(expected, list):
+        assert isinstance(actual, list) and len(actual) == len(expected), where
+        for i, (a, e) in enumerate(zip(actual, expected)):
+            same(a, e, f"{where}[{i}]")
+    elif isinstance(expected, (str, bool)) or expected is None:
+        assert actual == expected, where
+    elif isinstance(expected, int):
+        assert actual == expected and isinstance(actual, int), where
+    else:
+        assert abs(actual - expected) <= 1e-12 * max(1.0, abs(expected)), f"{where}: {actual} vs {expected}"
+
+
+def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
+    for study_file, (_, expected) in ((small, small_tool), (GRASP_STUDY, grasp_tool)):
+        r = kdl_space.study(str(study_file), threads=2)
+        expected = dict(expected)
+        del expected["table"]  # the tool's file; a result in memory has none
+        same(r.summary, expected, "summary")
+        assert r.summary["samples"] == r.study.samples and r.summary["failed"] == r.failed == 0
+        assert r.summary["fingerprint"] == f"{r.study.fingerprint:016x}"
+        # the summary of the rows in any order is the same
+        shuffled = r.table[np.random.default_rng(1).permutation(len(r))]
+        same(r.study.summary(shuffled), r.summary, "shuffled")
+    grasp = kdl_space.study(str(GRASP_STUDY), threads=2)
+    assert set(grasp.summary["probabilities"]) == {"exceeds.joint_rate", "exceeds.base_rate", "exceeds.any"}
+    best = grasp.summary["best"][0]
+    assert best["objective"] == grasp["base_rate"].min()
+    assert grasp["base_rate"][best["sample"]] == best["objective"]
+    assert set(best["inputs"]) == {"robot.self_motion", "target.tumble", "target.tumble.axis_x",
+                                   "target.tumble.axis_y", "target.tumble.axis_z"}
+    assert repr(grasp) == f"<kdl_space.StudyResult '{GRASP_STUDY}' 400 samples (0 failed), table (400, {len(grasp.columns)})>"
+
+
+def test_unreachable_scheduler(small, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    t0 = time.monotonic()
+    with pytest.raises(kdl_space.InputError, match="scheduler tcp://127.0.0.1:1: cannot connect within 2 s"):
+        kdl_space.study(str(small), engine="dask", scheduler="tcp://127.0.0.1:1", timeout=2)
+    assert time.monotonic() - t0 < 6.0
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_inputs(small, tmp_path):
+    missing = tmp_path / "nope.yaml"
+    with pytest.raises(kdl_space.InputError, match="nope.yaml"):
+        kdl_space.load_study(str(missing))
+    with pytest.raises(kdl_space.InputError, match="nope.yaml"):
+        kdl_space.study(missing)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(SMALL_STUDY + "colour: blue\n")
+    with pytest.raises(kdl_space.InputError, match="colour"):
+        kdl_space.load_study(str(bad))
+    bad.write_text(SMALL_STUDY.replace("target.tumble:", "target.spin:"))
+    with pytest.raises(kdl_space.InputError, match="target.spin"):
+        kdl_space.load_study(str(bad))
+
+    s = kdl_space.load_study(str(small))
+    with pytest.raises(ValueError, match="begin"):
+        s.rows(10, 5)
+    with pytest.raises(ValueError, match="end"):
+        s.rows(0, 61)
+    with pytest.raises(ValueError, match="begin"):
+        s.rows(-1, 5)
+    with pytest.raises(ValueError, match="threads"):
+        s.rows(0, 5, threads=-2)
+    with pytest.raises(ValueError, match=r"rows: expected shape \(n, %d\)" % len(s.columns)):
+        s.summary(np.zeros((3, 4)))
+    with pytest.raises(ValueError, match="engine"):
+        kdl_space.study(s, engine="mpi")
+    with pytest.raises(ValueError, match="threads"):
+        kdl_space.study(s, threads=-1)
+    with pytest.raises(ValueError, match="chunk_size"):
+        kdl_space.study(s, engine="dask", chunk_size=0)
+    with pytest.raises(ValueError, match="only for engine='dask'"):
+        kdl_space.study(s, scheduler="tcp://127.0.0.1:8786")
+    with pytest.raises(TypeError, match="study"):
+        kdl_space.study(42)
+    r = kdl_space.StudyResult(s, s.rows(0, 3))
+    with pytest.raises(KeyError, match="no column"):
+        r["impulse"]
+    assert len(r) == 3 and bit_identical(r["sample"], np.arange(3.0))
