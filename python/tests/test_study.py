@@ -87,8 +87,8 @@ def test_load_study_properties(small):
     assert s.chunks(25, 10, 55) == [(10, 25), (25, 50), (50, 55)]
     assert repr(s).startswith(f"<kdl_space.Study '{small}' 60 samples, inputs [target.tumble, robot.q.joint2], columns (")
     g = kdl_space.load_study(str(GRASP_STUDY))
-    assert g.latin_hypercube and g.heat_map == ("robot.self_motion", "target.tumble", "base_rate")
-    assert g.distributions["robot.self_motion"] == {"kind": "grid", "a": -1.2, "b": 1.2, "count": 25}
+    assert not g.latin_hypercube and g.samples == 31 * 13 and g.heat_map == ("robot.self_motion", "robot.q.joint7", "base_rate")
+    assert g.distributions["robot.self_motion"] == {"kind": "grid", "a": -1.5, "b": 1.5, "count": 31}
 
 
 def test_rows_equal_the_tool_table(grasp_tool):
@@ -98,8 +98,8 @@ def test_rows_equal_the_tool_table(grasp_tool):
     assert header == s.columns
     assert head == f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{s.samples}"
     rows = s.rows(0, s.samples, threads=2)
-    assert rows.shape == (400, len(s.columns)) and rows.dtype == np.float64
-    assert np.all(rows[:, 1] == 0.0) and np.all(rows[:, 0] == np.arange(400))
+    assert rows.shape == (403, len(s.columns)) and rows.dtype == np.float64
+    assert np.all(rows[:, 1] == 0.0) and np.all(rows[:, 0] == np.arange(403))
     assert bit_identical(rows, expected)
     assert bit_identical(s.rows(0, s.samples), rows)                       # 1 thread
     assert bit_identical(s.rows(0, s.samples, threads=0), rows)            # all cores
@@ -227,9 +227,8 @@ def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
     best = grasp.summary["best"][0]
     assert best["objective"] == grasp["base_rate"].min()
     assert grasp["base_rate"][best["sample"]] == best["objective"]
-    assert set(best["inputs"]) == {"robot.self_motion", "target.tumble", "target.tumble.axis_x",
-                                   "target.tumble.axis_y", "target.tumble.axis_z"}
-    assert repr(grasp) == f"<kdl_space.StudyResult '{GRASP_STUDY}' 400 samples (0 failed), table (400, {len(grasp.columns)})>"
+    assert set(best["inputs"]) == {"robot.self_motion", "robot.q.joint7"}
+    assert repr(grasp) == f"<kdl_space.StudyResult '{GRASP_STUDY}' 403 samples (0 failed), table (403, {len(grasp.columns)})>"
 
 
 def test_unreachable_scheduler(small, tmp_path, monkeypatch):
