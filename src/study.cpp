@@ -107,9 +107,7 @@ StudyEvaluator::StudyEvaluator(std::shared_ptr<const Study> study)
     w.places_target |= in.field == F::TargetGrasp || in.field == F::Timing;
     if (in.field == F::SelfMotion && !w.self_motion)
       w.self_motion = std::make_unique<SelfMotion>(sc.capture.robot.model, sc.capture.robot.contact, sc.capture.robot.state);
-    std::size_t values = 0;
-    for (const StudyInput& i : study_->inputs) values += static_cast<std::size_t>(sampling::valuesOf(i));
-    w.drawn.assign(values, 0.0);
+    w.drawn.resize(w.drawn.size() + static_cast<std::size_t>(sampling::valuesOf(in)));
   }
   const auto* target = std::get_if<RigidTarget>(&sc.capture.target);
   if (target && (w.moves_hand || w.places_target)) {
