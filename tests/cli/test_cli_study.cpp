@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <unistd.h>
 
 #include "cli_runner.hpp"
 
@@ -21,7 +22,8 @@ const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/"
 const std::string kShippedStudy = kScenarios + "study_grasp_configuration.yaml";
 
 std::string scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_cli_study";
+  // One folder per process: ctest runs these tests in parallel processes, each writing its study.
+  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_cli_study_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return (dir / name).string();
 }
