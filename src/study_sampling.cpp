@@ -80,22 +80,20 @@ std::uint64_t gridSize(const Study& study) {
 int valuesOf(const StudyInput& input) { return input.field == StudyInput::Field::TargetTumble ? 4 : 1; }
 
 void draw(const Study& study, std::uint64_t i, double* values) {
-  std::uint64_t grid_index = i % gridSize(study);
-  // Grid coordinates: the last grid input varies fastest, so peel them off from the end.
-  std::vector<std::uint64_t> point(study.inputs.size(), 0);
-  for (std::size_t k = study.inputs.size(); k-- > 0;) {
-    const Distribution& d = study.inputs[k].distribution;
-    if (d.kind != Distribution::Kind::Grid) continue;
-    point[k] = grid_index % static_cast<std::uint64_t>(d.count);
-    grid_index /= static_cast<std::uint64_t>(d.count);
-  }
+  const std::uint64_t grid_index = i % gridSize(study);
   for (std::size_t k = 0; k < study.inputs.size(); ++k) {
     const StudyInput& in = study.inputs[k];
     const Distribution& d = in.distribution;
     const std::uint64_t stream = 4 * k;
     double value;
     if (d.kind == Distribution::Kind::Grid) {
-      value = d.count == 1 ? d.a : d.a + (d.b - d.a) * static_cast<double>(point[k]) / static_cast<double>(d.count - 1);
+      // This input's grid coordinate: the last grid input varies fastest.
+      std::uint64_t stride = 1;
+      for (std::size_t later = k + 1; later < study.inputs.size(); ++later)
+        if (study.inputs[later].distribution.kind == Distribution::Kind::Grid)
+          stride *= static_cast<std::uint64_t>(study.inputs[later].distribution.count);
+      const std::uint64_t point = grid_index / stride % static_cast<std::uint64_t>(d.count);
+      value = d.count == 1 ? d.a : d.a + (d.b - d.a) * static_cast<double>(point) / static_cast<double>(d.count - 1);
     } else {
       double u = unit(study.seed, i, stream);
       if (study.latin_hypercube)  // stratum permute(i) of `samples`, a uniform point inside it

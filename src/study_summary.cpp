@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "kdl_space/study.hpp"
+#include "study_sampling.hpp"
 
 namespace kdl_space {
 namespace {
@@ -22,7 +23,7 @@ StudySummary summarizeStudy(const Study& study, const std::vector<double>& rows)
   const std::vector<std::string> columns = studyColumns(study);
   const std::size_t m = columns.size(), count = rows.size() / m;
   std::size_t first_outcome = 2;
-  for (const StudyInput& in : study.inputs) first_outcome += in.field == StudyInput::Field::TargetTumble ? 4 : 1;
+  for (const StudyInput& in : study.inputs) first_outcome += static_cast<std::size_t>(sampling::valuesOf(in));
   StudySummary s;
   s.samples = count;
   std::vector<std::size_t> good;

@@ -119,12 +119,10 @@ std::vector<double> mergeParts(const std::vector<std::string>& paths, const Stud
 }  // namespace
 
 Json studySummaryJson(const Study& st, const StudySummary& s, const std::string& table) {
-  char fp[17];
-  std::snprintf(fp, sizeof fp, "%016llx", static_cast<unsigned long long>(st.fingerprint));
   Json outcomes = Json::object(), probabilities = Json::object();
   for (const OutcomeSummary& o : s.outcomes) outcomes[o.name] = quantiles(o);
   for (const auto& [name, p] : s.probabilities) probabilities[name] = p;
-  return Json{{"study", st.file},       {"fingerprint", fp},          {"table", table},
+  return Json{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
               {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
               {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
               {"best", digests(s.best)}, {"worst", digests(s.worst)}};
@@ -177,13 +175,15 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     };
     std::vector<StudyChunk> todo;
     for (const StudyChunk& c : chunks) {
-      try {
-        if (!fs::exists(chunkFile(c), ec)) throw InputError("");
-        const StudyPart p = readStudyPart(chunkFile(c), st, columns);
-        std::copy(p.rows.begin(), p.rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
-      } catch (const InputError&) {
-        todo.push_back(c);  // missing, or of another version of the study: computed again
+      if (fs::exists(chunkFile(c), ec)) {
+        try {
+          const StudyPart p = readStudyPart(chunkFile(c), st, columns);
+          std::copy(p.rows.begin(), p.rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
+          continue;
+        } catch (const InputError&) {  // cut short, or of another version of the study: computed again
+        }
       }
+      todo.push_back(c);
     }
     fs::create_directories(parts, ec);
     if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");

@@ -35,11 +35,12 @@ void writeData(const std::string& path, const std::vector<std::size_t>& cols, st
 void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
                           const std::vector<double>& rows) {
   const std::string where = "--plot " + out.path() + ": ";
-  std::vector<std::string> shown{"impulse.force", "impulse.moment", "base_rate", "max_dqdot", "energy_lost"};
-  const std::vector<std::string> units{"N s", "N m s", "rad/s", "rad/s", "J"};
-  if (study.motion_duration > 0.0) shown.emplace_back("peak_base_rate");
+  std::vector<std::pair<std::string, std::string>> shown{  // outcome, unit
+      {"impulse.force", "N s"}, {"impulse.moment", "N m s"}, {"base_rate", "rad/s"}, {"max_dqdot", "rad/s"},
+      {"energy_lost", "J"}};
+  if (study.motion_duration > 0.0) shown.emplace_back("peak_base_rate", "rad/s");
   std::vector<std::size_t> cols;
-  for (const std::string& name : shown) cols.push_back(columnOf(columns, name));
+  for (const auto& [name, unit] : shown) cols.push_back(columnOf(columns, name));
   const std::size_t m = columns.size();
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
   writeData(data.path(), cols, m, rows, where);
@@ -54,7 +55,7 @@ void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::
     // Bins: 40 over the column's range (stats finds it; one value gets one bin of width 1e-9).
     g << "stats " << gnuplotQuoted(data.path()) << " using " << k + 1 << " nooutput\n"
       << "w = (STATS_max > STATS_min) ? (STATS_max - STATS_min) / 40.0 : 1e-9\n"
-      << "set xlabel " << gnuplotLabel(shown[k] + (k < units.size() ? " [" + units[k] + "]" : " [rad/s]")) << "\n"
+      << "set xlabel " << gnuplotLabel(shown[k].first + " [" + shown[k].second + "]") << "\n"
       << "plot " << gnuplotQuoted(data.path()) << " using (w * floor(($" << k + 1
       << " - STATS_min) / w) + STATS_min + w / 2):(1.0) smooth frequency with boxes\n";
   }

@@ -8,13 +8,17 @@
 #include "cli_common.hpp"
 
 namespace kdl_space::cli {
+std::string fingerprintText(const Study& study) {
+  char fp[17];
+  std::snprintf(fp, sizeof fp, "%016" PRIx64, study.fingerprint);
+  return fp;
+}
+
 namespace {
 
 /// The comment line that heads a part: which study (its fingerprint) and which rows.
 std::string headLine(const Study& study, std::uint64_t begin, std::uint64_t end) {
-  char fp[17];
-  std::snprintf(fp, sizeof fp, "%016" PRIx64, study.fingerprint);
-  return "# kdl_space study; fingerprint " + std::string(fp) + "; samples " + std::to_string(study.samples) + "; rows " +
+  return "# kdl_space study; fingerprint " + fingerprintText(study) + "; samples " + std::to_string(study.samples) + "; rows " +
          std::to_string(begin) + "-" + std::to_string(end);
 }
 

@@ -17,6 +17,9 @@ struct StudyPart {
   std::vector<double> rows;
 };
 
+/// The study's fingerprint as the table's head line and the summary JSON write it (16 hex digits).
+std::string fingerprintText(const Study& study);
+
 /// \brief Writes rows [begin, end) to `path` (under a temporary name, renamed into place).
 /// `option` names the file in messages. Throws InputError if it cannot be written.
 void writeStudyPart(const std::string& path, const std::string& option, const Study& study,
