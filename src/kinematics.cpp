@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "detail/joint_motion.hpp"
+#include "detail/lanes.hpp"
 #include "detail/multiversion.hpp"
 
 namespace kdl_space {
@@ -34,7 +35,6 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
   const Vector3d p_b = toEigen(state.world_T_base.p);
   kin.R[0] = toEigen(state.world_T_base.M);
   kin.p[0] = p_b;
-  Vector3d first_moment = Vector3d::Zero();
   // The joints' sines first: a call in the pass below would spill its registers every body.
   for (std::size_t i = 1; i < nb; ++i) {
     const detail::JointMotion& j = bodies[i];
@@ -42,37 +42,47 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
     const double t = j.scale * state.q.data(j.joint);
     kin.sc_[i] = Eigen::Vector2d(std::sin(t), 1.0 - std::cos(t));
   }
-  // Parents first. Each result is built in registers and stored once (a store read back in
-  // pieces stalls).
+  // Parents first, in four-lane vectors (detail/lanes.hpp). The pose of body i - 1, the parent of
+  // most bodies, stays in registers; the results are stored once.
+  using detail::Lanes;
+  using detail::LaneMatrix;
+  const Lanes base = detail::lanes(p_b);
+  LaneMatrix R = detail::lanes(kin.R[0]);
+  Lanes p = base, first_moment = Lanes{0.0, 0.0, 0.0, 0.0};
   for (std::size_t i = 0; i < nb; ++i) {
     const detail::JointMotion& j = bodies[i];
     if (j.parent >= 0) {
-      const Matrix3d& R_parent = kin.R[j.parent];
-      const Vector3d& p_parent = kin.p[j.parent];
+      const bool previous = j.parent == static_cast<int>(i) - 1;
+      const LaneMatrix R_parent = previous ? R : detail::lanes(kin.R[j.parent]);
+      const Lanes p_parent = previous ? p : detail::lanes(kin.p[j.parent]);
       if (j.kind == detail::JointMotion::Revolute) {  // rotation about the joint's axis line, then pose(0)
         const double s = kin.sc_[i].x(), c1 = kin.sc_[i].y();
-        kin.R[i].noalias() = R_parent * (j.R0 + s * j.K1 + c1 * j.K2);
-        kin.p[i] = p_parent + R_parent * (j.p0 + s * j.k1 + c1 * j.k2);
+        R = detail::times(R_parent, Matrix3d(j.R0 + s * j.K1 + c1 * j.K2));
+        p = p_parent + detail::times(R_parent, Vector3d(j.p0 + s * j.k1 + c1 * j.k2));
       } else {
-        kin.R[i].noalias() = R_parent * j.R0;
-        kin.p[i] = p_parent + R_parent * (j.kind == detail::JointMotion::Prismatic
-                                              ? Vector3d(j.p0 + j.scale * state.q.data(j.joint) * j.axis)
-                                              : j.p0);
+        R = detail::times(R_parent, j.R0);
+        p = p_parent + detail::times(R_parent, j.kind == detail::JointMotion::Prismatic
+                                                   ? Vector3d(j.p0 + j.scale * state.q.data(j.joint) * j.axis)
+                                                   : j.p0);
       }
+      detail::store(R, kin.R[i]);
+      detail::store(p, kin.p[i]);
       if (j.joint >= 0) {
         // The joint's unit twist, rotated to world axes and moved from the parent's origin to p_b.
-        const Vector3d w = R_parent * j.twist_w;
-        const Vector3d v = R_parent * j.twist_v + w.cross(p_b - p_parent);
-        kin.S[i] << v, w;
+        const Lanes w = detail::times(R_parent, j.twist_w);
+        const Lanes v = detail::times(R_parent, j.twist_v) + detail::cross(w, base - p_parent);
+        detail::store3(v, kin.S[i].data());
+        detail::store3(w, kin.S[i].data() + 3);
       }
     }
-    const Matrix3d& R = kin.R[i];
-    kin.com[i] = R * j.com + kin.p[i];
-    kin.I_com[i].noalias() = R * j.I_com * R.transpose();
-    first_moment += j.mass * kin.com[i];
+    const Lanes c = detail::times(R, j.com) + p;
+    detail::store(c, kin.com[i]);
+    detail::store(detail::timesTransposed(detail::times(R, j.I_com), R), kin.I_com[i]);  // R I R^T
+    first_moment += j.mass * c;
   }
+  const Vector3d r_g = Vector3d(first_moment[0], first_moment[1], first_moment[2]) / model.totalMass();
   kin.p_b = p_b;
-  kin.r_g = first_moment / model.totalMass();
+  kin.r_g = r_g;
   // Finite inputs of absurd magnitude (a base 1e300 m away) overflow: refuse.
   if (!kin.r_g.allFinite() || !kin.p.back().allFinite()) return E_NOT_FINITE;
   kin.state.world_T_base = state.world_T_base;

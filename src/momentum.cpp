@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 
 #include "detail/joint_motion.hpp"
+#include "detail/lanes.hpp"
 #include "detail/multiversion.hpp"
 
 namespace kdl_space {
@@ -18,36 +19,60 @@ MomentumSolver::MomentumSolver(std::shared_ptr<const FloatingModel> model) : mod
 KDL_SPACE_MULTIVERSION void MomentumSolver::sweep(const Kinematics& kin, const Vector6d& V_b, const Eigen::VectorXd& qdot,
                                                   Vector6d& h_b, double& twoT) {
   const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
-  Vector3d P_sum = Vector3d::Zero(), L_sum = Vector3d::Zero(), first_moment = Vector3d::Zero();
-  Matrix3d I_sum = Matrix3d::Zero(), mrr = Matrix3d::Zero();  // sum_i I_i, sum_i m_i r_i r_i^T
-  double energy = 0.0, mr2 = 0.0;                               // 2 T, sum_i m_i |r_i|^2
+  // In four-lane vectors (detail/lanes.hpp); the twist of body i - 1, the parent of most bodies,
+  // stays in registers.
+  using detail::Lanes;
+  const Lanes zero{0.0, 0.0, 0.0, 0.0}, base = detail::lanes(kin.p_b);
+  Lanes v = zero, w = zero;  // the twist of the body before
+  Lanes P_sum = zero, L_sum = zero, first_moment = zero, energy = zero, mr2 = zero;
+  detail::LaneMatrix I_sum{{zero, zero, zero}}, mrr{{zero, zero, zero}};  // sum_i I_i, sum_i m_i r_i r_i^T
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const detail::JointMotion& b = bodies[i];
-    if (b.parent < 0) V_[i] = V_b;
-    else V_[i] = b.joint >= 0 ? Vector6d(V_[b.parent] + kin.S[i] * qdot(b.joint)) : V_[b.parent];
+    if (b.parent < 0) {
+      v = detail::load3(V_b.data()), w = detail::load3(V_b.data() + 3);
+    } else {
+      if (b.parent != static_cast<int>(i) - 1)
+        v = detail::load3(V_[b.parent].data()), w = detail::load3(V_[b.parent].data() + 3);
+      if (b.joint >= 0) {
+        const double qd = qdot(b.joint);
+        v += detail::load3(kin.S[i].data()) * qd;
+        w += detail::load3(kin.S[i].data() + 3) * qd;
+      }
+    }
+    detail::store3(v, V_[i].data());
+    detail::store3(w, V_[i].data() + 3);
     if (!(b.mass > 0.0)) continue;  // a frame-only link
-    const Vector3d r = kin.com[i] - kin.p_b;
-    const Vector3d w = V_[i].tail<3>();
-    const Vector3d v_c = V_[i].head<3>() + w.cross(r);  // CoM velocity
-    const Vector3d P = b.mass * v_c;
-    const Vector3d Iw = kin.I_com[i] * w;
+    const Lanes r = detail::lanes(kin.com[i]) - base;
+    const Lanes v_c = v + detail::cross(w, r);  // CoM velocity
+    const Lanes P = b.mass * v_c;
+    const detail::LaneMatrix I = detail::lanes(kin.I_com[i]);
+    const Lanes Iw = detail::times(I, w[0], w[1], w[2]);
     P_sum += P;
-    L_sum += Iw + r.cross(P);  // about p_b
-    energy += P.dot(v_c) + w.dot(Iw);
-    const Vector3d mr = b.mass * r;
+    L_sum += Iw + detail::cross(r, P);  // about p_b
+    energy += P * v_c + w * Iw;
+    const Lanes mr = b.mass * r;
     first_moment += mr;
-    mr2 += mr.dot(r);
-    mrr.noalias() += mr * r.transpose();
-    I_sum += kin.I_com[i];
+    mr2 += mr * r;
+    for (int k = 0; k < 3; ++k) {
+      mrr.c[k] += mr * r[k];
+      I_sum.c[k] += I.c[k];
+    }
   }
-  h_b << P_sum, L_sum;
-  twoT = energy;
+  h_b << P_sum[0], P_sum[1], P_sum[2], L_sum[0], L_sum[1], L_sum[2];
+  twoT = detail::sum3(energy);
   // sum_i I_i about p_b (spatialInertia's blocks): [[w E, -skew(c)], [skew(c), I_b]], c = first
   // moment, I_b = sum_i (I_i + m_i (|r_i|^2 E - r_i r_i^T)) (parallel axes)
+  const Vector3d c(first_moment[0], first_moment[1], first_moment[2]);
+  Matrix3d I_b;
+  for (int k = 0; k < 3; ++k) {
+    const Lanes col = I_sum.c[k] - mrr.c[k];
+    I_b.col(k) = Vector3d(col[0], col[1], col[2]);
+  }
+  I_b.diagonal().array() += detail::sum3(mr2);
   I_tot_.topLeftCorner<3, 3>() = model_->totalMass() * Matrix3d::Identity();
-  I_tot_.topRightCorner<3, 3>() = -skew(first_moment);
-  I_tot_.bottomLeftCorner<3, 3>() = skew(first_moment);
-  I_tot_.bottomRightCorner<3, 3>() = I_sum + mr2 * Matrix3d::Identity() - mrr;
+  I_tot_.topRightCorner<3, 3>() = -skew(c);
+  I_tot_.bottomLeftCorner<3, 3>() = skew(c);
+  I_tot_.bottomRightCorner<3, 3>() = I_b;
 }
 
 int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
@@ -64,10 +89,8 @@ int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
   for (unsigned int j = 0; j < model_->nj(); ++j) twoT += armature[j] * v.qdot(j) * v.qdot(j);
   p_b_ = kin.p_b;
   r_g_ = kin.r_g;
-  for (std::size_t i = 0; i < nb; ++i) {
-    R_[i] = kin.R[i];
-    p_[i] = kin.p[i];
-  }
+  R_ = kin.R;  // same sizes: no allocation
+  p_ = kin.p;
   // I_g = I_b - w skew(r)^T skew(r) with r = r_g - p_b (parallel axes, eq. 3)
   const Vector3d r = r_g_ - p_b_;
   I_g_ = I_tot_.bottomRightCorner<3, 3>() -

@@ -17,7 +17,7 @@
 
 namespace kdl_space {
 namespace detail {
-struct Symmetric6d;  // src/detail/symmetric6d.hpp: a packed symmetric 6x6
+struct LaneSymmetric6d;  // src/detail/lane_symmetric6d.hpp: a symmetric 6x6 in four-lane blocks
 }
 
 /// \brief G* at one contact point and the velocity jump of the whole robot from an impulse there,
@@ -26,7 +26,7 @@ struct Symmetric6d;  // src/detail/symmetric6d.hpp: a packed symmetric 6x6
 ///
 /// `compute(kin)`: one backward pass of articulated-body inertias
 /// I^A_i = I_i + sum over children (I^A_c - U_c D_c^-1 U_c^T), U = I^A S, D = S^T U (+ armature),
-/// all in world axes about the base frame's origin (packed symmetric 6x6), and
+/// all in world axes about the base frame's origin (four-lane 3x3 blocks), and
 /// Omega_0 = (I^A_0)^-1 by a root-free Cholesky factorisation.
 /// `G_star(h)`: the inverse inertia a wrench on body i meets, outward along the path from the
 /// base to h's body: from Omega_0, Omega_i = T_i Omega_parent T_i^T + S_i D_i^-1 S_i^T,
@@ -84,7 +84,8 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
  private:
   /// 0, or the code of a contact query that cannot be answered.
   int ready(const Contact& h) const;
-  /// Marks the bodies from h.body to the base in path_ (root last); returns the count.
+  /// The bodies from h.body to the base in path_ (root last; kept for the next query at the same
+  /// body); returns the count.
   int walkPath(const Contact& h);
 
   std::shared_ptr<const FloatingModel> model_;
@@ -96,12 +97,16 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::vector<Matrix3d> R_;                        ///< per body: world rotation (copied from kin)
   std::vector<Vector3d> p_;                        ///< per body: world position of the frame origin
   std::vector<Vector6d> S_;                        ///< per body: unit joint twist at p_b (0 if fixed)
-  std::vector<detail::Symmetric6d> IA_;            ///< per body: articulated inertia at p_b
+  /// per body: the sum of the articulated inertias (at p_b) of its children other than the next body
+  std::vector<detail::LaneSymmetric6d> IA_;
+  std::vector<char> far_children_;                 ///< per body: children other than the next body (summed in IA_)
+  std::vector<char> first_far_child_;              ///< per body: its parent's far child done first (sets the sum)
   std::vector<Vector6d> U_;                        ///< per body: I^A S
   std::vector<double> D_;                          ///< per body: S^T I^A S + armature
   std::vector<double> Dinv_;                       ///< per body: 1 / D (no division in the queries)
   Matrix6d Omega0_ = Matrix6d::Zero();            ///< (I^A_0)^-1
-  std::vector<int> path_;                          ///< scratch: contact path
+  std::vector<int> path_;                          ///< the path of body path_body_ to the base (walkPath)
+  int path_body_ = -1, path_count_ = 0;
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   Eigen::VectorXd dq_;                             ///< scratch: joint-rate jumps (n)
   std::vector<double> Sp_;                         ///< scratch: S^T p, the bias force along the joint (zero off the path)
