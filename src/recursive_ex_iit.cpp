@@ -29,7 +29,6 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
     far_children_[parent] = 1;
   }
   U_.assign(nb, Vector6d::Zero());
-  D_.assign(nb, 0.0);
   Dinv_.assign(nb, 0.0);
   path_.resize(nb);
   dq_.setZero(model_->nj());
@@ -96,9 +95,9 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
     if (i > 0 && moves_[i]) {
       const detail::Lanes S_top = detail::load3(kin.S[i].data()), S_bottom = detail::load3(kin.S[i].data() + 3);
       A.times(kin.S[i], top, bottom);
-      double D = detail::sum3(S_top * top + S_bottom * bottom) + armature[j.joint];
+      double D = detail::dot(S_top, S_bottom, top, bottom) + armature[j.joint];
       if (pending) {
-        const double us = detail::sum3(S_top * carried_top + S_bottom * carried_bottom), k = carried_Dinv * us;
+        const double us = detail::dot(S_top, S_bottom, carried_top, carried_bottom), k = carried_Dinv * us;
         top -= k * carried_top;
         bottom -= k * carried_bottom;
         D -= k * us;
@@ -107,7 +106,6 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
       Dinv = 1.0 / D;
       detail::store3(top, U_[i].data());
       detail::store3(bottom, U_[i].data() + 3);
-      D_[i] = D;
       Dinv_[i] = Dinv;
     }  // else fixed or locked: the body rides on its parent
     if (pending) A.subtractRank1(carried_top, carried_bottom, carried_Dinv);
@@ -171,7 +169,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response re
     const detail::Lanes U_top = detail::load3(U_[i].data()), U_bottom = detail::load3(U_[i].data() + 3);
     detail::Lanes w_top, w_bottom;
     Omega.times(U_[i], w_top, w_bottom);
-    const double c = detail::sum3(U_top * w_top + U_bottom * w_bottom), e = 0.5 * d * (d * c + 1.0);
+    const double c = detail::dot(U_top, U_bottom, w_top, w_bottom), e = 0.5 * d * (d * c + 1.0);
     Omega.subtractRank2(S_top, S_bottom, d * w_top - e * S_top, d * w_bottom - e * S_bottom);
   }
   const Matrix6d O = Omega.dense();
@@ -206,9 +204,8 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
   const int count = walkPath(h);
   using detail::Lanes;
   using detail::load3;
-  using detail::sum3;
   const auto dot = [](const Vector6d& x, const Vector6d& y) {
-    return sum3(load3(x.data()) * load3(y.data()) + load3(x.data() + 3) * load3(y.data() + 3));
+    return detail::dot(load3(x.data()), load3(x.data() + 3), load3(y.data()), load3(y.data() + 3));
   };
   const Vector6d p0 = -transfer(r).transpose() * F;  // the impulse as a bias force at p_b
   // Inward along the path: S_i^T p_i is all the outward pass needs. The last joint's term,
@@ -221,7 +218,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
     const int i = path_[k];
     if (!moves_[i]) continue;
     const Lanes S_top = load3(S_[i].data()), S_bottom = load3(S_[i].data() + 3);
-    double Sp = sum3(S_top * p_top + S_bottom * p_bottom);
+    double Sp = detail::dot(S_top, S_bottom, p_top, p_bottom);
     if (U_late) {
       Sp -= dot(S_[i], *U_late) * g;
       p_top -= g * load3(U_late->data());

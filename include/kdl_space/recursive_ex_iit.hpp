@@ -102,8 +102,7 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::vector<char> far_children_;                 ///< per body: children other than the next body (summed in IA_)
   std::vector<char> first_far_child_;              ///< per body: its parent's far child done first (sets the sum)
   std::vector<Vector6d> U_;                        ///< per body: I^A S
-  std::vector<double> D_;                          ///< per body: S^T I^A S + armature
-  std::vector<double> Dinv_;                       ///< per body: 1 / D (no division in the queries)
+  std::vector<double> Dinv_;                       ///< per body: 1 / D, D = S^T I^A S + armature (no division in the queries)
   Matrix6d Omega0_ = Matrix6d::Zero();            ///< (I^A_0)^-1
   std::vector<int> path_;                          ///< the path of body path_body_ to the base (walkPath)
   int path_body_ = -1, path_count_ = 0;

@@ -2,6 +2,7 @@
 (KDL_SPACE_CLI), the default arm."""
 import os
 import pathlib
+import threading
 
 import pytest
 
@@ -28,3 +29,23 @@ def cli():
 def arm():
     import kdl_space
     return kdl_space.load_urdf(str(ARM))
+
+
+def on_two_threads(work):
+    """work(k) for k = 0, 1 on two threads side by side: their results, in order. Fails if either
+    raises or is still running after 120 s."""
+    out, errors = {}, []
+
+    def run(k):
+        try:
+            out[k] = work(k)
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not errors and not any(t.is_alive() for t in threads), errors
+    return out[0], out[1]

@@ -7,14 +7,13 @@ import json
 import resource
 import subprocess
 import sys
-import threading
 import tracemalloc
 
 import numpy as np
 import pytest
 
 import kdl_space
-from conftest import CAPTURE_SCENARIO
+from conftest import CAPTURE_SCENARIO, on_two_threads
 
 Q = {"joint1": 0.3, "joint2": 0.7, "joint3": -0.4, "joint4": 0.8, "joint5": 0.2, "joint6": -0.6, "joint7": 0.1}
 QDOT = {"joint1": 0.05, "joint2": -0.04, "joint4": 0.06, "joint6": 0.03, "joint7": -0.08}
@@ -352,23 +351,13 @@ def test_run_errors(arm):
 
 
 def test_threads_run_controllers_side_by_side(arm):
-    out, errors = {}, []
-
     def work(k):
-        try:
-            sim = kdl_space.Simulator(arm)
-            target = np.full(arm.nj, 0.1)
-            out[k] = sim.run(moving(arm), 0.5, 0.05, controller=pd(20.0, 5.0, target), control_rate=50.0).q
-        except Exception as e:  # noqa: BLE001
-            errors.append(e)
+        sim = kdl_space.Simulator(arm)
+        target = np.full(arm.nj, 0.1)
+        return sim.run(moving(arm), 0.5, 0.05, controller=pd(20.0, 5.0, target), control_rate=50.0).q
 
-    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=120)
-    assert not errors and not any(t.is_alive() for t in threads)
-    assert np.array_equal(out[0], out[1])
+    first, second = on_two_threads(work)
+    assert np.array_equal(first, second)
 
 
 def test_no_reference_leaks(arm):

@@ -9,29 +9,20 @@ import tracemalloc
 import numpy as np
 
 import kdl_space
+from conftest import on_two_threads
 
 
 def test_two_threads_compute_g_star(arm):
-    results, errors = {}, []
-
     def work(k):
-        try:
-            solver = kdl_space.FreeFloatingSolver(arm)  # one solver per thread
-            c = arm.contact("end_effector")
-            for i in range(200):
-                solver.compute(kdl_space.State(arm, q={"joint2": 0.01 * i}))
-                G = solver.G_star(c)
-            results[k] = G
-        except Exception as e:  # noqa: BLE001
-            errors.append(e)
+        solver = kdl_space.FreeFloatingSolver(arm)  # one solver per thread
+        c = arm.contact("end_effector")
+        for i in range(200):
+            solver.compute(kdl_space.State(arm, q={"joint2": 0.01 * i}))
+            G = solver.G_star(c)
+        return G
 
-    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=120)
-    assert not errors and not any(t.is_alive() for t in threads)
-    assert np.array_equal(results[0], results[1])
+    first, second = on_two_threads(work)
+    assert np.array_equal(first, second)
 
 
 def test_one_solver_shared_by_threads_is_serialised(arm):

@@ -66,6 +66,10 @@ inline Lanes cross(const Lanes& a, const Lanes& b) {
 
 /// v[0] + v[1] + v[2]
 inline double sum3(const Lanes& v) { return v[0] + v[1] + v[2]; }
+/// The dot product of two 6-vectors given as their (top; bottom) halves.
+inline double dot(const Lanes& a_top, const Lanes& a_bottom, const Lanes& b_top, const Lanes& b_bottom) {
+  return sum3(a_top * b_top + a_bottom * b_bottom);
+}
 
 /// Stores lanes 0-2 (three doubles; lane 3 is not written).
 inline void store3(const Lanes& v, double* out) {
