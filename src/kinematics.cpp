@@ -5,6 +5,7 @@
 #include "detail/joint_motion.hpp"
 #include "detail/lanes.hpp"
 #include "detail/multiversion.hpp"
+#include "detail/sines.hpp"
 
 namespace kdl_space {
 
@@ -16,7 +17,9 @@ Kinematics::Kinematics(const FloatingModel& m)
       S(m.bodies().size(), Vector6d::Zero()),
       com(m.bodies().size(), Vector3d::Zero()),
       I_com(m.bodies().size(), Matrix3d::Zero()),
-      sc_(m.bodies().size(), Eigen::Vector2d(0.0, 0.0)) {}
+      angle_((m.bodies().size() + 3) / 4 * 4, 0.0),
+      sin_(angle_.size(), 0.0),
+      cos_(angle_.size(), 1.0) {}
 
 KDL::Frame Kinematics::pose(int i) const {
   KDL::Rotation M;
@@ -35,13 +38,13 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
   const Vector3d p_b = toEigen(state.world_T_base.p);
   kin.R[0] = toEigen(state.world_T_base.M);
   kin.p[0] = p_b;
-  // The joints' sines first: a call in the pass below would spill its registers every body.
+  // The joints' sines first, all at once (detail/sines.hpp); a call in the pass below would also
+  // spill its registers every body.
   for (std::size_t i = 1; i < nb; ++i) {
     const detail::JointMotion& j = bodies[i];
-    if (j.kind != detail::JointMotion::Revolute) continue;
-    const double t = j.scale * state.q.data(j.joint);
-    kin.sc_[i] = Eigen::Vector2d(std::sin(t), 1.0 - std::cos(t));
+    if (j.kind == detail::JointMotion::Revolute) kin.angle_[i] = j.scale * state.q.data(j.joint);
   }
+  detail::sinesAndCosines(kin.angle_.data(), kin.sin_.data(), kin.cos_.data(), kin.angle_.size());
   // Parents first, in four-lane vectors (detail/lanes.hpp). The pose of body i - 1, the parent of
   // most bodies, stays in registers; the results are stored once.
   using detail::Lanes;
@@ -56,7 +59,7 @@ KDL_SPACE_MULTIVERSION int forwardKinematics(const FloatingModel& model, const S
       const LaneMatrix R_parent = previous ? R : detail::lanes(kin.R[j.parent]);
       const Lanes p_parent = previous ? p : detail::lanes(kin.p[j.parent]);
       if (j.kind == detail::JointMotion::Revolute) {  // rotation about the joint's axis line, then pose(0)
-        const double s = kin.sc_[i].x(), c1 = kin.sc_[i].y();
+        const double s = kin.sin_[i], c1 = 1.0 - kin.cos_[i];
         R = detail::times(R_parent, Matrix3d(j.R0 + s * j.K1 + c1 * j.K2));
         p = p_parent + detail::times(R_parent, Vector3d(j.p0 + s * j.k1 + c1 * j.k2));
       } else {

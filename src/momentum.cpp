@@ -86,7 +86,7 @@ int MomentumSolver::compute(const Kinematics& kin, const FloatingVelocity& v) {
   sweep(kin, toEigen(v.base_twist), v.qdot.data, h_b, twoT);
   // The rotors' own energy, as the armature on H's diagonal (their momentum is neglected, as in H)
   const std::vector<double>& armature = model_->armature();
-  for (unsigned int j = 0; j < model_->nj(); ++j) twoT += armature[j] * v.qdot(j) * v.qdot(j);
+  twoT += Eigen::Map<const Eigen::VectorXd>(armature.data(), model_->nj()).dot(v.qdot.data.cwiseAbs2());
   p_b_ = kin.p_b;
   r_g_ = kin.r_g;
   R_ = kin.R;  // same sizes: no allocation

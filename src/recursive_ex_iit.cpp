@@ -159,19 +159,43 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response re
   // with T_i = 1 - S_i D_i^-1 U_i^T (an impulse's bias force crossing joint i inward is T_i^T
   // times it). Expanded with w = Omega U, c = U^T w: Omega - (S y^T + y S^T),
   // y = w/D - (c/D^2 + 1/D) S / 2. In four-lane blocks (detail/lane_symmetric6d.hpp).
+  // Each joint's update is applied to Omega one step late: with the joint before's S', y', w',
+  // and P = Omega' U (Omega' without that update), w = P - S' (y'.U) - y' (S'.U) and
+  // c = U.P - 2 (y'.U)(S'.U), where y'.U = (w'.U)/D' - e' (S'.U): from joint to joint only
+  // w' -> w'.U -> w waits for the step before.
+  using detail::Lanes;
   detail::LaneSymmetric6d Omega = detail::LaneSymmetric6d::from(response == Response::FreeFloating ? Omega0_
                                                                                                 : Matrix6d::Zero());
+  const Lanes zero{0.0, 0.0, 0.0, 0.0};
+  Lanes S_late_top = zero, S_late_bottom = zero, y_late_top = zero, y_late_bottom = zero;
+  Lanes w_late_top = zero, w_late_bottom = zero;
+  double d_late = 0.0, e_late = 0.0;
+  bool pending = false;  // an update not yet applied to Omega
   for (int k = count - 2; k >= 0; --k) {
     const int i = path_[k];
     if (!moves_[i]) continue;  // fixed or locked
     const double d = Dinv_[i];
-    const detail::Lanes S_top = detail::load3(S_[i].data()), S_bottom = detail::load3(S_[i].data() + 3);
-    const detail::Lanes U_top = detail::load3(U_[i].data()), U_bottom = detail::load3(U_[i].data() + 3);
-    detail::Lanes w_top, w_bottom;
-    Omega.times(U_[i], w_top, w_bottom);
-    const double c = detail::dot(U_top, U_bottom, w_top, w_bottom), e = 0.5 * d * (d * c + 1.0);
-    Omega.subtractRank2(S_top, S_bottom, d * w_top - e * S_top, d * w_bottom - e * S_bottom);
+    const Lanes S_top = detail::load3(S_[i].data()), S_bottom = detail::load3(S_[i].data() + 3);
+    const Lanes U_top = detail::load3(U_[i].data()), U_bottom = detail::load3(U_[i].data() + 3);
+    Lanes w_top, w_bottom;
+    Omega.times(U_[i], w_top, w_bottom);  // P
+    double c = detail::dot(U_top, U_bottom, w_top, w_bottom);
+    if (pending) {
+      const double SU = detail::dot(S_late_top, S_late_bottom, U_top, U_bottom);
+      const double yU = d_late * detail::dot(w_late_top, w_late_bottom, U_top, U_bottom) - e_late * SU;
+      w_top -= yU * S_late_top + SU * y_late_top;
+      w_bottom -= yU * S_late_bottom + SU * y_late_bottom;
+      c -= 2.0 * yU * SU;
+      Omega.subtractRank2(S_late_top, S_late_bottom, y_late_top, y_late_bottom);
+    }
+    const double e = 0.5 * d * (d * c + 1.0);
+    S_late_top = S_top, S_late_bottom = S_bottom;
+    w_late_top = w_top, w_late_bottom = w_bottom;
+    y_late_top = d * w_top - e * S_top, y_late_bottom = d * w_bottom - e * S_bottom;
+    d_late = d, e_late = e;
+    pending = true;
   }
+  if (pending) Omega.subtractRank2(S_late_top, S_late_bottom, y_late_top, y_late_bottom);
   const Matrix6d O = Omega.dense();
   // G = X Omega X^T, X = transfer(r) = [E, -r^; 0, E] (eq. 5, 11), by 3x3 blocks: with
   // Omega = [a, b; b^T, c], G = [a - r^ b^T + e r^, e; e^T, c], e = b - r^ c.

@@ -9,7 +9,7 @@ cmake_minimum_required(VERSION 3.16)
 function(layer_of name out)
   get_filename_component(stem "${name}" NAME_WE)
   set(table
-    "export,spatial,errors,text,symmetric6d,lanes,lane_symmetric6d,multiversion,rosenbrock,response=0"
+    "export,spatial,errors,text,symmetric6d,lanes,lane_symmetric6d,multiversion,rosenbrock,sines,response=0"
     "diagnostics,model,model_build,model_rules,joint_motion=1"
     "state,kinematics,momentum=2"
     "free_floating_solver,recursive_ex_iit=3"
