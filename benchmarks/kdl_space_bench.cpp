@@ -28,6 +28,8 @@
 #include "generated_chain.hpp"
 #include "kdl_space/collision.hpp"
 #include "kdl_space/forward_dynamics.hpp"
+#include "kdl_space/kinematics.hpp"
+#include "kdl_space/momentum.hpp"
 #include "kdl_space/recursive_ex_iit.hpp"
 #include "kdl_space/simulation.hpp"
 #include "kdl_space/study.hpp"
@@ -409,6 +411,57 @@ void registerCase(const Case& c) {
       benchmark::DoNotOptimize(target.twistAfter().data());
     }
   });
+  // The capture's stages one by one, each alone in its loop (what ours_capture_end_to_end spends
+  // where): forward kinematics, the momentum sweep, the articulated-body pass, G* along the contact
+  // path, the velocity jump of an impulse.
+  benchmark::RegisterBenchmark((n + "/ours_stage_kinematics").c_str(), [cp](benchmark::State& st) {
+    Kinematics kin(*cp->model);
+    std::size_t i = 0;
+    for (auto _ : st) {
+      forwardKinematics(*cp->model, cp->at(i++), kin);
+      benchmark::DoNotOptimize(kin.I_com.back().data());
+    }
+  });
+  const auto stageKinematics = [cp] {
+    std::vector<Kinematics> kin(2, Kinematics(*cp->model));
+    for (std::size_t i = 0; i < 2; ++i) forwardKinematics(*cp->model, cp->at(i), kin[i]);
+    return kin;
+  };
+  benchmark::RegisterBenchmark((n + "/ours_stage_momentum").c_str(), [cp, stageKinematics](benchmark::State& st) {
+    const std::vector<Kinematics> kin = stageKinematics();
+    MomentumSolver momentum(cp->model);
+    std::size_t i = 0;
+    for (auto _ : st) {
+      momentum.compute(kin[i++ & 1], cp->velocity);
+      benchmark::DoNotOptimize(momentum.kineticEnergy());
+    }
+  });
+  benchmark::RegisterBenchmark((n + "/ours_stage_articulated_body").c_str(), [cp, stageKinematics](benchmark::State& st) {
+    const std::vector<Kinematics> kin = stageKinematics();
+    RecursiveExIITSolver solver(cp->model);
+    std::size_t i = 0;
+    for (auto _ : st) benchmark::DoNotOptimize(solver.compute(kin[i++ & 1]));
+  });
+  benchmark::RegisterBenchmark((n + "/ours_stage_G_path").c_str(), [cp](benchmark::State& st) {
+    RecursiveExIITSolver solver(cp->model);
+    solver.compute(cp->state);
+    Matrix6d G;
+    for (auto _ : st) {
+      solver.G_star(cp->contact, G);
+      benchmark::DoNotOptimize(G.data());
+    }
+  });
+  benchmark::RegisterBenchmark((n + "/ours_stage_velocity_jump").c_str(), [cp](benchmark::State& st) {
+    RecursiveExIITSolver solver(cp->model);
+    solver.compute(cp->state);
+    const Vector6d F = (Vector6d() << 3.0, -1.0, 2.0, 0.2, 0.1, -0.3).finished();
+    Vector6d d_base;
+    KDL::JntArray dqdot(cp->model->nj());
+    for (auto _ : st) {
+      solver.velocityJump(cp->contact, F, d_base, dqdot);
+      benchmark::DoNotOptimize(dqdot.data.data());
+    }
+  });
   // A study of captures of this robot (the box of ours_capture_end_to_end tumbling about a random
   // axis, its speed drawn too): the time per sample, drawing and the whole row included, on one
   // core; and the wall time per sample of runStudy on 1 and 2 threads (chunks of 256).
@@ -690,13 +743,28 @@ int main(int argc, char** argv) {
           << growth("crb_forward_dynamics") << (growth("DART_forward_dynamics").empty() ? "" : ", DART ")
           << growth("DART_forward_dynamics") << "\n";
 
-  // The capture path end to end.
+  // The capture path end to end, and its stages each timed alone.
+  const std::vector<std::string> stages{"ours_stage_kinematics", "ours_stage_momentum", "ours_stage_articulated_body",
+                                        "ours_stage_G_path", "ours_stage_velocity_jump"};
   table << "\n### Capture end to end (state to G*, impulse and the whole state after; FloatingSide + "
-           "RigidBodySide + collide)\n\n| model | CPU time per call |\n|---|---|\n";
-  for (const Case& c : cases())
-    if (time(c.name, "ours_capture_end_to_end") > 0.0)
-      table << "| " << c.name << " (" << c.model->nj() << " joints) | " << fmt(time(c.name, "ours_capture_end_to_end"))
-            << " |\n";
+           "RigidBodySide + collide)\n\nIts stages, each timed alone: forward kinematics, the momentum sweep, the "
+           "articulated-body pass, G* along the contact path, the velocity jump. The rest (the impulse, the "
+           "target's side, the bookkeeping of the state after) is the difference, as noisy as the six medians it "
+           "is made of.\n\n"
+           "| model | CPU time per call | kinematics | momentum | articulated body | G* path | velocity jump | the rest |\n"
+           "|---|---|---|---|---|---|---|---|\n";
+  for (const Case& c : cases()) {
+    const double whole = time(c.name, "ours_capture_end_to_end");
+    if (whole < 0.0) continue;
+    table << "| " << c.name << " (" << c.model->nj() << " joints) | " << fmt(whole);
+    double rest = whole;
+    for (const std::string& m : stages) {
+      const double t = time(c.name, m);
+      table << " | " << cell(t);
+      rest = t < 0.0 || rest < 0.0 ? -1.0 : rest - t;
+    }
+    table << " | " << cell(rest) << " |\n";
+  }
 
   // Studies.
   table << "\n### Capture studies (per sample: the draws, the capture and the row; a study of the box above "

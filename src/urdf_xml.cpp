@@ -330,8 +330,8 @@ void Reader::readJoint(const TiXmlElement* e) {
     for (const char* a : {"rising", "falling"}) readOptional(calibration, a, owner, "<calibration", unused);
   if (const TiXmlElement* mimic = e->FirstChildElement("mimic")) {
     double multiplier = 1.0, offset = 0.0;
-    const bool ok = readOptional(mimic, "multiplier", owner, "<mimic", multiplier) &
-                    readOptional(mimic, "offset", owner, "<mimic", offset);
+    const bool multiplier_ok = readOptional(mimic, "multiplier", owner, "<mimic", multiplier);
+    const bool ok = readOptional(mimic, "offset", owner, "<mimic", offset) && multiplier_ok;  // both read, both reported
     if (readRequired(mimic, {"joint"}, owner, "<mimic") && ok && rules::isMovable(joint.type)) {
       joint.has_mimic = true;
       joint.mimic_leader = mimic->Attribute("joint");

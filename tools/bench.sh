@@ -20,6 +20,9 @@ load_start=$(cut -d' ' -f1-3 /proc/loadavg)
 load_end=$(cut -d' ' -f1-3 /proc/loadavg)
 
 out="$root/docs/benchmarks.md"
+# The sections measured by hand (below the marker) are kept as they are.
+marker="<!-- measured by hand: every section below this line is kept by tools/bench.sh -->"
+by_hand=$(awk -v m="$marker" '$0 == m { kept = 1 } kept' "$out" 2>/dev/null || true)
 {
   echo "# Benchmarks"
   echo
@@ -69,6 +72,11 @@ out="$root/docs/benchmarks.md"
   echo "## The default model (urdf/space_arm7.urdf, contact end_effector)"
   echo
   cat "$model"
-} >"$out"
+  if [ -n "$by_hand" ]; then
+    echo
+    echo "$by_hand"
+  fi
+} >"$out.new"
+mv "$out.new" "$out"
 rm -f "$chains" "$model"
 echo "tools/bench.sh: wrote $out"

@@ -11,7 +11,9 @@
 
 // These inline helpers pass vectors by value inside one translation unit, never across the
 // library's ABI: GCC's note that an AVX vector argument changes the ABI does not apply.
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wpsabi"
+#elif defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
