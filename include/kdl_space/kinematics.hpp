@@ -29,8 +29,8 @@ struct KDL_SPACE_EXPORT Kinematics {
   std::vector<Matrix3d> I_com;  ///< per body: inertia about its CoM, world axes [kg m^2]
   Vector3d p_b = Vector3d::Zero();  ///< base frame origin (= p[0]) [m]
   Vector3d r_g = Vector3d::Zero();  ///< system CoM [m]
-  /// Workspace of forwardKinematics: per body its joint angle, and the angle's sine and cosine
-  /// (sized to a multiple of four, the rest zero).
+  /// Workspace of forwardKinematics: per body its joint angle (zero for a body without a
+  /// revolute joint), and the angle's sine and cosine; padded to a multiple of four angles.
   std::vector<double> angle_, sin_, cos_;
 
   Kinematics() = default;
