@@ -26,14 +26,14 @@
 
 #include "crb_forward_dynamics.hpp"
 #include "generated_chain.hpp"
-#include "kdl_space/collision.hpp"
-#include "kdl_space/forward_dynamics.hpp"
-#include "kdl_space/kinematics.hpp"
-#include "kdl_space/momentum.hpp"
-#include "kdl_space/recursive_ex_iit.hpp"
-#include "kdl_space/simulation.hpp"
-#include "kdl_space/study.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/study/study.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
 #ifdef KDL_SPACE_WITH_DART
 #include <dart/dynamics/BodyNode.hpp>

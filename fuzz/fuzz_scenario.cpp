@@ -17,7 +17,7 @@
 #include <iostream>
 #include <string>
 
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace {
 namespace fs = std::filesystem;

@@ -11,12 +11,12 @@
 #include <memory>
 #include <string>
 
-#include "kdl_space/errors.hpp"
-#include "kdl_space/free_floating_solver.hpp"
-#include "kdl_space/recursive_ex_iit.hpp"
-#include "kdl_space/state.hpp"
-#include "kdl_space/urdf_check.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/multibody/state.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace kdl_space;

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::cli {
 

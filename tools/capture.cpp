@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
-#include "kdl_space/kinematics.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
 #include "scene_writer.hpp"
 
 namespace kdl_space::cli {

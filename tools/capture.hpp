@@ -9,7 +9,7 @@
 
 #include "cli_common.hpp"
 #include "scene_writer.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::cli {
 

@@ -11,8 +11,8 @@
 
 #include "approach_report.hpp"
 #include "cli_common.hpp"
-#include "kdl_space/joined_system.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/impact/joined_system.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 #include "sample.hpp"
 #include "scene_writer.hpp"
 

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
-#include "kdl_space/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
 
 namespace kdl_space::cli {
 namespace {

@@ -1,62 +1,87 @@
-# Checks that the library's include graph goes one way, down the layers of docs/ARCHITECTURE.md:
-#   0 spatial   1 model   2 state/kinematics   3 solvers   4 impact/collision   5 capture
-#   6 dynamics/simulation   7 loaders/checker   (8 tools: may include anything of the library)
-# Every header and source of include/kdl_space/ and src/ has a layer (by its name below); a file
-# may include only files of its own layer or lower ones. A file with no layer fails the check:
-# give it one here. Also refuses a library file of more than 450 lines. Run: cmake -DSOURCE_DIR=<repo> -P tools/check_layers.cmake (ctest: layers).
+# Checks that the library's include graph goes one way, down the layers of docs/ARCHITECTURE.md.
+# A layer is a folder, the same under include/kdl_space/ and src/:
+#   0 spatial (and src/detail/)   1 multibody   2 algorithm   3 impact   4 simulation
+#   5 parsers (urdf/, scenario/)  6 operation   7 study       (tools/, python/: anything)
+# A file of the library may include only files of its own folder's layer or lower ones, named by
+# their folder ("kdl_space/impact/capture.hpp", "multibody/model_rules.hpp", "detail/lanes.hpp");
+# the flat paths include/kdl_space/<name>.hpp are forwarding headers for downstream code (one
+# release), which the library itself never includes. A folder with no layer fails the check: give
+# it one here and in docs/ARCHITECTURE.md. Also refuses a library file of more than 450 lines.
+# Run: cmake -DSOURCE_DIR=<repo> -P tools/check_layers.cmake (ctest: layers).
 cmake_minimum_required(VERSION 3.16)
 
-function(layer_of name out)
-  get_filename_component(stem "${name}" NAME_WE)
-  set(table
-    "export,spatial,errors,text,symmetric6d,lanes,lane_symmetric6d,multiversion,rosenbrock,sines,response=0"
-    "diagnostics,model,model_build,model_rules,joint_motion=1"
-    "state,kinematics,momentum=2"
-    "free_floating_solver,recursive_ex_iit=3"
-    "impact,impact_friction,collision=4"
-    "capture,joined_system=5"
-    "forward_dynamics,dense_forward_dynamics,simulation,simulation_events,simulation_stiff,simulation_layout,actuation,approach,rigid_motion=6"
-    "urdf_loader,urdf_check,urdf_xml,urdf_graph,urdf_numbers,urdf_summary,scenario,scenario_fields,scenario_sections,scenario_approach,scenario_simulator,input_file=7"
-    "study,study_loader,study_run,study_sampling,study_self_motion,study_summary=8")
-  foreach(row IN LISTS table)
-    string(REGEX REPLACE ".*=" "" rank "${row}")
-    string(REGEX REPLACE "=.*" "" names "${row}")
-    string(REPLACE "," "|" alternatives "${names}")
-    if(stem MATCHES "^(${alternatives})$")
-      set(${out} ${rank} PARENT_SCOPE)
-      return()
-    endif()
-  endforeach()
-  set(${out} "" PARENT_SCOPE)
+set(kdl_space_layers spatial detail multibody algorithm impact simulation parsers operation study)
+set(kdl_space_ranks 0 0 1 2 3 4 5 6 7)
+
+# The rank of a folder name (the first component of a path below include/kdl_space/ or src/).
+function(rank_of folder out)
+  list(FIND kdl_space_layers "${folder}" i)
+  if(i LESS 0)
+    set(${out} "" PARENT_SCOPE)
+  else()
+    list(GET kdl_space_ranks ${i} rank)
+    set(${out} ${rank} PARENT_SCOPE)
+  endif()
 endfunction()
 
-file(GLOB_RECURSE files "${SOURCE_DIR}/include/kdl_space/*.hpp" "${SOURCE_DIR}/src/*.hpp" "${SOURCE_DIR}/src/*.cpp")
 set(problems "")
-foreach(file IN LISTS files)
-  file(RELATIVE_PATH rel "${SOURCE_DIR}" "${file}")
-  layer_of("${file}" mine)
-  if(mine STREQUAL "")
-    string(APPEND problems "${rel}: has no layer (add it to tools/check_layers.cmake and docs/ARCHITECTURE.md)\n")
+file(GLOB forwarders RELATIVE "${SOURCE_DIR}/include/kdl_space" "${SOURCE_DIR}/include/kdl_space/*.hpp")
+file(GLOB_RECURSE files RELATIVE "${SOURCE_DIR}" "${SOURCE_DIR}/include/kdl_space/*/*.hpp" "${SOURCE_DIR}/src/*.hpp"
+     "${SOURCE_DIR}/src/*.cpp")
+foreach(rel IN LISTS files)
+  string(REGEX REPLACE "^(include/kdl_space|src)/" "" inside "${rel}")
+  string(REGEX REPLACE "/.*" "" folder "${inside}")
+  if(inside STREQUAL folder)
+    string(APPEND problems "${rel}: a library file outside the layers' folders: move it into one\n")
     continue()
   endif()
-  file(STRINGS "${file}" lines)
+  rank_of("${folder}" mine)
+  if(mine STREQUAL "")
+    string(APPEND problems "${rel}: folder '${folder}' has no layer (add it to tools/check_layers.cmake and docs/ARCHITECTURE.md)\n")
+    continue()
+  endif()
+  file(STRINGS "${SOURCE_DIR}/${rel}" lines)
   list(LENGTH lines length)
   if(length GREATER 450)
-    string(APPEND problems "${rel}: ${length} lines: split it (a file holds one job, ~400 lines at most)\n")
+    string(APPEND problems "${rel}: ${length} lines: split it by concept (a file holds one job, ~400 lines at most)\n")
   endif()
-  file(STRINGS "${file}" includes REGEX "^#include \"")
+  file(STRINGS "${SOURCE_DIR}/${rel}" includes REGEX "^#include \"")
   foreach(line IN LISTS includes)
     string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" included "${line}")
-    layer_of("${included}" theirs)
+    string(REGEX REPLACE "^kdl_space/" "" path "${included}")
+    if(path STREQUAL "export.hpp")
+      continue()  # generated: the export macros, layer 0
+    endif()
+    string(REGEX REPLACE "/.*" "" theirs_folder "${path}")
+    if(path STREQUAL theirs_folder)
+      if(path IN_LIST forwarders)
+        string(APPEND problems "${rel} includes ${included}, a forwarding header: name its folder (kdl_space/<layer>/...)\n")
+      else()
+        string(APPEND problems "${rel} includes ${included}, which is in no layer's folder\n")
+      endif()
+      continue()
+    endif()
+    rank_of("${theirs_folder}" theirs)
     if(theirs STREQUAL "")
-      string(APPEND problems "${rel}: includes ${included}, which has no layer\n")
+      string(APPEND problems "${rel} includes ${included}, whose folder '${theirs_folder}' has no layer\n")
     elseif(theirs GREATER mine)
-      string(APPEND problems "${rel} (layer ${mine}) includes ${included} (layer ${theirs}): an upward edge\n")
+      string(APPEND problems "${rel} (${folder}, layer ${mine}) includes ${included} (${theirs_folder}, layer ${theirs}): an upward edge\n")
     endif()
   endforeach()
 endforeach()
+# Every forwarding header names one header of a layer's folder that exists.
+foreach(name IN LISTS forwarders)
+  if(name STREQUAL "export.hpp")
+    continue()
+  endif()
+  file(STRINGS "${SOURCE_DIR}/include/kdl_space/${name}" target REGEX "^#include \"kdl_space/")
+  string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" target "${target}")
+  if(NOT target OR NOT EXISTS "${SOURCE_DIR}/include/${target}")
+    string(APPEND problems "include/kdl_space/${name}: a forwarding header must include the header it stands for\n")
+  endif()
+endforeach()
 if(problems)
-  message(FATAL_ERROR "The include graph goes up a layer:\n${problems}")
+  message(FATAL_ERROR "The include graph goes up a layer, or a file has no layer:\n${problems}")
 endif()
 list(LENGTH files count)
-message(STATUS "include graph: ${count} files, every include points down or sideways")
+message(STATUS "include graph: ${count} files in the layers' folders, every include points down or sideways")

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/model.hpp"
-#include "kdl_space/diagnostics.hpp"
-#include "kdl_space/errors.hpp"
-#include "kdl_space/input_file.hpp"  // checkInputFile, parseFiniteNumber
+#include "kdl_space/multibody/model.hpp"
+#include "kdl_space/multibody/diagnostics.hpp"
+#include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/parsers/input_file.hpp"  // checkInputFile, parseFiniteNumber
 
 namespace CLI {
 class Validator;

@@ -7,9 +7,9 @@
 
 #include "cli_common.hpp"
 #include "detail/text.hpp"
-#include "kdl_space/free_floating_solver.hpp"
-#include "kdl_space/urdf_check.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
 namespace kdl_space::cli {
 namespace {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "kdl_space/simulation.hpp"
+#include "kdl_space/simulation/simulation.hpp"
 #include "sample.hpp"
 
 namespace kdl_space::cli {

@@ -10,7 +10,7 @@
 #include <limits>
 #include <sstream>
 
-#include "kdl_space/kinematics.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
 
 #include "gnuplot_text.hpp"
 

@@ -17,10 +17,10 @@
 #include <kdl/frames.hpp>
 
 #include "cli_common.hpp"
-#include "kdl_space/collision.hpp"
-#include "kdl_space/model.hpp"
-#include "kdl_space/spatial.hpp"
-#include "kdl_space/state.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/multibody/model.hpp"
+#include "kdl_space/spatial/spatial.hpp"
+#include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space::cli {
 

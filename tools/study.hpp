@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "kdl_space/study.hpp"
+#include "kdl_space/study/study.hpp"
 
 namespace kdl_space::cli {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/study.hpp"
+#include "kdl_space/study/study.hpp"
 
 namespace kdl_space::cli {
 

@@ -1,7 +1,7 @@
 // Loads a URDF robot on a free-floating base and prints G* at a contact link.
 #include <iostream>
-#include <kdl_space/free_floating_solver.hpp>
-#include <kdl_space/urdf_loader.hpp>
+#include <kdl_space/algorithm/free_floating_solver.hpp>
+#include <kdl_space/parsers/urdf/urdf_loader.hpp>
 
 int main(int argc, char** argv) {
   if (argc != 3) { std::cerr << "usage: print_g_star ROBOT.urdf CONTACT_LINK\n"; return 2; }

@@ -5,8 +5,8 @@
 #include "conversions.hpp"
 #include "capture_types.hpp"
 #include "impact_law.hpp"
-#include "kdl_space/capture.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::python {
 namespace {

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "conversions.hpp"
-#include "kdl_space/capture.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::python {
 

@@ -15,10 +15,10 @@
 #include <utility>
 #include <vector>
 
-#include "kdl_space/errors.hpp"
-#include "kdl_space/model.hpp"
-#include "kdl_space/spatial.hpp"
-#include "kdl_space/state.hpp"
+#include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/multibody/model.hpp"
+#include "kdl_space/spatial/spatial.hpp"
+#include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space::python {
 namespace py = pybind11;

@@ -3,7 +3,7 @@
 #include <sstream>
 
 #include "conversions.hpp"
-#include "kdl_space/errors.hpp"
+#include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space::python {
 

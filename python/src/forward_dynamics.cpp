@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "conversions.hpp"
-#include "kdl_space/dense_forward_dynamics.hpp"
-#include "kdl_space/forward_dynamics.hpp"
+#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
 #include "simulation_types.hpp"
 
 namespace kdl_space::python {

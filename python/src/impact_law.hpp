@@ -2,7 +2,7 @@
 #pragma once
 
 #include "conversions.hpp"
-#include "kdl_space/impact.hpp"
+#include "kdl_space/impact/impact.hpp"
 
 namespace kdl_space::python {
 

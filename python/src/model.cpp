@@ -3,8 +3,8 @@
 #include <sstream>
 
 #include "conversions.hpp"
-#include "kdl_space/urdf_check.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
 namespace kdl_space::python {
 

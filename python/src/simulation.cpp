@@ -16,7 +16,7 @@
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
-#include "kdl_space/simulation.hpp"
+#include "kdl_space/simulation/simulation.hpp"
 #include "simulation_types.hpp"
 
 namespace kdl_space::python {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "conversions.hpp"
-#include "kdl_space/simulation.hpp"
+#include "kdl_space/simulation/simulation.hpp"
 
 namespace kdl_space::python {
 

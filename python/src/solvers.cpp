@@ -3,8 +3,8 @@
 #include <kdl/jacobian.hpp>
 
 #include "conversions.hpp"
-#include "kdl_space/free_floating_solver.hpp"
-#include "kdl_space/recursive_ex_iit.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
 
 namespace kdl_space::python {
 namespace {

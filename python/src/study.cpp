@@ -12,7 +12,7 @@
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
-#include "kdl_space/study.hpp"
+#include "kdl_space/study/study.hpp"
 
 namespace kdl_space::python {
 namespace {

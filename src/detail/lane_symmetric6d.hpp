@@ -3,8 +3,8 @@
 // steps is a few lane-wide fused multiply-adds. A speed internal of the library, not API.
 #pragma once
 
-#include "lanes.hpp"
-#include "symmetric6d.hpp"
+#include "detail/lanes.hpp"
+#include "detail/symmetric6d.hpp"
 
 namespace kdl_space::detail {
 

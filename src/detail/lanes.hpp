@@ -7,7 +7,7 @@
 
 #include <cstring>
 
-#include "kdl_space/spatial.hpp"
+#include "kdl_space/spatial/spatial.hpp"
 
 // These inline helpers pass vectors by value inside one translation unit, never across the
 // library's ABI: GCC's note that an AVX vector argument changes the ABI does not apply.

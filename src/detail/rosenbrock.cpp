@@ -1,13 +1,13 @@
 // RODAS3 (Sandu et al. 1997): one step with its embedded error estimate. See rosenbrock.hpp for
 // the method's equations and the finite-difference Jacobian.
-#include "rosenbrock.hpp"
+#include "detail/rosenbrock.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "kdl_space/errors.hpp"
+#include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space::detail {
 namespace {

@@ -23,7 +23,7 @@
 // factorisation of W (Eigen::PartialPivLU). RODAS3 is not a W-method: the order holds for the
 // Jacobian at (t, x), which the O(sqrt(eps)) differences approximate far below any tolerance used.
 //
-// A private detail of the library: compute calls return codes (kdl_space/errors.hpp), never
+// A private detail of the library: compute calls return codes (kdl_space/spatial/errors.hpp), never
 // throw, never print, and allocate nothing after the constructor.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "sines.hpp"
+#include "detail/sines.hpp"
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // The packed symmetric 6x6 of the O(n) recursions: a speed internal of the library, not API.
 #pragma once
 
-#include "kdl_space/spatial.hpp"
+#include "kdl_space/spatial/spatial.hpp"
 
 namespace kdl_space::detail {
 

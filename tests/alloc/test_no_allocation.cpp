@@ -14,12 +14,12 @@
 #include <cstdlib>
 #include <new>
 
-#include "kdl_space/collision.hpp"
-#include "kdl_space/momentum.hpp"
-#include "kdl_space/forward_dynamics.hpp"
-#include "kdl_space/recursive_ex_iit.hpp"
-#include "kdl_space/simulation.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "detail/rosenbrock.hpp"
 #include "generated_chain.hpp"
 #include "test_util.hpp"

@@ -12,7 +12,7 @@
 
 #include "../../tools/scene_writer.hpp"
 #include "cli_runner.hpp"
-#include "kdl_space/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::test {
 namespace {

@@ -7,9 +7,9 @@
 #include <memory>
 #include <set>
 
-#include "kdl_space/collision.hpp"
-#include "kdl_space/simulation.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/forward_dynamics.hpp"
-#include "kdl_space/free_floating_solver.hpp"
-#include "kdl_space/kinematics.hpp"
-#include "kdl_space/momentum.hpp"
-#include "kdl_space/recursive_ex_iit.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

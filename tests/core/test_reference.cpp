@@ -2,7 +2,7 @@
 // independent rigid-body engine, no KDL), to 1e-9 relative (1e-12 absolute where zero).
 #include <gtest/gtest.h>
 
-#include "kdl_space/free_floating_solver.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "reference_case.hpp"
 
 namespace kdl_space::test {

@@ -19,8 +19,8 @@
 
 #include "impact_robots.hpp"
 #include "impact_util.hpp"
-#include "kdl_space/capture.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

@@ -27,10 +27,10 @@
 #include <random>
 #include <sstream>
 
-#include "kdl_space/collision.hpp"
+#include "kdl_space/impact/collision.hpp"
 #include "impact_robots.hpp"
 #include "impact_util.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

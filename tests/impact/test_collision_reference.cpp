@@ -2,7 +2,7 @@
 // floating-base mass matrix as an impulsive constraint problem, not from G*), to 1e-9 relative.
 #include <gtest/gtest.h>
 
-#include "kdl_space/collision.hpp"
+#include "kdl_space/impact/collision.hpp"
 #include "impact_util.hpp"
 #include "reference_case.hpp"
 

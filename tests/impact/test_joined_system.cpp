@@ -20,12 +20,12 @@
 #include <string>
 
 #include "impact_robots.hpp"
-#include "kdl_space/capture.hpp"
-#include "kdl_space/forward_dynamics.hpp"
-#include "kdl_space/joined_system.hpp"
-#include "kdl_space/scenario.hpp"
-#include "kdl_space/simulation.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/impact/joined_system.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

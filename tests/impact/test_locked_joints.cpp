@@ -18,8 +18,8 @@
 #include <random>
 
 #include "impact_robots.hpp"
-#include "kdl_space/capture.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 #include "virtual_joint_route.hpp"
 

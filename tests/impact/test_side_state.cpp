@@ -7,9 +7,9 @@
 #include <memory>
 #include <random>
 
-#include "kdl_space/collision.hpp"
-#include "kdl_space/momentum.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "kdl_space/study.hpp"
+#include "kdl_space/study/study.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space {

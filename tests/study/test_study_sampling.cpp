@@ -6,9 +6,9 @@
 #include <cmath>
 #include <set>
 
-#include "kdl_space/scenario.hpp"
-#include "study_sampling.hpp"
-#include "study_self_motion.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "study/study_sampling.hpp"
+#include "study/study_self_motion.hpp"
 
 namespace kdl_space {
 namespace {

@@ -1,6 +1,6 @@
 // The composite-rigid-body route of free-floating forward dynamics, the tests' (and the
 // benchmark's) second route beside the library's articulated-body algorithm: the library's
-// DenseForwardDynamics (include/kdl_space/dense_forward_dynamics.hpp; the route the simulation
+// DenseForwardDynamics (include/kdl_space/algorithm/dense_forward_dynamics.hpp; the route the simulation
 // takes for coupled joints), which shares only FreeFloatingSolver (and through it
 // forwardKinematics) with the articulated-body route.
 //
@@ -12,10 +12,10 @@
 #include <memory>
 #include <vector>
 
-#include "kdl_space/dense_forward_dynamics.hpp"
-#include "kdl_space/forward_dynamics.hpp"
-#include "kdl_space/free_floating_solver.hpp"
-#include "kdl_space/simulation.hpp"
+#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/simulation/simulation.hpp"
 
 namespace kdl_space::test {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

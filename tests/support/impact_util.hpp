@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "kdl_space/collision.hpp"
+#include "kdl_space/impact/collision.hpp"
 
 namespace kdl_space::test {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "kdl_space/spatial.hpp"
+#include "kdl_space/spatial/spatial.hpp"
 
 namespace kdl_space::test {
 

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "kdl_space/spatial.hpp"
-#include "kdl_space/urdf_loader.hpp"
+#include "kdl_space/spatial/spatial.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {

@@ -7,7 +7,7 @@
 #include <random>
 #include <string>
 
-#include "kdl_space/state.hpp"
+#include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space::test {
 

@@ -28,9 +28,9 @@
 #include <utility>
 #include <vector>
 
-#include "kdl_space/collision.hpp"
-#include "kdl_space/model.hpp"
-#include "kdl_space/state.hpp"
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/multibody/model.hpp"
+#include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space::test {
 

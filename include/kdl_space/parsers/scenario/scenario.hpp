@@ -1,0 +1,74 @@
+// Capture scenarios (YAML or JSON files): what the robot is, where and how fast it moves, what it
+// hits and with which impact law (a CaptureProblem), and what to simulate after the impact. What
+// `kdl_space capture` and `simulate` read; a library user can build the same types in code.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kdl_space/simulation/approach.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/export.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+
+namespace kdl_space {
+
+/// The `simulation` section: the motion (after the impact, or from the robot's initial state).
+struct SimulationSpec {
+  double duration = 20.0;     ///< [s] (the tool's --duration overrides it)
+  double output_step = 0.05;  ///< output row spacing [s]
+  SimulationOptions options;  ///< options.grounded: see `base`
+  /// `base: free | grounded`; unset: the robot's mode holds (grounded if it was grounded).
+  std::optional<bool> grounded;
+  /// By joint index of the robot, resolved from names and patterns ("*", "wrist_*"): exact names
+  /// win over patterns, later patterns over earlier ones, "*" is the default. Joints not listed
+  /// keep the mode of the robot (locked for `mode: locked` and `robot.locked`, else free).
+  std::vector<std::pair<unsigned int, JointControl>> joints;
+  std::vector<std::pair<unsigned int, LimitMode>> limits;  ///< resolved as `joints`; default warn
+  /// `target_joints`: a captured free-floating target's joints after the capture, by the target's
+  /// joint index (its model order), resolved as `joints` (default: its own mode, free or braked).
+  std::vector<std::pair<unsigned int, JointControl>> target_joints;
+  BaseControl base_control;
+  std::vector<ScheduledWrench> wrenches;
+};
+
+/// A scenario file, read and checked.
+struct Scenario {
+  std::string file;         ///< the path it was read from
+  std::string robot_urdf;   ///< the robot's URDF (resolved path)
+  /// The target's URDF (resolved path): a free-floating target, or a rigid one read from a file
+  /// (one without movable joints, or the links from `target.link` down); empty for a rigid target
+  /// given by numbers.
+  std::string target_urdf;
+  /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot (whose
+  /// `contact` may then be omitted: the base's origin).
+  bool impact = true;
+  CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
+  /// The `approach` section: the robot starts from its initial state, reaches the grasp point on
+  /// the moving (rigid) target, and the law applies at the contact instant, from the states then.
+  std::optional<ApproachSpec> approach;
+  SimulationSpec simulation;
+};
+
+/// \brief Reads and checks a scenario file; URDF paths are relative to the scenario's folder.
+/// Every number is finite, every name exists in its model, a rigid target's mass and inertia
+/// are those of a rigid body; a free-floating target's contact is checked by solveCapture.
+/// The joints a system's `locked:` list brakes at the impact are in its FloatingSystem::locked
+/// (`capture.robot.locked`: what a simulation keeps braked after the impact too).
+/// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
+/// be > 0 kg, got -3") for every problem, the file's own (missing, empty, not YAML) included.
+KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
+
+/// \brief The simulator as the scenario says, for `model` (the robot's, or the robot with a
+/// captured payload, or a joined system: the robot's joints are found by name). The robot's mode
+/// holds through the motion (a grounded base stays grounded, braked joints stay braked) unless the
+/// simulation section changes it. For an approach (`approach`) the joints are left free for its
+/// velocity servo (the section's joint controls act after the capture).
+/// \throws ModelError as the Simulator's set-up calls.
+KDL_SPACE_EXPORT std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                                          bool approach);
+
+}  // namespace kdl_space

@@ -1,0 +1,93 @@
+// What acts on a free-floating system during a motion besides its own dynamics: the joints'
+// controls (free, braked, PD servo), their effort limits and friction, the base's own attitude and
+// position control (reaction wheels, thrusters), and external wrenches on a time schedule. Each
+// is evaluated at a state by a plain function, so that a test can check it on its own.
+#pragma once
+
+#include <kdl/frames.hpp>
+#include <cmath>
+#include <limits>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/spatial/spatial.hpp"
+
+namespace kdl_space {
+
+/// What drives a joint.
+struct JointControl {
+  enum class Mode {
+    Free,    ///< zero torque
+    Locked,  ///< brakes on: the joint moves with its neighbour (rate held at zero)
+    PD,      ///< servo to a set point: tau = kp (set_point - q) - kd qdot
+  };
+  Mode mode = Mode::Free;
+  double kp = 0.0, kd = 0.0, set_point = 0.0;
+  /// PD only: the set point is the joint's position at the start of the motion (Simulator::run
+  /// fills set_point from the state it starts from).
+  bool hold = false;
+};
+
+/// What a joint's position limits do in a motion.
+enum class LimitMode {
+  Ignore,  ///< nothing
+  Warn,    ///< the motion goes on; the excursions are recorded (SimulationStats::joints)
+  Stop,    ///< hard stops: an inelastic impact at the limit, then held there while pushed into it
+};
+
+/// \brief The joint friction torque: viscous damping and a regularised Coulomb friction,
+/// tau_f = -damping qdot - friction tanh(qdot / v_s) (URDF <dynamics damping friction>).
+/// The regularisation keeps the motion smooth: the Coulomb torque is a damping of slope
+/// friction / v_s near rest, so a joint under a torque below `friction` creeps at about
+/// v_s atanh(tau / friction) instead of sticking exactly. Its power tau_f qdot is never positive.
+inline double frictionTorque(double qdot, double damping, double friction, double v_s) {
+  return -damping * qdot - friction * std::tanh(qdot / v_s);
+}
+
+/// \brief The satellite's own control of its base (reaction wheels, thrusters), applied as an
+/// external wrench on the base body; the momentum then changes by its impulse.
+struct BaseControl {
+  /// Attitude PD toward a set point: n = kp e - kd w, e the rotation vector of
+  /// set_point * R_base^-1 (world axes); each component in the base's axes limited to
+  /// +-torque_limit (a wheel per base axis).
+  struct Attitude {
+    bool on = false;
+    bool hold = false;  ///< the set point is the base's orientation at the start of the motion
+    KDL::Rotation set_point = KDL::Rotation::Identity();  ///< world_R_base wanted
+    double kp = 0.0, kd = 0.0;                            ///< [N m/rad], [N m s/rad]
+    Vector3d torque_limit = Vector3d::Constant(std::numeric_limits<double>::infinity());  ///< [N m]
+  };
+  /// Position PD of the base frame's origin: f = kp (set_point - p_b) - kd v_b, each component in
+  /// the base's axes limited to +-force_limit (thrusters fixed to the base), acting through the
+  /// base body's centre of mass (no moment).
+  struct Position {
+    bool on = false;
+    bool hold = false;  ///< the set point is the base's position at the start of the motion
+    Vector3d set_point = Vector3d::Zero();  ///< world [m]
+    double kp = 0.0, kd = 0.0;              ///< [N/m], [N s/m]
+    Vector3d force_limit = Vector3d::Constant(std::numeric_limits<double>::infinity());  ///< [N]
+  };
+  Attitude attitude;
+  Position position;
+  bool on() const { return attitude.on || position.on; }
+};
+
+/// \brief The base control's wrench (f; n), world axes, the moment about the base body's centre
+/// of mass (f acts through it). `world_T_base` and `base_twist` (v of the base origin; w) are the
+/// base's; `saturated` tells whether a limit was reached on any axis.
+KDL_SPACE_EXPORT Vector6d baseControlWrench(const BaseControl& control, const KDL::Frame& world_T_base,
+                                            const KDL::Twist& base_twist, bool* saturated = nullptr);
+
+/// \brief An external wrench on a body over a time window (a thruster firing, a push): the force
+/// f acts at `point` (in the body's frame) and the couple n is added; both in world axes, or in
+/// the body's axes (turning with it) when `body_axes`.
+struct ScheduledWrench {
+  unsigned int body = 0;                 ///< index in FloatingModel::bodies()
+  Vector3d point = Vector3d::Zero();     ///< body frame [m]
+  Vector6d wrench = Vector6d::Zero();    ///< (f; n) [N; N m]
+  bool body_axes = false;
+  double start = 0.0;                                          ///< [s]
+  double end = std::numeric_limits<double>::infinity();        ///< active on [start, end)
+  bool activeAt(double t) const { return t >= start && t < end; }
+};
+
+}  // namespace kdl_space

@@ -1,0 +1,61 @@
+// Error codes of the compute calls (KDL::SolverI style; our own codes are <= -101) and the
+// exception thrown by constructors, loaders and set-up calls.
+//
+// The rule, for every class and free function of the library:
+//  - Compute calls (everything called per state, per contact, per impulse or per step:
+//    FreeFloatingSolver's queries, RecursiveExIITSolver, ForwardDynamicsSolver::CartToJnt,
+//    Simulator::run / engageBrakes / energyAndMomentum, solveImpact, ImpactSide::applyImpulse,
+//    collide) never throw. They check the sizes of their inputs and outputs, the finiteness of
+//    their inputs and the range of their parameters, and return 0 (E_NOERROR) or one of the
+//    codes below. On an error their outputs are left untouched (Simulator::run documents its
+//    state argument). A result that overflows (finite inputs of absurd magnitude) is reported as
+//    E_NOT_FINITE, never returned.
+//  - Constructors, loaders and set-up calls (FloatingModel, loadUrdfFile/String, jointsByName,
+//    FloatingSide, RigidBodySide, Simulator and Simulator::setJointControl) throw ModelError with a
+//    message that names the file, the link or joint, and what is wrong: they run once, before
+//    any loop, and an object they cannot build must not exist.
+// Callbacks that the caller hands to a compute call (Simulator's torque callback and observer)
+// are the caller's code: an exception they throw propagates unchanged.
+#pragma once
+
+#include <kdl/solveri.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "kdl_space/export.hpp"
+
+namespace kdl_space {
+
+/// Return codes of compute calls. 0 and KDL's codes (e.g. KDL::SolverI::E_SIZE_MISMATCH = -4)
+/// keep their KDL meaning; ours start at -101.
+enum Error : int {
+  E_NOERROR = KDL::SolverI::E_NOERROR,
+  E_SIZE_MISMATCH = KDL::SolverI::E_SIZE_MISMATCH,
+  E_NOT_COMPUTED = -101,          ///< compute(state) has not succeeded yet
+  E_NOT_FINITE = -102,            ///< an input holds NaN or an infinity, or a result overflowed
+  E_NOT_POSITIVE_DEFINITE = -103, ///< H* (or, for the grounded G, H; G_A + G_B for an impact) failed its factorisation
+  E_BAD_CONTACT = -104,           ///< a contact refers to no body of this model
+  E_MAX_STEPS = -105,             ///< a simulation spent its step budget (SimulationOptions::max_steps)
+  E_BAD_ARGUMENT = -106,          ///< a parameter is out of its range (impact law, time span, enum value)
+  E_STEP_UNDERFLOW = -107,        ///< the adaptive step size fell to round-off of the time
+};
+
+/// Human-readable text of a return code.
+KDL_SPACE_EXPORT const char* strError(int code);
+
+/// Thrown by constructors, loaders and set-up calls when a model or an input cannot be used. The
+/// message names the file, the link or joint, and what is wrong.
+class KDL_SPACE_EXPORT ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Thrown by the scenario loader and the capture set-up when an input (a file, a field, a
+/// value) cannot be used: the message names the file, the field (e.g. "target.mass") and what
+/// is wrong.
+class KDL_SPACE_EXPORT InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace kdl_space

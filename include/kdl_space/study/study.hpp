@@ -1,0 +1,161 @@
+// Capture studies: a scenario plus distributions over its inputs (the target's tumble, the grasp,
+// the arm's configuration, the timing, the target's mass), sampled deterministically (sample i
+// depends only on the seed and i), each sample a capture and optionally a short motion after it;
+// one row of outcomes per sample, and their summary. What `kdl_space study` and kdl_space.study()
+// run; the engines (threads, shards, Dask) only decide where the rows are computed.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+
+namespace kdl_space {
+
+/// How one input is drawn.
+struct Distribution {
+  enum class Kind {
+    Uniform,  ///< uniform on [a, b]
+    Normal,   ///< normal, mean a, standard deviation b
+    Grid,     ///< `count` evenly spaced values from a to b (a factor of the study's full grid)
+  };
+  Kind kind = Kind::Uniform;
+  double a = 0.0, b = 0.0;
+  long count = 0;  ///< Grid only
+};
+
+/// What one input of a study sets in the scenario (see docs/studies.md for the field names).
+struct StudyInput {
+  enum class Field {
+    TargetTwist,   ///< target.twist.{vx,vy,vz,wx,wy,wz}: a component of its twist at the CoM, world
+    TargetTumble,  ///< target.tumble: its angular velocity, this rate [rad/s] about a random axis
+    TargetMass,    ///< target.mass [kg] (its inertia scaled with it: the same shape, denser)
+    TargetGrasp,   ///< target.grasp.{x,y,z}: the grasp point moved on the target, target frame [m]
+    Timing,        ///< timing: the capture this much later [s] along the target's torque-free tumble
+    JointPosition, ///< robot.q.JOINT [rad or m]
+    JointRate,     ///< robot.qdot.JOINT [rad/s or m/s]
+    SelfMotion,    ///< robot.self_motion: this far [rad] along the redundant arm's self-motion
+    ContactOffset, ///< robot.contact.offset.{x,y,z}: the hand's contact point, contact link frame [m]
+  };
+  std::string name;  ///< as in the study file ("robot.q.joint3")
+  Field field = Field::TargetTwist;
+  int index = 0;     ///< the component (0..5, 0..2) or the joint (model order)
+  Distribution distribution;
+};
+
+/// Limits whose exceedance a study counts (unset: not checked).
+struct StudyLimits {
+  /// Per joint (model order) [rad/s]: after the impact and, with a motion, through it.
+  std::optional<std::vector<double>> joint_rate;
+  std::optional<std::vector<double>> joint_torque;  ///< per joint [N m], through the motion
+  std::optional<double> base_rate;                  ///< |w| of the base after the impact [rad/s]
+};
+
+/// A heat map of one outcome over two inputs.
+struct StudyHeatMap {
+  std::string x, y, outcome;  ///< column names
+};
+
+/// A study file, read and checked.
+struct Study {
+  std::string file;
+  std::uint64_t fingerprint = 0;  ///< of the study's, scenario's and URDFs' bytes: parts must agree
+  Scenario scenario;
+  std::vector<StudyInput> inputs;  ///< in file order
+  std::uint64_t samples = 0;
+  std::uint64_t seed = 0;
+  bool latin_hypercube = false;    ///< `sampling: latin_hypercube` (else independent draws)
+  double motion_duration = 0.0;    ///< [s]; 0: no motion after the capture
+  double motion_output_step = 0.0; ///< [s] where the motion's peaks are read
+  StudyLimits limits;
+  std::string objective = "base_rate";  ///< the outcome the best (smallest) and worst samples rank by
+  std::optional<StudyHeatMap> heat_map;
+  /// The most samples a study may ask for.
+  static constexpr std::uint64_t max_samples = 1000000000ULL;
+};
+
+/// \brief Reads and checks a study file (YAML or JSON): its scenario (loadScenario, relative to
+/// the study's folder), each input's field and distribution, the sample count, seed, limits.
+/// \throws InputError "FILE[:LINE]: FIELD: what is wrong", as loadScenario.
+KDL_SPACE_EXPORT Study loadStudy(const std::string& path);
+
+/// \brief The table's columns: sample, status, the inputs drawn (target.tumble adds its axis),
+/// then the outcomes (impulse, base twist after, base_rate, joint rate jumps, energy lost, the
+/// motion's peaks, the limits exceeded as 0/1).
+KDL_SPACE_EXPORT std::vector<std::string> studyColumns(const Study& study);
+
+/// \brief Computes rows of a study: one per sample, the values of studyColumns(). Owns its
+/// workspaces (the capture's side, the self-motion's solver), so one per thread.
+class KDL_SPACE_EXPORT StudyEvaluator {
+ public:
+  explicit StudyEvaluator(std::shared_ptr<const Study> study);
+  ~StudyEvaluator();
+  StudyEvaluator(const StudyEvaluator&) = delete;
+  StudyEvaluator& operator=(const StudyEvaluator&) = delete;
+  /// \brief Sample i's row into `row` (studyColumns().size() values). Never throws: a sample
+  /// that cannot be computed has its status (an Error code, or E_BAD_ARGUMENT for a set-up the
+  /// library refused) and NaN outcomes; its inputs are always filled.
+  void evaluate(std::uint64_t i, double* row);
+  std::size_t columns() const { return columns_; }
+
+ private:
+  struct Work;
+  std::shared_ptr<const Study> study_;
+  std::size_t columns_;
+  std::unique_ptr<Work> work_;
+};
+
+/// A run of rows [begin, end) in chunks.
+struct StudyChunk {
+  std::uint64_t begin = 0, end = 0;
+};
+
+/// \brief The chunks of [begin, end) on the study's fixed grid of chunks (of chunk_size samples
+/// from 0; the first and last cut to the range): the same whatever the engine or the threads,
+/// so a run can resume from chunks written by another.
+KDL_SPACE_EXPORT std::vector<StudyChunk> studyChunks(std::uint64_t begin, std::uint64_t end, std::uint64_t chunk_size);
+
+/// The chunk size a study of `samples` uses by default (256 chunks or more, 16 to 65536 rows).
+KDL_SPACE_EXPORT std::uint64_t defaultChunkSize(std::uint64_t samples);
+
+/// \brief Computes `chunks` on `threads` threads (0: all cores), each with its own evaluator;
+/// `done(chunk, rows)` (rows: chunk size x columns, row-major) is called for each chunk as it
+/// completes, one call at a time, in any order. `cancel` (may be null) set to true stops the run
+/// after the chunks under way. An exception thrown by `done` stops the run and propagates.
+KDL_SPACE_EXPORT void runStudy(const std::shared_ptr<const Study>& study, const std::vector<StudyChunk>& chunks,
+                               unsigned threads,
+                               const std::function<void(const StudyChunk&, const std::vector<double>& rows)>& done,
+                               const std::atomic<bool>* cancel = nullptr);
+
+/// Quantiles of one outcome over the samples that computed (status 0).
+struct OutcomeSummary {
+  std::string name;
+  double min = 0, q05 = 0, q25 = 0, median = 0, q75 = 0, q95 = 0, max = 0, mean = 0;
+};
+/// One sample's inputs and the objective, for the best and worst lists.
+struct SampleDigest {
+  std::uint64_t sample = 0;
+  double objective = 0.0;
+  std::vector<std::pair<std::string, double>> inputs;
+};
+/// What a whole table says.
+struct StudySummary {
+  std::uint64_t samples = 0, failed = 0;
+  std::vector<OutcomeSummary> outcomes;
+  /// Per limit column ("exceeds.base_rate", ..., "exceeds.any"): the fraction of computed
+  /// samples that exceed it.
+  std::vector<std::pair<std::string, double>> probabilities;
+  std::vector<SampleDigest> best, worst;  ///< by the objective: up to 5 each
+};
+
+/// \brief The summary of a table (rows x studyColumns(study), row-major, any order of samples).
+/// Quantiles interpolate linearly between order statistics.
+KDL_SPACE_EXPORT StudySummary summarizeStudy(const Study& study, const std::vector<double>& rows);
+
+}  // namespace kdl_space

@@ -1,0 +1,287 @@
+#include "kdl_space/parsers/scenario/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "detail/text.hpp"
+#include "kdl_space/parsers/input_file.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "multibody/model_rules.hpp"
+#include "parsers/scenario/scenario_approach.hpp"
+#include "parsers/scenario/scenario_fields.hpp"
+#include "parsers/scenario/scenario_sections.hpp"
+
+namespace kdl_space {
+namespace {
+
+using detail::listNames;
+using detail::number;
+using fields::echo;
+using fields::Field;
+
+std::vector<std::string> linkNames(const FloatingModel& model) {
+  std::vector<std::string> names;
+  for (const Body& b : model.bodies()) names.push_back(b.name);
+  return names;
+}
+
+/// A pose from optional `position` and `rpy` fields of f (URDF convention).
+KDL::Frame pose(const Field& f) {
+  const Eigen::VectorXd p = f.has("position") ? f.at("position").vector(3) : Eigen::VectorXd::Zero(3);
+  const Eigen::VectorXd r = f.has("rpy") ? f.at("rpy").vector(3) : Eigen::VectorXd::Zero(3);
+  return basePose(KDL::Vector(p(0), p(1), p(2)), r(0), r(1), r(2));
+}
+
+/// Joint values by name; an unknown name is reported at its field.
+KDL::JntArray joints(const Field& f, const FloatingModel& model) {
+  const std::map<std::string, double> values = f.namedNumbers();
+  for (const auto& [name, value] : values)
+    if (model.jointIndex(name) < 0)
+      f.at(name).fail("the model has no movable joint " + echo(name) + " (its movable joints: " +
+                      listNames(model.jointNames()) + ")");
+  return jointsByName(model, values);
+}
+
+/// The joints braked at the impact (`locked: [joint, ...]`), as flags in model order: each a
+/// movable joint of the model, named once, whose rate `qdot` is 0 (a braked joint does not move).
+std::vector<bool> lockedJoints(const Field& f, const FloatingModel& model, const KDL::JntArray& qdot,
+                               const std::string& qdot_path) {
+  std::vector<bool> locked(model.nj(), false);
+  for (const Field& item : f.items("joint names")) {
+    const std::string name = item.text();
+    const int j = model.jointIndex(name);
+    if (j < 0)
+      item.fail("the model has no movable joint " + echo(name) + " (its movable joints: " +
+                listNames(model.jointNames()) + ")");
+    if (locked[j]) item.fail("joint " + echo(name) + " is listed twice");
+    if (qdot(j) != 0.0)
+      item.fail("joint " + echo(name) + " is braked, so its rate " + qdot_path + "." + name + " must be 0, got " +
+                number(qdot(j)));
+    locked[j] = true;
+  }
+  return locked;
+}
+
+/// A joint's armature: a reflected inertia [kg m^2 or kg], or {rotor_inertia: I, gear_ratio: n}
+/// for n^2 I.
+double rotorInertia(const Field& f) {
+  if (f.isScalar()) {
+    const double a = f.number();
+    if (a < 0.0) f.fail("must be >= 0, got " + number(a));
+    return a;
+  }
+  f.onlyKeys({"rotor_inertia", "gear_ratio"});
+  const double I = f.at("rotor_inertia").number(), n = f.at("gear_ratio").number();
+  if (I < 0.0) f.at("rotor_inertia").fail("must be >= 0, got " + number(I));
+  if (!(n > 0.0)) f.at("gear_ratio").fail("must be > 0, got " + number(n));
+  return n * n * I;
+}
+
+/// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
+FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link"});
+  FloatingSystem s;
+  const Field urdf = f.at("urdf");
+  urdf_path = urdf.text();
+  if (urdf_path.empty()) urdf.fail("the file name is empty");
+  if (std::filesystem::path(urdf_path).is_relative())
+    urdf_path = (std::filesystem::path(folder) / urdf_path).lexically_normal().string();
+  try {
+    checkInputFile(urdf_path, "URDF file");
+    s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
+  } catch (const InputError& e) {
+    urdf.fail(e.what());
+  } catch (const ModelError& e) {
+    urdf.fail(e.what());
+  }
+  if (f.has("armature")) {  // rotor inertias, reflected: a number, or n^2 I_rotor
+    std::vector<double> armature = s.model->armature();
+    for (const auto& [j, value] : sections::byJoint<double>(f.at("armature"), *s.model, rotorInertia)) armature[j] = value;
+    s.model = std::make_shared<const FloatingModel>(s.model->withArmature(armature));
+  }
+  s.state = State(*s.model);
+  s.velocity = FloatingVelocity(*s.model);
+  if (f.has("base")) {
+    const Field base = f.at("base");
+    base.onlyKeys({"position", "rpy", "twist"});
+    s.state.world_T_base = pose(base);
+    if (base.has("twist")) s.velocity.base_twist = toTwist(Vector6d(base.at("twist").vector(6)));
+  }
+  if (f.has("q")) s.state.q = joints(f.at("q"), *s.model);
+  if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model);
+  if (f.has("locked"))
+    s.locked = lockedJoints(f.at("locked"), *s.model, s.velocity.qdot, (f.path().empty() ? "" : f.path() + ".") + "qdot");
+  if (f.has("contact")) {  // required for an impact (loadScenario); a plain motion has none: the base
+    const Field contact = f.at("contact");
+    contact.onlyKeys({"link", "offset"});
+    const std::string link = contact.at("link").text();
+    const Eigen::VectorXd o = contact.has("offset") ? contact.at("offset").vector(3) : Eigen::VectorXd::Zero(3);
+    if (s.model->bodyIndex(link) < 0)
+      contact.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*s.model)) + ")");
+    s.contact = s.model->contact(link, KDL::Vector(o(0), o(1), o(2)));
+  } else {
+    s.contact.body = 0;  // the base's origin
+  }
+  if (f.has("mode")) {
+    const std::string mode = f.at("mode").text();
+    if (mode == "free") s.response = Response::FreeFloating;
+    else if (mode == "grounded") s.response = Response::Grounded;
+    else if (mode == "locked") s.response = Response::JointsLocked;
+    else f.at("mode").fail(echo(mode) + " is not one of free, grounded, locked");
+  }
+  return s;
+}
+
+/// A rigid target in the file's terms; its mass and inertia those of a rigid body.
+RigidTarget rigidTarget(const Field& f) {
+  if (f.has("place"))
+    f.at("place").fail("a rigid target has no contact point of its own (the point hit is the robot's contact point): "
+                       "place it with pose");
+  f.onlyKeys({"mass", "inertia", "pose", "com", "twist"});
+  RigidTarget b;
+  b.mass = f.at("mass").number();
+  if (!(b.mass > 0.0)) f.at("mass").fail("must be > 0 kg, got " + number(b.mass));
+  const Field inertia = f.at("inertia");
+  const Matrix3d I = inertia.matrix3();
+  const rules::InertiaVerdict verdict = rules::judgeInertia(I);
+  if (!verdict.symmetric) {
+    Eigen::Index i = 0, j = 0;
+    (I - I.transpose()).cwiseAbs().maxCoeff(&i, &j);
+    inertia.fail("must be symmetric, but row " + std::to_string(i + 1) + " column " + std::to_string(j + 1) + " is " +
+                 number(I(i, j)) + " and row " + std::to_string(j + 1) + " column " + std::to_string(i + 1) + " is " +
+                 number(I(j, i)));
+  }
+  const Vector3d& l = verdict.moments;  // ascending
+  const std::string moments = "(principal moments " + number(l(0)) + ", " + number(l(1)) + ", " + number(l(2)) + " kg m^2)";
+  if (verdict.kind == rules::InertiaVerdict::NotPositiveDefinite) inertia.fail("must be positive definite " + moments);
+  if (verdict.kind == rules::InertiaVerdict::TriangleInequality)
+    inertia.fail("is no rigid body's inertia: its principal moments break the triangle inequality I1 + I2 >= I3 " +
+                 moments);
+  b.inertia = I;
+  if (f.has("pose")) {
+    f.at("pose").onlyKeys({"position", "rpy"});
+    b.pose = pose(f.at("pose"));
+  }
+  if (f.has("com")) b.com = f.at("com").vector(3);
+  if (f.has("twist")) b.twist = f.at("twist").vector(6);
+  return b;
+}
+
+/// A target URDF read as one rigid body: a file without movable joints, or the links from
+/// `link` down (its joints held at `q`); placed and moved by `base` as a rigid body given by numbers.
+RigidTarget rigidUrdfTarget(const Field& f, const FloatingSystem& t) {
+  for (const char* key : {"contact", "place", "qdot", "mode", "locked", "armature"})
+    if (f.has(key))
+      f.at(key).fail(std::string("the target is read as one rigid body (") +
+                     (f.has("link") ? "the links from target.link down" : "its file has no movable joint") +
+                     "): the point hit is the robot's contact point, and it moves as a whole (give its pose and twist in "
+                     "target.base)");
+  int body = 0;
+  if (f.has("link")) {
+    const std::string link = f.at("link").text();
+    body = t.model->bodyIndex(link);
+    if (body < 0)
+      f.at("link").fail("the model has no link " + echo(link) + " (its links: " + listNames(linkNames(*t.model)) + ")");
+  }
+  try {
+    return rigidSubtree(*t.model, t.state, body, t.velocity.base_twist);
+  } catch (const InputError& e) {
+    f.fail(e.what());
+  }
+}
+
+/// `place: touch`: the target's base moved (translated) so that its contact point is the robot's.
+void place(const Field& f, const FloatingSystem& robot, FloatingSystem& target) {
+  if (f.text() != "touch") f.fail(echo(f.text()) + " is not touch (the target's base moved so that its contact point is the robot's)");
+  Kinematics a(*robot.model), b(*target.model);
+  if (forwardKinematics(*robot.model, robot.state, a) || forwardKinematics(*target.model, target.state, b))
+    f.fail("the contact points cannot be computed at the given states");
+  target.state.world_T_base.p += toKDL(a.point(robot.contact) - b.point(target.contact));
+}
+
+/// The impact law; `has_normal` is set when a normal is given.
+ImpactLaw law(const Field& f, bool& has_normal) {
+  f.onlyKeys({"type", "normal", "restitution", "friction"});
+  ImpactLaw l;
+  const std::string type = f.at("type").text();
+  if (type == "capture") l.kind = ImpactKind::Capture;
+  else if (type == "point") l.kind = ImpactKind::PointImpact;
+  else if (type == "friction") l.kind = ImpactKind::FrictionalImpact;
+  else if (type == "translational") l.kind = ImpactKind::TranslationalCapture;
+  else f.at("type").fail(echo(type) + " is not one of capture, point, friction, translational");
+  const bool point = l.kind == ImpactKind::PointImpact || l.kind == ImpactKind::FrictionalImpact;
+  has_normal = f.has("normal");
+  if (point && !has_normal) f.at("normal");  // reports "missing"
+  if (has_normal) {
+    const Vector3d n = f.at("normal").vector(3);
+    if (!(n.norm() > 1e-12)) f.at("normal").fail("has zero length");
+    l.normal = n.normalized();
+  }
+  if (f.has("restitution")) {
+    l.restitution = f.at("restitution").number();
+    if (l.restitution < 0.0 || l.restitution > 1.0) f.at("restitution").fail("must lie in [0, 1], got " + number(l.restitution));
+  } else if (point) {
+    f.at("restitution");  // reports "missing"
+  }
+  if (f.has("friction")) {
+    l.friction = f.at("friction").number();
+    if (l.friction < 0.0) f.at("friction").fail("must be >= 0, got " + number(l.friction));
+  } else if (l.kind == ImpactKind::FrictionalImpact) {
+    f.at("friction");  // reports "missing"
+  }
+  return l;
+}
+
+}  // namespace
+
+Scenario loadScenario(const std::string& path) {
+  Scenario s;
+  s.file = path;
+  const YAML::Node root = fields::parseFile(path, "scenario file (YAML or JSON)");
+  const Field top(root, "", &s.file);
+  if (root.IsNull())
+    throw InputError(path + ": holds no data; a scenario is a mapping with robot, target and law (or robot and simulation)");
+  if (!root.IsMap())
+    top.fail("a scenario is a mapping with robot, target and law (or robot and simulation), not " + fields::kindOf(root));
+  top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
+  if (top.at("robot").has("place")) top.at("robot").at("place").fail("only a free-floating target is placed (target.place: touch)");
+  // A plain motion has neither target nor law; an impact needs both.
+  s.impact = top.has("target") || top.has("law");
+  if (s.impact) {
+    top.at("robot").at("contact");  // reports it missing: an impact needs the robot's contact point
+    const Field target = top.at("target");
+    if (target.has("urdf")) {
+      FloatingSystem t = system(target, folder, s.target_urdf);
+      if (target.has("link") || t.model->nj() == 0) {
+        s.capture.target = rigidUrdfTarget(target, t);  // one rigid body: the robot's contact point is hit
+      } else {
+        if (!target.has("contact")) target.at("contact");  // reports it missing
+        if (target.has("place")) place(target.at("place"), s.capture.robot, t);
+        s.capture.target = std::move(t);
+      }
+    } else {
+      s.capture.target = rigidTarget(target);
+    }
+    s.capture.law = law(top.at("law"), s.capture.has_normal);
+  } else if (!top.has("simulation")) {
+    top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
+  }
+  if (top.has("approach")) {
+    const Field approach = top.at("approach");
+    if (!s.impact) approach.fail("an approach reaches a target: give target and law too");
+    if (std::holds_alternative<FloatingSystem>(s.capture.target))
+      approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
+    s.approach = sections::approach(approach, *s.capture.robot.model);
+  }
+  if (top.has("simulation")) {
+    const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);
+    s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model,
+                                        s.impact && floating ? floating->model.get() : nullptr);
+  }
+  return s;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,151 @@
+#include "parsers/scenario/scenario_fields.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/parsers/input_file.hpp"
+
+namespace kdl_space::fields {
+
+std::string echo(const std::string& text) {
+  std::string shown;
+  for (std::size_t i = 0; i < text.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    shown += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
+  }
+  return "'" + shown + (text.size() > 40 ? "...'" : "'");
+}
+
+YAML::Node parseFile(const std::string& file, const std::string& kind) {
+  checkInputFile(file, kind);
+  try {
+    return YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw InputError(file + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    std::string msg;  // yaml-cpp quotes the offending byte: keep it printable
+    for (const char c : e.msg) msg += static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f ? c : '?';
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML or JSON: " + msg);
+  } catch (const std::exception& e) {
+    throw InputError(file + ": cannot read the file: " + e.what());
+  }
+}
+
+std::string kindOf(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "no value";
+  if (node.IsSequence()) return "a list of " + std::to_string(node.size());
+  if (node.IsMap()) return "a mapping";
+  return echo(node.Scalar());
+}
+
+Field::Field(YAML::Node node, std::string path, const std::string* file)
+    : node_(std::move(node)), path_(std::move(path)), file_(file) {}
+
+void Field::fail(const std::string& what) const {
+  std::string where = *file_;
+  if (node_.IsDefined() && node_.Mark().line >= 0) where += ":" + std::to_string(node_.Mark().line + 1);
+  throw InputError(where + ": " + (path_.empty() ? "" : path_ + ": ") + what);
+}
+
+bool Field::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
+
+Field Field::at(const std::string& key) const {
+  if (!node_.IsMap()) fail("expected a mapping, got " + kindOf(node_));
+  const std::string path = path_.empty() ? key : path_ + "." + key;
+  if (!has(key)) child(node_, path).fail("missing (a required field)");
+  const Field f = child(node_[key], path);
+  if (node_[key].IsNull()) {
+    for (const auto& item : node_)  // the key's line: a missing value has none of its own
+      if (item.first.IsScalar() && item.first.Scalar() == key) child(item.first, path).fail("has no value");
+    f.fail("has no value");
+  }
+  return f;
+}
+
+void Field::onlyKeys(std::initializer_list<const char*> allowed) const {
+  std::string expected;
+  for (const char* k : allowed) expected += (expected.empty() ? "" : ", ") + std::string(k);
+  keys();  // a mapping, no key twice
+  for (const auto& item : node_) {
+    const std::string k = item.first.Scalar();
+    const bool known = std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; });
+    if (!known) child(item.first, path_.empty() ? k : path_ + "." + k).fail("unknown field (expected one of " + expected + ")");
+  }
+}
+
+std::vector<std::string> Field::keys() const {
+  if (!node_.IsMap()) fail("expected a mapping, got " + kindOf(node_));
+  std::vector<std::string> k;
+  for (const auto& item : node_) {
+    if (!item.first.IsScalar()) child(item.first, path_).fail("a field name must be a text, got " + kindOf(item.first));
+    const std::string name = item.first.Scalar();
+    const std::string path = path_.empty() ? name : path_ + "." + name;
+    if (std::find(k.begin(), k.end(), name) != k.end()) child(item.first, path).fail("given twice");
+    k.push_back(name);
+  }
+  return k;
+}
+
+std::string Field::text() const {
+  if (!node_.IsScalar()) fail("expected a text value, got " + kindOf(node_));
+  return node_.Scalar();
+}
+
+double Field::number() const {
+  if (!node_.IsScalar()) fail("expected a number, got " + kindOf(node_));
+  double v = 0.0;
+  try {
+    v = node_.as<double>();  // YAML's forms too: .inf, .nan
+  } catch (const YAML::Exception&) {
+    std::string why;
+    if (!parseFiniteNumber(node_.Scalar(), v, why))
+      fail(echo(node_.Scalar()) + (why.find("too large") != std::string::npos ? " is too large (not a finite number)"
+                                                                               : " is not a number"));
+  }
+  if (!std::isfinite(v)) fail(echo(node_.Scalar()) + " is not a finite number");
+  return v;
+}
+
+Eigen::VectorXd Field::vector(int size) const {
+  if (!node_.IsSequence() || static_cast<int>(node_.size()) != size)
+    fail("expected a list of " + std::to_string(size) + " numbers, got " + kindOf(node_));
+  Eigen::VectorXd v(size);
+  for (int i = 0; i < size; ++i) v(i) = child(node_[i], path_ + "[" + std::to_string(i) + "]").number();
+  return v;
+}
+
+Eigen::Matrix3d Field::matrix3() const {
+  if (!node_.IsSequence() || node_.size() != 3) fail("expected 3 rows of 3 numbers, got " + kindOf(node_));
+  Eigen::Matrix3d m;
+  for (int i = 0; i < 3; ++i) m.row(i) = child(node_[i], path_ + "[" + std::to_string(i) + "]").vector(3);
+  return m;
+}
+
+std::map<std::string, double> Field::namedNumbers() const {
+  if (!node_.IsMap()) fail("expected a mapping NAME: VALUE, got " + kindOf(node_));
+  std::map<std::string, double> values;
+  for (const std::string& name : keys()) values[name] = at(name).number();
+  return values;
+}
+
+std::vector<Field> Field::items(const std::string& what) const {
+  if (!node_.IsSequence()) fail("expected a list of " + what + ", got " + kindOf(node_));
+  std::vector<Field> list;
+  for (std::size_t i = 0; i < node_.size(); ++i) list.push_back(child(node_[i], path_ + "[" + std::to_string(i) + "]"));
+  return list;
+}
+
+bool Field::flag() const {
+  const std::string t = text();
+  if (t == "true") return true;
+  if (t == "false") return false;
+  fail(echo(t) + " is not one of true, false");
+}
+
+Eigen::Vector3d Field::perAxis() const {
+  if (node_.IsSequence()) return vector(3);
+  return Eigen::Vector3d::Constant(number());
+}
+
+}  // namespace kdl_space::fields

@@ -1,0 +1,31 @@
+#include "kdl_space/parsers/scenario/scenario.hpp"
+
+namespace kdl_space {
+
+std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                         bool approach) {
+  const SimulationSpec& spec = sc.simulation;
+  const FloatingSystem& robot = sc.capture.robot;
+  const auto jointIn = [&](unsigned int j) {  // a joint of the robot's model, in `model`
+    return static_cast<unsigned int>(model->jointIndex(robot.model->jointNames()[j]));
+  };
+  SimulationOptions options = spec.options;
+  options.grounded = spec.grounded.value_or(robot.response == Response::Grounded);
+  auto sim = std::make_unique<Simulator>(model, options);
+  JointControl locked;
+  locked.mode = JointControl::Mode::Locked;
+  for (unsigned int j = 0; j < robot.model->nj(); ++j)
+    if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j]))
+      sim->setJointControl(jointIn(j), locked);
+  if (!approach)
+    for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(joint), control);
+  for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(joint), mode);
+  sim->setBaseControl(spec.base_control);
+  for (ScheduledWrench w : spec.wrenches) {
+    w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
+    sim->addWrench(w);
+  }
+  return sim;
+}
+
+}  // namespace kdl_space

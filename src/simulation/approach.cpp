@@ -1,0 +1,197 @@
+#include "kdl_space/simulation/approach.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <string>
+
+namespace kdl_space {
+
+namespace {
+[[noreturn]] void refuse(const std::string& what) { throw ModelError("ApproachController: " + what); }
+
+void positive(double x, const char* what) {
+  if (!(x > 0.0) || !std::isfinite(x)) refuse(std::string(what) + " must be finite and > 0");
+}
+
+/// The robot's joint rates could not be commanded at a stage: run() stops with this code.
+struct CommandFailed {
+  int rc;
+};
+}  // namespace
+
+std::vector<double> defaultRateLimits(const FloatingModel& model) {
+  std::vector<double> limits(model.nj(), std::numeric_limits<double>::infinity());
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const double v = model.jointProperties()[j].velocity;
+    if (std::isfinite(v) && v > 0.0) limits[j] = v;
+  }
+  return limits;
+}
+
+ApproachController::ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand,
+                                       ApproachSpec spec, FreeRigidMotion target)
+    : model_(std::move(model)), hand_(hand), spec_(std::move(spec)), target_(std::move(target)),
+      solver_(model_ ? model_ : throw ModelError("ApproachController: null model")) {
+  const unsigned int n = model_->nj();
+  if (hand_.body < 0 || hand_.body >= static_cast<int>(model_->bodies().size())) refuse("the hand is no body of the model");
+  if (!allFinite(hand_.offset) || !allFinite(spec_.grasp)) refuse("the hand offset and the grasp frame must be finite");
+  positive(spec_.gain, "the gain");
+  positive(spec_.threshold, "the singular value threshold");
+  positive(spec_.servo_bandwidth, "the servo bandwidth");
+  positive(spec_.position_tolerance, "the position tolerance");
+  positive(spec_.orientation_tolerance, "the orientation tolerance");
+  positive(spec_.max_duration, "the longest approach");
+  if (!(spec_.damping >= 0.0) || !std::isfinite(spec_.damping)) refuse("the damping must be finite and >= 0");
+  if (!(spec_.speed_tolerance > 0.0)) refuse("the speed tolerance must be > 0");
+  if (spec_.rate_limits.empty()) spec_.rate_limits = defaultRateLimits(*model_);
+  if (spec_.rate_limits.size() != n) refuse(std::to_string(spec_.rate_limits.size()) + " rate limits for " + std::to_string(n) + " joints");
+  for (double v : spec_.rate_limits)
+    if (!(v > 0.0)) refuse("a rate limit must be > 0");
+  J_ = KDL::Jacobian(n);
+  J_base_ = KDL::Jacobian(n);
+}
+
+int ApproachController::grasp(double t, KDL::Frame& frame, Vector6d& twist) {
+  RigidTarget b;
+  if (const int rc = target_.at(t, b)) return rc;
+  const KDL::Frame g = b.pose * spec_.grasp;
+  const Vector3d c = toEigen(b.pose * toKDL(b.com));
+  const Vector3d w = b.twist.tail<3>();
+  twist << b.twist.head<3>() + w.cross(toEigen(g.p) - c), w;  // the grasp point's velocity
+  frame = g;
+  return E_NOERROR;
+}
+
+int ApproachController::command(const SimulationState& s, ApproachCommand& out) {
+  const unsigned int n = model_->nj();
+  if (s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (const int rc = solver_.compute(s.state)) return rc;
+  Vector6d PL_g;
+  if (const int rc = solver_.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
+  const KDL::JntArray still(n);
+  KDL::Twist drift, t_h;
+  if (grounded_) {  // the base held: t_h = J qdot
+    if (const int rc = solver_.J(hand_, J_)) return rc;
+    t_h = toTwist(J_.data * s.velocity.qdot.data);
+  } else {
+    if (const int rc = solver_.J_star(hand_, J_)) return rc;
+    if (const int rc = solver_.handTwist(hand_, still, PL_g, drift)) return rc;  // eq. 4, qdot = 0
+    if (const int rc = solver_.handTwist(hand_, s.velocity.qdot, PL_g, t_h)) return rc;
+  }
+  KDL::Frame G;
+  Vector6d grasp_twist;
+  if (const int rc = grasp(s.t, G, grasp_twist)) return rc;
+  const KDL::Frame& link = solver_.bodyPose(hand_.body);
+  const KDL::Vector p_hand = link * hand_.offset;
+  Vector6d e;
+  e << toEigen(G.p - p_hand), toEigen((G.M * link.M.Inverse()).GetRot());
+  const Vector6d reference = grasp_twist + spec_.gain * e;
+  const int m = spec_.orientation ? 6 : 3;
+  const Eigen::MatrixXd A = J_.data.topRows(m);
+  const Eigen::VectorXd b = (reference - toEigen(drift)).head(m);
+  // Damped least squares (Nakamura; Maciejewski): the damping grows as J* nears a singularity.
+  const Eigen::MatrixXd AAt = A * A.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(AAt, Eigen::EigenvaluesOnly);
+  const double sigma = std::sqrt(std::max(eig.eigenvalues()(0), 0.0));
+  const double ratio = sigma / spec_.threshold;
+  const double l2 = ratio < 1.0 ? spec_.damping * spec_.damping * (1.0 - ratio * ratio) : 0.0;
+  const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + l2 * Eigen::MatrixXd::Identity(m, m));  // J J^T + l^2 E
+  Eigen::VectorXd qdot = A.transpose() * damped.solve(b);
+  if (spec_.null_space == NullSpaceTask::Reaction && !grounded_ && static_cast<int>(n) > m) {
+    // Of qdot + N z (N = E - J+ J*: rates that leave the hand's twist alone), the one whose base
+    // angular velocity w_b = A_w qdot + c (the base's J* and drift) is least.
+    if (const int rc = solver_.J_star(Contact{0, KDL::Vector::Zero()}, J_base_)) return rc;
+    KDL::Twist base_drift;
+    if (const int rc = solver_.handTwist(Contact{0, KDL::Vector::Zero()}, still, PL_g, base_drift)) return rc;
+    const Eigen::MatrixXd N = Eigen::MatrixXd::Identity(n, n) - A.transpose() * damped.solve(A);  // E - J+ J
+    const Eigen::MatrixXd B = J_base_.data.bottomRows(3) * N;
+    const Vector3d w_b = J_base_.data.bottomRows(3) * qdot + toEigen(base_drift).tail<3>();
+    // Damped (mu = 1% of |A_w|^2): where the null space hardly turns the base, it is not driven hard.
+    const Matrix3d BBt = B * B.transpose();
+    const double mu = 1e-2 * J_base_.data.bottomRows(3).squaredNorm() + 1e-300;
+    const Eigen::VectorXd z = -B.transpose() * (BBt + mu * Matrix3d::Identity()).ldlt().solve(w_b);
+    qdot += N * z;
+  }
+  double scale = 1.0;
+  for (unsigned int j = 0; j < n; ++j)
+    if (std::abs(qdot(j)) * scale > spec_.rate_limits[j]) scale = spec_.rate_limits[j] / std::abs(qdot(j));
+  qdot *= scale;
+  if (!qdot.allFinite()) return E_NOT_FINITE;
+  if (out.qdot.rows() != n) out.qdot = KDL::JntArray(n);
+  out.qdot.data = qdot;
+  out.error = e;
+  out.reference = reference;
+  out.drift = toEigen(drift);
+  out.sigma_min = sigma;
+  out.damping = std::sqrt(l2);
+  out.scale = scale;
+  out.relative_speed = (toEigen(t_h).head<3>() - grasp_twist.head<3>()).norm();
+  return E_NOERROR;
+}
+
+int runApproach(Simulator& sim, ApproachController& controller, SimulationState& s, double output_dt,
+                const std::function<void(const SimulationState&, const ApproachCommand&)>& observer,
+                ApproachRecord& record) {
+  const unsigned int n = sim.model().nj();
+  const ApproachSpec& spec = controller.spec();
+  ApproachRecord rec;
+  rec.kv.assign(n, 0.0);
+  for (unsigned int j = 0; j < n; ++j) {
+    if (sim.jointControls()[j].mode == JointControl::Mode::Locked) continue;  // braked: not servoed
+    double m = 0.0;
+    if (const int rc = sim.apparentInertia(s, j, m)) return rc;
+    rec.kv[j] = spec.servo_bandwidth * m;
+  }
+  controller.setGrounded(sim.options().grounded);
+  const KDL::Rotation base_start = s.state.world_T_base.M;
+  ApproachCommand stage, sample;
+  int failure = E_NOERROR;
+  sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
+    if (const int rc = controller.command(x, stage)) throw CommandFailed{rc};
+    for (unsigned int j = 0; j < n; ++j) tau(j) += rec.kv[j] * (stage.qdot(j) - x.velocity.qdot(j));
+  });
+  bool reached = false;
+  const auto watch = [&](const SimulationState& x) {
+    if ((failure = controller.command(x, sample))) {
+      reached = true;  // stops the run: the failure is returned below
+      return;
+    }
+    const double distance = sample.error.head<3>().norm(), angle = sample.error.tail<3>().norm();
+    if (distance < rec.closest_distance) {
+      rec.closest_distance = distance;
+      rec.closest_time = x.t;
+    }
+    rec.final_distance = distance;
+    rec.final_angle = angle;
+    rec.min_sigma = std::min(rec.min_sigma, sample.sigma_min);
+    rec.max_damping = std::max(rec.max_damping, sample.damping);
+    rec.min_scale = std::min(rec.min_scale, sample.scale);
+    if (observer) observer(x, sample);
+    reached = distance <= spec.position_tolerance && (!spec.orientation || angle <= spec.orientation_tolerance) &&
+              sample.relative_speed <= spec.speed_tolerance;
+  };
+  sim.setStopCondition([&](const SimulationState&) { return reached; });
+  const double t0 = s.t;
+  int rc = E_NOERROR;
+  try {
+    rc = sim.run(s, t0 + spec.max_duration, output_dt, watch);
+  } catch (const CommandFailed& f) {
+    rc = f.rc;
+  } catch (...) {
+    sim.setTorqueCallback({});
+    sim.setStopCondition({});
+    throw;
+  }
+  sim.setTorqueCallback({});
+  sim.setStopCondition({});
+  if (rc == E_NOERROR) rc = failure;
+  rec.reached = reached && failure == E_NOERROR;
+  if (rec.reached) rec.t_contact = s.t;
+  rec.duration = s.t - t0;
+  rec.base_rotation = (s.state.world_T_base.M * base_start.Inverse()).GetRot().Norm();
+  record = rec;
+  return rc;
+}
+
+}  // namespace kdl_space

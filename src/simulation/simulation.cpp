@@ -1,0 +1,394 @@
+#include "kdl_space/simulation/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "simulation/simulation_layout.hpp"
+
+namespace kdl_space {
+namespace {
+
+// Dormand & Prince (1980) RK5(4)7M tableau.
+constexpr double kC[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+constexpr double kA[7][6] = {
+    {},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+constexpr double kB5[7] = {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0.0};
+constexpr double kB4[7] = {5179.0 / 57600, 0.0, 7571.0 / 16695, 393.0 / 640, -92097.0 / 339200, 187.0 / 2100, 1.0 / 40};
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The forward dynamics of a motion: the O(n) recursion, or the dense route when joints are
+/// coupled (mimic), which the recursion cannot carry.
+detail::Dynamics dynamicsFor(const std::shared_ptr<const FloatingModel>& model) {
+  if (!model->mimic().empty()) return detail::Dynamics(std::in_place_type<DenseForwardDynamics>, model);
+  return detail::Dynamics(std::in_place_type<ForwardDynamicsSolver>, model);
+}
+
+}  // namespace
+
+Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
+    : model_(model ? std::move(model) : throw ModelError("simulation: null model")),
+      kin_(*model_),
+      momentum_(model_),
+      dynamics_(dynamicsFor(model_)),
+      options_(options) {
+  const unsigned int n = this->model().nj();
+  controls_.assign(n, JointControl{});
+  limit_modes_.assign(n, LimitMode::Warn);
+  at_stop_.assign(n, false);
+  just_stopped_.assign(n, false);
+  locked_now_.assign(n, false);
+  saturated_.assign(n, false);
+  friction_velocity_.assign(n, options_.friction_velocity);
+  stats_.joints.assign(n, JointRecord{});
+  scratch_.state = State(this->model());
+  scratch_.velocity.qdot = KDL::JntArray(n);
+  scratch_.tau = KDL::JntArray(n);
+  tau_control_ = KDL::JntArray(n);
+  tau_friction_ = KDL::JntArray(n);
+  tau_extra_ = KDL::JntArray(n);
+  acc_.qddot = KDL::JntArray(n);
+  f_ext_.assign(this->model().bodies().size(), KDL::Wrench::Zero());
+  const int size = detail::StateLayout(n).size;
+  k_.assign(7, Vector::Zero(size));
+  x_.setZero(size);
+  x_tmp_.setZero(size);
+  x_new_.setZero(size);
+  x_prev_.setZero(size);
+  x_event_.setZero(size);
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  if (!positive(options_.step) || !positive(options_.rtol) || !positive(options_.atol) ||
+      !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity) || !positive(options_.friction_rate))
+    throw ModelError(
+        "simulation: step, rtol, atol, max_step, max_steps, friction_velocity and friction_rate must be finite and > 0");
+  if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54 &&
+      options_.integrator != Integrator::Rosenbrock)
+    throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54, Rosenbrock");
+  if (std::visit([&](auto& d) { return d.setGravity(options_.gravity); }, dynamics_) != E_NOERROR)
+    throw ModelError("simulation: gravity must be finite");
+  std::visit([&](auto& d) { d.setGrounded(options_.grounded); }, dynamics_);
+  if (options_.integrator == Integrator::Rosenbrock) makeStiffStepper();
+}
+
+Simulator::~Simulator() = default;
+
+void Simulator::setJointControl(unsigned int joint, const JointControl& control) {
+  if (joint >= controls_.size())
+    throw ModelError("simulation: joint index " + std::to_string(joint) + " out of range (the model has " +
+                     std::to_string(controls_.size()) + " joints)");
+  const std::string who = "simulation: joint '" + model().jointNames()[joint] + "': ";
+  if (control.mode != JointControl::Mode::Free && control.mode != JointControl::Mode::Locked &&
+      control.mode != JointControl::Mode::PD)
+    throw ModelError(who + "the mode is not one of Free, Locked, PD");
+  if (control.kp < 0.0 || control.kd < 0.0 || !std::isfinite(control.kp) || !std::isfinite(control.kd) ||
+      !std::isfinite(control.set_point))
+    throw ModelError(who + "gains must be finite and >= 0");
+  controls_[joint] = control;
+  applyLocks();
+}
+
+void Simulator::setLimitMode(unsigned int joint, LimitMode mode) {
+  if (joint >= limit_modes_.size())
+    throw ModelError("simulation: joint index " + std::to_string(joint) + " out of range (the model has " +
+                     std::to_string(limit_modes_.size()) + " joints)");
+  if (mode != LimitMode::Ignore && mode != LimitMode::Warn && mode != LimitMode::Stop)
+    throw ModelError("simulation: the limit mode is not one of Ignore, Warn, Stop");
+  const JointProperties& p = model().jointProperties()[joint];
+  if (mode == LimitMode::Stop && !(std::isfinite(p.lower) && std::isfinite(p.upper)))
+    throw ModelError("simulation: joint '" + model().jointNames()[joint] +
+                     "' has no position limits (a continuous joint): it has no stop");
+  limit_modes_[joint] = mode;
+}
+
+void Simulator::setBaseControl(const BaseControl& control) {
+  const auto gain = [](double x) { return std::isfinite(x) && x >= 0.0; };
+  const auto limit = [](const Vector3d& l) { return !l.hasNaN() && (l.array() > 0.0).all(); };
+  const BaseControl::Attitude& a = control.attitude;
+  const BaseControl::Position& p = control.position;
+  if (a.on) {
+    if (!gain(a.kp) || !gain(a.kd)) throw ModelError("simulation: base_control.attitude: gains must be finite and >= 0");
+    if (!limit(a.torque_limit)) throw ModelError("simulation: base_control.attitude: torque limits must be > 0");
+    const Matrix3d R = toEigen(a.set_point);
+    if (!R.allFinite() || (R.transpose() * R - Matrix3d::Identity()).norm() > 1e-9 || R.determinant() < 0.0)
+      throw ModelError("simulation: base_control.attitude: the set point is not a rotation");
+  }
+  if (p.on) {
+    if (!gain(p.kp) || !gain(p.kd)) throw ModelError("simulation: base_control.position: gains must be finite and >= 0");
+    if (!limit(p.force_limit)) throw ModelError("simulation: base_control.position: force limits must be > 0");
+    if (!p.set_point.allFinite()) throw ModelError("simulation: base_control.position: the set point must be finite");
+  }
+  if (control.on() && options_.grounded)
+    throw ModelError("simulation: base_control: the base is grounded (held still): it has nothing to control");
+  base_control_ = control;
+}
+
+void Simulator::addWrench(const ScheduledWrench& w) {
+  if (w.body >= model().bodies().size())
+    throw ModelError("simulation: wrench on body " + std::to_string(w.body) + ": out of range (the model has " +
+                     std::to_string(model().bodies().size()) + " bodies)");
+  if (!w.point.allFinite() || !w.wrench.allFinite() || !std::isfinite(w.start) || std::isnan(w.end))
+    throw ModelError("simulation: wrench on link '" + model().bodies()[w.body].name + "': values must be finite");
+  if (!(w.end > w.start))
+    throw ModelError("simulation: wrench on link '" + model().bodies()[w.body].name + "': end must be after start");
+  wrenches_.push_back(w);
+}
+
+void Simulator::applyLocks() {
+  for (std::size_t j = 0; j < controls_.size(); ++j)
+    locked_now_[j] = controls_[j].mode == JointControl::Mode::Locked || at_stop_[j];
+  std::visit([&](auto& d) { d.setLocked(locked_now_); }, dynamics_);
+}
+
+int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
+  if (const int rc = momentum_.compute(kin_, s.velocity)) return rc;
+  h_O = momentum_.momentum();
+  T = momentum_.kineticEnergy();
+  return E_NOERROR;
+}
+
+int Simulator::actuation(SimulationState& s) {
+  const unsigned int n = model().nj();
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!std::isfinite(s.t)) return E_NOT_FINITE;
+  double T;
+  Vector6d h_O;
+  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
+  pack(s, h_O, x_tmp_);  // x_tmp_: a stage's workspace, free between steps
+  if (const int rc = unpack(x_tmp_, s.t, scratch_)) return rc;
+  if (const int rc = actuate(s.t, x_tmp_)) return rc;
+  if (s.tau.rows() != n) s.tau = KDL::JntArray(n);
+  s.tau.data = scratch_.tau.data;
+  s.base_wrench = scratch_.base_wrench;
+  return E_NOERROR;
+}
+
+void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const {
+  const detail::StateLayout L(model().nj());
+  const KDL::Frame& T = s.state.world_T_base;
+  double qx, qy, qz, qw;
+  T.M.GetQuaternion(qx, qy, qz, qw);
+  x.head<3>() = toEigen(T.p);
+  x.segment<4>(3) << qx, qy, qz, qw;
+  x.segment(L.q, L.n) = s.state.q.data;
+  x.segment<6>(L.h) = h_O;
+  x.segment(L.qdot, L.n) = s.velocity.qdot.data;
+  x.segment<6>(L.work) << s.work.controller, s.work.friction, s.work.limits, s.work.base_control, s.work.wrenches,
+      s.work.gravity;
+  x.segment<6>(L.impulse) = s.impulse;
+}
+
+int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
+  const detail::StateLayout L(model().nj());
+  if (!x.allFinite()) return E_NOT_FINITE;
+  const Eigen::Vector4d quat = x.segment<4>(3).normalized();
+  s.t = t;
+  s.state.world_T_base = KDL::Frame(KDL::Rotation::Quaternion(quat(0), quat(1), quat(2), quat(3)),
+                                    KDL::Vector(x(0), x(1), x(2)));
+  s.state.q.data = x.segment(L.q, L.n);
+  s.velocity.qdot.data = x.segment(L.qdot, L.n);
+  const auto w = x.segment<6>(L.work);
+  s.work = EnergySplit{w(0), w(1), w(2), w(3), w(4), w(5)};
+  s.impulse = x.segment<6>(L.impulse);
+  if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;  // the one pass of this stage
+  if (options_.grounded) {
+    s.velocity.base_twist = KDL::Twist::Zero();
+    return E_NOERROR;
+  }
+  return momentum_.baseTwist(kin_, x.segment<6>(L.h), s.velocity.qdot, s.velocity.base_twist);  // eq. 2
+}
+
+int Simulator::derivative(double t, const Vector& x, Vector& dx) {
+  const detail::StateLayout L(model().nj());
+  if (const int rc = unpack(x, t, scratch_)) return rc;
+  if (const int rc = actuate(t, x)) return rc;
+  const bool external = base_control_.on() || !wrenches_.empty();
+  static const std::vector<KDL::Wrench> none;
+  if (const int rc = std::visit(
+          [&](auto& d) { return d.CartToJnt(kin_, scratch_.velocity, scratch_.tau, external ? f_ext_ : none, acc_); },
+          dynamics_))
+    return rc;
+  const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
+  const Eigen::Vector4d quat = x.segment<4>(3);
+  dx.head<3>() = toEigen(scratch_.velocity.base_twist.vel);
+  dx.segment<3>(3) = 0.5 * (quat(3) * w + w.cross(quat.head<3>()));  // 1/2 (0, w) * q, w in world
+  dx(6) = -0.5 * w.dot(quat.head<3>());
+  dx.segment(L.q, L.n) = x.segment(L.qdot, L.n);
+  dx.segment<6>(L.h) = options_.grounded ? Vector6d::Zero() : external_;  // dh_O/dt: the external wrench
+  dx.segment(L.qdot, L.n) = acc_.qddot.data;
+  const auto& qdot = scratch_.velocity.qdot.data;
+  dx.segment<6>(L.work) << tau_control_.data.dot(qdot), tau_friction_.data.dot(qdot), 0.0, external_power_[0],
+      external_power_[1], external_power_[2];
+  dx.segment<6>(L.impulse) = external_;
+  return E_NOERROR;
+}
+
+int Simulator::stepRK4(double t, double h, Vector& x) {
+  const detail::WrenchClock clock(wrench_clock_, t, h);
+  if (int rc = derivative(t, x, k_[0])) return rc;
+  x_tmp_ = x + 0.5 * h * k_[0];
+  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[1])) return rc;
+  x_tmp_ = x + 0.5 * h * k_[1];
+  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[2])) return rc;
+  x_tmp_ = x + h * k_[2];
+  if (int rc = derivative(t + h, x_tmp_, k_[3])) return rc;
+  x += h / 6.0 * (k_[0] + 2.0 * k_[1] + 2.0 * k_[2] + k_[3]);
+  return E_NOERROR;
+}
+
+double Simulator::errorNorm(const Vector& x, const Vector& x_new, const Vector& difference) const {
+  // The motion's own components; the work and impulse integrals follow and do not steer the step.
+  const Eigen::Index size = detail::StateLayout(model().nj()).work;
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < size; ++i) {
+    const double scale = options_.atol + options_.rtol * std::max(std::abs(x(i)), std::abs(x_new(i)));
+    sum += (difference(i) / scale) * (difference(i) / scale);
+  }
+  return std::sqrt(sum / static_cast<double>(size));
+}
+
+int Simulator::stepDP54(double t, double h, const Vector& x, double& error, bool& trial_failed) {
+  const detail::WrenchClock clock(wrench_clock_, t, h);
+  trial_failed = false;
+  for (int i = 0; i < 7; ++i) {
+    x_tmp_ = x;
+    for (int j = 0; j < i; ++j) x_tmp_ += h * kA[i][j] * k_[j];
+    if (int rc = derivative(t + kC[i] * h, x_tmp_, k_[i])) {
+      trial_failed = i > 0;  // a stage away from x: a smaller step may not reach that state
+      return rc;
+    }
+  }
+  x_new_ = x;
+  x_tmp_.setZero();  // the error estimate
+  for (int i = 0; i < 7; ++i) {
+    x_new_ += h * kB5[i] * k_[i];
+    x_tmp_ += h * (kB5[i] - kB4[i]) * k_[i];
+  }
+  error = errorNorm(x, x_new_, x_tmp_);
+  trial_failed = !std::isfinite(error);
+  return trial_failed ? E_NOT_FINITE : E_NOERROR;
+}
+
+int Simulator::publish(const Vector& x, double t, SimulationState& s) {
+  if (const int rc = unpack(x, t, scratch_)) return rc;
+  if (const int rc = actuate(t, x)) return rc;
+  s.t = scratch_.t;
+  s.state.world_T_base = scratch_.state.world_T_base;
+  s.state.q.data = scratch_.state.q.data;  // sizes checked by run(): no allocation
+  s.velocity.base_twist = scratch_.velocity.base_twist;
+  s.velocity.qdot.data = scratch_.velocity.qdot.data;
+  s.tau.data = scratch_.tau.data;
+  s.base_wrench = scratch_.base_wrench;
+  s.work = scratch_.work;
+  s.impulse = scratch_.impulse;
+  return E_NOERROR;
+}
+
+double Simulator::nextSwitch(double t) const {
+  double next = kInf;
+  for (const ScheduledWrench& w : wrenches_) {
+    if (w.start > t) next = std::min(next, w.start);
+    if (w.end > t) next = std::min(next, w.end);
+  }
+  return next;
+}
+
+int Simulator::run(SimulationState& s, double t_end, double output_dt,
+                   const std::function<void(const SimulationState&)>& observer) {
+  const unsigned int n = model().nj();
+  stats_.accepted_steps = stats_.rejected_steps = 0;
+  stats_.min_step = kInf;
+  stats_.max_step = 0.0;
+  stats_.base_saturation_time = 0.0;
+  std::fill(stats_.joints.begin(), stats_.joints.end(), JointRecord{});
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!std::isfinite(t_end) || !std::isfinite(s.t) || std::isnan(output_dt)) return E_NOT_FINITE;
+  if (!(output_dt > 0.0) || t_end < s.t) return E_BAD_ARGUMENT;
+  if (options_.grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) return E_BAD_ARGUMENT;
+  if (s.tau.rows() != n) s.tau = KDL::JntArray(n);  // an output: sized once
+  s.work = EnergySplit{};
+  s.impulse.setZero();
+  if (const int rc = startRun(s)) return rc;
+  double T;
+  Vector6d h_O;
+  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
+  Vector& x = x_;
+  pack(s, h_O, x);
+  // The start must be evaluable; every later failure of the dynamics is the motion's.
+  if (const int rc = derivative(s.t, x, k_[0])) return rc;
+  if (const int rc = publish(x, s.t, s)) return rc;
+  if (observer) observer(s);
+  if (stop_ && stop_(s)) return E_NOERROR;
+
+  // RK4 takes `step` as given; max_step bounds only the adaptive methods.
+  const bool adaptive = options_.integrator != Integrator::RK4;
+  double t = s.t, h = adaptive ? std::min(options_.step, options_.max_step) : options_.step;
+  long outputs = 1;
+  const double t0 = s.t;
+  // On an error, s is left at the last accepted step if its state can be evaluated (else at the
+  // last output), so that the caller sees how far the run got. A mass matrix that fails its
+  // factorisation (positive definite at every configuration of a valid model, as at the start)
+  // means the state has left the range where round-off is small: the motion blew up.
+  const auto failed = [&](int rc) {
+    publish(x, t, s);
+    return rc == E_NOT_POSITIVE_DEFINITE ? static_cast<int>(E_NOT_FINITE) : rc;
+  };
+  while (t < t_end) {
+    if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return failed(E_MAX_STEPS);
+    const double t_out = std::min(t0 + outputs * output_dt, t_end);
+    const double t_next = std::min(t_out, nextSwitch(t));
+    // Land exactly on the output time (or a wrench's switch) when within round-off of it (no
+    // sliver steps).
+    const bool lands = t_next - t <= h * (1.0 + 1e-9);
+    const double h_try = lands ? t_next - t : h;
+    x_prev_ = x;
+    if (options_.integrator == Integrator::RK4) {
+      if (const int rc = stepRK4(t, h_try, x)) return failed(rc);
+    } else {
+      double error = 0.0;
+      bool trial_failed = false;
+      const int rc = options_.integrator == Integrator::Rosenbrock ? stepRosenbrock(t, h_try, x, error, trial_failed)
+                                                                   : stepDP54(t, h_try, x, error, trial_failed);
+      if (rc) {
+        if (!trial_failed) return failed(rc);
+        error = kInf;  // the trial step went where the dynamics are undefined: a rejected step
+      }
+      const double exponent = options_.integrator == Integrator::Rosenbrock ? stiffErrorExponent() : -0.2;
+      const double factor = error == 0.0 ? 5.0 : std::clamp(0.9 * std::pow(error, exponent), 0.2, 5.0);
+      if (error > 1.0) {
+        ++stats_.rejected_steps;
+        h = h_try * factor;
+        if (h < 1e-14 * std::max(1.0, std::abs(t))) return failed(E_STEP_UNDERFLOW);
+        continue;
+      }
+      x = x_new_;
+      if (!lands || factor < 1.0) h = std::min(h_try * factor, options_.max_step);
+    }
+    ++stats_.accepted_steps;
+    x.segment<4>(3).normalize();  // the orientation stays a unit quaternion
+    double t_new = lands ? t_next : t + h_try;
+    if (const int rc = afterStep(t, h_try, x_prev_, t_new, x)) return failed(rc);
+    const double taken = t_new - t;
+    if (!lands || stats_.accepted_steps == 1) {  // an output's sliver step says nothing of the motion
+      stats_.min_step = std::min(stats_.min_step, taken);
+      stats_.max_step = std::max(stats_.max_step, taken);
+    }
+    t = t_new;
+    if (t == t_out) {
+      if (const int rc = publish(x, t, s)) return failed(rc);
+      if (observer) observer(s);
+      ++outputs;
+      if (stop_ && stop_(s)) break;
+    }
+  }
+  if (stats_.min_step == kInf) stats_.min_step = 0.0;
+  return publish(x, t, s);
+}
+
+}  // namespace kdl_space

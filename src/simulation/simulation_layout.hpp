@@ -1,0 +1,34 @@
+// Private to the simulator: where each part of the integrated state lies in its vector, and the
+// forward dynamics it runs.
+#pragma once
+
+#include <limits>
+#include <variant>
+
+#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+
+namespace kdl_space::detail {
+
+/// x = (p_b (3), quaternion x y z w (4), q (n), h_O = (P; L about the origin) (6), qdot (n),
+/// work (6: EnergySplit's order), external impulse (6)).
+struct StateLayout {
+  explicit StateLayout(unsigned int joints)
+      : n(static_cast<int>(joints)), q(7), h(7 + n), qdot(13 + n), work(13 + 2 * n), impulse(19 + 2 * n),
+        size(25 + 2 * n) {}
+  int n, q, h, qdot, work, impulse, size;
+};
+
+/// The articulated-body recursion; the dense route for a model with mimic joints.
+using Dynamics = std::variant<ForwardDynamicsSolver, DenseForwardDynamics>;
+
+/// Sets Simulator's wrench clock to a step's midpoint for the step's duration (NaN after it).
+struct WrenchClock {
+  double& clock;
+  WrenchClock(double& c, double t, double h) : clock(c) { clock = t + 0.5 * h; }
+  ~WrenchClock() { clock = std::numeric_limits<double>::quiet_NaN(); }
+  WrenchClock(const WrenchClock&) = delete;
+  WrenchClock& operator=(const WrenchClock&) = delete;
+};
+
+}  // namespace kdl_space::detail

@@ -1,0 +1,20 @@
+#include "kdl_space/spatial/errors.hpp"
+
+namespace kdl_space {
+
+const char* strError(int code) {
+  switch (code) {
+    case E_NOERROR: return "no error";
+    case E_SIZE_MISMATCH: return "the size of an input or output does not match the model";
+    case E_NOT_COMPUTED: return "compute(state) has not succeeded for this solver";
+    case E_NOT_FINITE: return "an input holds NaN or infinite values, or a result overflowed";
+    case E_NOT_POSITIVE_DEFINITE: return "an inertia matrix is not positive definite";
+    case E_BAD_CONTACT: return "the contact refers to no body of this model";
+    case E_MAX_STEPS: return "the simulation spent its step budget (is a controller unstable?)";
+    case E_BAD_ARGUMENT: return "a parameter is out of its range";
+    case E_STEP_UNDERFLOW: return "the adaptive step size fell to round-off (a stiff or singular motion)";
+    default: return "unknown error";
+  }
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,229 @@
+// A study's rows: sample i's inputs drawn (study_sampling), set in the scenario's capture problem,
+// the capture solved (CaptureSolver, its robot side kept between samples), and the outcomes.
+#include "kdl_space/study/study.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/simulation/rigid_motion.hpp"
+#include "study/study_sampling.hpp"
+#include "study/study_self_motion.hpp"
+
+namespace kdl_space {
+
+std::vector<std::string> studyColumns(const Study& study) {
+  std::vector<std::string> c{"sample", "status"};
+  for (const StudyInput& in : study.inputs) {
+    c.push_back(in.name);
+    if (in.field == StudyInput::Field::TargetTumble)
+      for (const char* a : {".axis_x", ".axis_y", ".axis_z"}) c.push_back(in.name + a);
+  }
+  for (const char* f : {"impulse.fx", "impulse.fy", "impulse.fz", "impulse.nx", "impulse.ny", "impulse.nz",
+                        "impulse.force", "impulse.moment", "base.vx", "base.vy", "base.vz", "base.wx", "base.wy",
+                        "base.wz", "base_rate"})
+    c.emplace_back(f);
+  const std::vector<std::string>& joints = study.scenario.capture.robot.model->jointNames();
+  for (const std::string& j : joints) c.push_back("dqdot." + j);
+  c.emplace_back("max_dqdot");
+  c.emplace_back("energy_lost");
+  if (study.motion_duration > 0.0) {
+    for (const std::string& j : joints) c.push_back("peak_torque." + j);
+    c.emplace_back("peak_base_rate");
+  }
+  if (study.limits.joint_rate) c.emplace_back("exceeds.joint_rate");
+  if (study.limits.joint_torque) c.emplace_back("exceeds.joint_torque");
+  if (study.limits.base_rate) c.emplace_back("exceeds.base_rate");
+  if (study.limits.joint_rate || study.limits.joint_torque || study.limits.base_rate) c.emplace_back("exceeds.any");
+  return c;
+}
+
+/// What one evaluator keeps between samples.
+struct StudyEvaluator::Work {
+  CaptureSolver capture;
+  CaptureProblem problem;        ///< the sample's (reset from the scenario's each time)
+  std::vector<double> drawn;     ///< the sample's inputs
+  std::unique_ptr<SelfMotion> self_motion;
+  std::unique_ptr<Kinematics> kin;  ///< the hand's pose, when an input moves it
+  KDL::Frame hand_nominal;          ///< the contact frame (body axes, at the contact point) at the scenario's state
+  Vector3d grasp = Vector3d::Zero();  ///< the nominal grasp point in the target's frame
+  bool moves_hand = false, places_target = false;
+};
+
+namespace {
+
+/// The contact frame: the contact body's axes, at the contact point.
+KDL::Frame handFrame(const Kinematics& kin, const Contact& h) {
+  const KDL::Frame body = kin.pose(h.body);
+  return KDL::Frame(body.M, body * h.offset);
+}
+
+/// The motion after the capture (the scenario's simulation section, its PD servos holding the
+/// capture configuration): each joint's largest |torque|, the base's largest |w| and the largest
+/// |qdot_j| / limit_j, at the output steps.
+int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureResult& r, std::vector<double>& peak,
+                double& peak_base_rate, double& rate_ratio) {
+  std::unique_ptr<Simulator> sim;
+  std::shared_ptr<const FloatingModel> model;
+  try {
+    model = attachTarget(problem, r);
+    sim = makeSimulator(st.scenario, model, false);
+    for (unsigned int j = 0; j < model->nj(); ++j) {
+      JointControl c = sim->jointControls()[j];
+      if (c.mode != JointControl::Mode::PD) continue;
+      c.hold = true;
+      sim->setJointControl(j, c);
+    }
+  } catch (const std::exception&) {
+    return E_BAD_ARGUMENT;
+  }
+  const FloatingModel& robot = *problem.robot.model;
+  std::vector<unsigned int> in_model(robot.nj());
+  for (unsigned int j = 0; j < robot.nj(); ++j) in_model[j] = static_cast<unsigned int>(model->jointIndex(robot.jointNames()[j]));
+  SimulationState s;
+  s.state = problem.robot.state;
+  s.velocity = r.robot.after;
+  const auto observe = [&](const SimulationState& x) {
+    for (unsigned int j = 0; j < robot.nj(); ++j) {
+      peak[j] = std::max(peak[j], std::abs(x.tau(in_model[j])));
+      if (st.limits.joint_rate)
+        rate_ratio = std::max(rate_ratio, std::abs(x.velocity.qdot(in_model[j])) / (*st.limits.joint_rate)[j]);
+    }
+    peak_base_rate = std::max(peak_base_rate, x.velocity.base_twist.rot.Norm());
+  };
+  return sim->run(s, st.motion_duration, st.motion_output_step, observe);
+}
+
+}  // namespace
+
+StudyEvaluator::StudyEvaluator(std::shared_ptr<const Study> study)
+    : study_(std::move(study)), columns_(studyColumns(*study_).size()), work_(std::make_unique<Work>()) {
+  Work& w = *work_;
+  const Scenario& sc = study_->scenario;
+  w.problem = sc.capture;
+  using F = StudyInput::Field;
+  for (const StudyInput& in : study_->inputs) {
+    w.moves_hand |= in.field == F::JointPosition || in.field == F::SelfMotion || in.field == F::ContactOffset;
+    w.places_target |= in.field == F::TargetGrasp || in.field == F::Timing;
+    if (in.field == F::SelfMotion && !w.self_motion)
+      w.self_motion = std::make_unique<SelfMotion>(sc.capture.robot.model, sc.capture.robot.contact, sc.capture.robot.state);
+    w.drawn.resize(w.drawn.size() + static_cast<std::size_t>(sampling::valuesOf(in)));
+  }
+  const auto* target = std::get_if<RigidTarget>(&sc.capture.target);
+  if (target && (w.moves_hand || w.places_target)) {
+    w.kin = std::make_unique<Kinematics>(*sc.capture.robot.model);
+    if (forwardKinematics(*sc.capture.robot.model, sc.capture.robot.state, *w.kin) != E_NOERROR)
+      throw InputError(study_->file + ": the scenario's state cannot be computed");
+    w.hand_nominal = handFrame(*w.kin, sc.capture.robot.contact);
+    w.grasp = toEigen(target->pose.Inverse() * w.hand_nominal.p);
+  }
+}
+
+StudyEvaluator::~StudyEvaluator() = default;
+
+void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
+  const Study& st = *study_;
+  const Scenario& sc = st.scenario;
+  Work& w = *work_;
+  std::fill(row, row + columns_, std::numeric_limits<double>::quiet_NaN());
+  row[0] = static_cast<double>(i);
+  sampling::draw(st, i, w.drawn.data());
+  std::copy(w.drawn.begin(), w.drawn.end(), row + 2);
+  double* out = row + 2 + w.drawn.size();
+  const auto fail = [&](int code) { row[1] = code; };
+
+  // The inputs, set in a copy of the scenario's problem: the robot's first, then the target's.
+  FloatingSystem& robot = w.problem.robot;
+  robot.state = sc.capture.robot.state;
+  robot.velocity = sc.capture.robot.velocity;
+  robot.contact = sc.capture.robot.contact;
+  const auto* target0 = std::get_if<RigidTarget>(&sc.capture.target);
+  RigidTarget target = target0 ? *target0 : RigidTarget{};
+  double self_motion = 0.0, timing = 0.0;
+  Vector3d grasp_shift = Vector3d::Zero();
+  const double* v = w.drawn.data();
+  using F = StudyInput::Field;
+  for (const StudyInput& in : st.inputs) {
+    const double x = *v;
+    switch (in.field) {
+      case F::TargetTwist: target.twist(in.index) = x; break;
+      case F::TargetTumble: target.twist.tail<3>() = x * Vector3d(v[1], v[2], v[3]); break;
+      case F::TargetMass: target.inertia *= x / target.mass, target.mass = x; break;
+      case F::TargetGrasp: grasp_shift(in.index) = x; break;
+      case F::Timing: timing = x; break;
+      case F::JointPosition: robot.state.q(in.index) = x; break;
+      case F::JointRate: robot.velocity.qdot(in.index) = x; break;
+      case F::SelfMotion: self_motion = x; break;
+      case F::ContactOffset: robot.contact.offset.data[in.index] = x; break;
+    }
+    v += sampling::valuesOf(in);
+  }
+  if (w.self_motion && self_motion != 0.0)
+    if (const int rc = w.self_motion->move(robot.state, self_motion)) return fail(rc);
+  if (target0) {
+    if (timing > 0.0) {  // later along the tumble: the attitude and twist then
+      try {
+        FreeRigidMotion motion(target);
+        if (const int rc = motion.at(timing, target)) return fail(rc);
+      } catch (const ModelError&) {
+        return fail(E_BAD_ARGUMENT);
+      }
+    }
+    if (w.kin) {  // the target rides with the hand: the grasp point (moved by target.grasp) at the contact point
+      if (const int rc = forwardKinematics(*robot.model, robot.state, *w.kin)) return fail(rc);
+      const KDL::Frame hand = handFrame(*w.kin, robot.contact);
+      target.pose.M = hand.M * w.hand_nominal.M.Inverse() * target.pose.M;
+      target.pose.p = hand.p - target.pose.M * toKDL(w.grasp + grasp_shift);
+    }
+    w.problem.target = target;
+  }
+  const CaptureResult* r = nullptr;
+  try {
+    r = &w.capture.solve(w.problem);
+  } catch (const InputError&) {
+    return fail(E_BAD_ARGUMENT);
+  }
+  const Vector6d F_h = r->impulse.F;
+  for (int k = 0; k < 6; ++k) *out++ = F_h(k);
+  *out++ = F_h.head<3>().norm();
+  *out++ = F_h.tail<3>().norm();
+  const Vector6d base = toEigen(r->robot.after.base_twist);
+  for (int k = 0; k < 6; ++k) *out++ = base(k);
+  const double base_rate = base.tail<3>().norm();
+  *out++ = base_rate;
+  const unsigned int n = robot.model->nj();
+  double max_jump = 0.0;
+  for (unsigned int j = 0; j < n; ++j) {
+    const double jump = r->robot.after.qdot(j) - r->robot.before.qdot(j);
+    *out++ = jump;
+    max_jump = std::max(max_jump, std::abs(jump));
+  }
+  *out++ = max_jump;
+  *out++ = r->energyLost();
+  // The limits: rates after the impact; the motion's peaks too.
+  double rate_ratio = 0.0, torque_ratio = 0.0, peak_base_rate = base_rate;
+  if (st.limits.joint_rate)
+    for (unsigned int j = 0; j < n; ++j)
+      rate_ratio = std::max(rate_ratio, std::abs(r->robot.after.qdot(j)) / (*st.limits.joint_rate)[j]);
+  if (st.motion_duration > 0.0) {
+    std::vector<double> peak(n, 0.0);
+    if (const int rc = motionPeaks(st, w.problem, *r, peak, peak_base_rate, rate_ratio)) return fail(rc);
+    for (unsigned int j = 0; j < n; ++j) {
+      *out++ = peak[j];
+      if (st.limits.joint_torque) torque_ratio = std::max(torque_ratio, peak[j] / (*st.limits.joint_torque)[j]);
+    }
+    *out++ = peak_base_rate;
+  }
+  bool any = false;
+  const auto flag = [&](bool exceeded) {
+    *out++ = exceeded ? 1.0 : 0.0;
+    any |= exceeded;
+  };
+  if (st.limits.joint_rate) flag(rate_ratio > 1.0);
+  if (st.limits.joint_torque) flag(torque_ratio > 1.0);
+  if (st.limits.base_rate) flag(peak_base_rate > *st.limits.base_rate);
+  if (st.limits.joint_rate || st.limits.joint_torque || st.limits.base_rate) flag(any);
+  row[1] = E_NOERROR;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,260 @@
+// loadStudy: the study file's fields, each checked where it is read, in the words of the file.
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "detail/text.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/study/study.hpp"
+#include "parsers/scenario/scenario_fields.hpp"
+#include "study/study_sampling.hpp"
+#include "study/study_self_motion.hpp"
+
+namespace kdl_space {
+namespace {
+
+using detail::number;
+using fields::echo;
+using fields::Field;
+
+/// FNV-1a over a file's bytes, folded into h (a missing file folds in nothing).
+std::uint64_t fold(std::uint64_t h, const std::string& path) {
+  if (path.empty()) return h;
+  std::ifstream in(path, std::ios::binary);
+  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) {
+    h ^= static_cast<unsigned char>(*it);
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+/// A whole number 0 <= n <= `most`, written in digits (no sign, point or exponent).
+std::uint64_t whole(const Field& f, std::uint64_t most, const std::string& what) {
+  const std::string text = f.text();
+  bool digits = !text.empty() && text.size() <= 20;
+  for (const char c : text) digits = digits && std::isdigit(static_cast<unsigned char>(c));
+  if (!digits) f.fail("must be " + what + ", got " + echo(text));
+  try {
+    const unsigned long long n = std::stoull(text);
+    if (n > most) f.fail("must be at most " + std::to_string(most) + ", got " + text);
+    return n;
+  } catch (const std::out_of_range&) {
+    f.fail("must be at most " + std::to_string(most) + ", got " + echo(text));
+  }
+}
+
+Distribution distribution(const Field& f) {
+  if (f.isScalar() || f.isSequence() || f.keys().size() != 1)
+    f.fail("give one distribution: {uniform: [low, high]}, {normal: {mean: m, std: s}} or {grid: [from, to, count]}");
+  f.onlyKeys({"uniform", "normal", "grid"});
+  Distribution d;
+  if (f.has("uniform")) {
+    const Field u = f.at("uniform");
+    const Eigen::VectorXd v = u.vector(2);
+    if (!(v(0) < v(1))) u.fail("is an empty range: low must be < high, got [" + number(v(0)) + ", " + number(v(1)) + "]");
+    d.kind = Distribution::Kind::Uniform, d.a = v(0), d.b = v(1);
+  } else if (f.has("normal")) {
+    const Field n = f.at("normal");
+    n.onlyKeys({"mean", "std"});
+    d.kind = Distribution::Kind::Normal, d.a = n.at("mean").number(), d.b = n.at("std").number();
+    if (!(d.b > 0.0)) n.at("std").fail("must be > 0, got " + number(d.b));
+  } else {
+    const Field g = f.at("grid");
+    const std::vector<Field> items = g.items("from, to, count");
+    if (items.size() != 3) g.fail("expected [from, to, count], got a list of " + std::to_string(items.size()));
+    d.kind = Distribution::Kind::Grid, d.a = items[0].number(), d.b = items[1].number();
+    d.count = static_cast<long>(whole(items[2], 1000000, "a whole number of points >= 1"));
+    if (d.count < 1) items[2].fail("must be >= 1 point, got 0");
+    if (d.count > 1 && !(d.a != d.b)) g.fail("is an empty range: from and to are both " + number(d.a));
+  }
+  return d;
+}
+
+/// The input a field name sets, checked against the scenario.
+StudyInput input(const Field& f, const std::string& name, const Scenario& sc) {
+  StudyInput in;
+  in.name = name;
+  in.distribution = distribution(f);
+  const FloatingModel& robot = *sc.capture.robot.model;
+  const bool rigid = std::holds_alternative<RigidTarget>(sc.capture.target);
+  const auto component = [&](const std::string& prefix, std::initializer_list<const char*> names) {
+    int k = 0;
+    for (const char* c : names) {
+      if (name == prefix + c) return k;
+      ++k;
+    }
+    std::string list;
+    for (const char* c : names) list += (list.empty() ? "" : ", ") + prefix + c;
+    f.fail("is no input of a study (" + list + ")");
+  };
+  const auto joint = [&](const std::string& prefix) {
+    const std::string joint_name = name.substr(prefix.size());
+    const int j = robot.jointIndex(joint_name);
+    if (j < 0)
+      f.fail("the robot has no movable joint " + echo(joint_name) + " (its movable joints: " +
+             detail::listNames(robot.jointNames()) + ")");
+    return j;
+  };
+  const bool target_field = name.rfind("target.", 0) == 0 || name == "timing";
+  if (target_field && !sc.impact) f.fail("the scenario has no target");
+  if (target_field && !rigid)
+    f.fail("the target is a free-floating system (target.urdf): a study varies a rigid target's inputs only");
+  using F = StudyInput::Field;
+  if (name.rfind("target.twist.", 0) == 0) {
+    in.field = F::TargetTwist, in.index = component("target.twist.", {"vx", "vy", "vz", "wx", "wy", "wz"});
+  } else if (name == "target.tumble") {
+    in.field = F::TargetTumble;
+  } else if (name == "target.mass") {
+    in.field = F::TargetMass;
+  } else if (name.rfind("target.grasp.", 0) == 0) {
+    in.field = F::TargetGrasp, in.index = component("target.grasp.", {"x", "y", "z"});
+  } else if (name == "timing") {
+    in.field = F::Timing;
+  } else if (name.rfind("robot.q.", 0) == 0) {
+    in.field = F::JointPosition, in.index = joint("robot.q.");
+  } else if (name.rfind("robot.qdot.", 0) == 0) {
+    in.field = F::JointRate, in.index = joint("robot.qdot.");
+  } else if (name == "robot.self_motion") {
+    in.field = F::SelfMotion;
+    try {
+      SelfMotion check(sc.capture.robot.model, sc.capture.robot.contact, sc.capture.robot.state);
+    } catch (const InputError& e) {
+      f.fail(std::string(e.what()).substr(std::string("robot.self_motion: ").size()));
+    }
+  } else if (name.rfind("robot.contact.offset.", 0) == 0) {
+    in.field = F::ContactOffset, in.index = component("robot.contact.offset.", {"x", "y", "z"});
+  } else {
+    f.fail("is no input of a study (target.twist.{vx,vy,vz,wx,wy,wz}, target.tumble, target.mass, "
+           "target.grasp.{x,y,z}, timing, robot.q.JOINT, robot.qdot.JOINT, robot.self_motion, "
+           "robot.contact.offset.{x,y,z})");
+  }
+  const Distribution& d = in.distribution;
+  const bool signed_value = in.field == F::TargetTwist || in.field == F::TargetGrasp || in.field == F::JointPosition ||
+                            in.field == F::JointRate || in.field == F::SelfMotion || in.field == F::ContactOffset;
+  if (!signed_value && d.kind != Distribution::Kind::Normal && std::min(d.a, d.b) < 0.0)
+    f.fail("takes values >= 0 (" + std::string(in.field == F::TargetMass ? "a mass" : in.field == F::Timing ? "a delay" : "a rate") +
+           "), but the range reaches " + number(std::min(d.a, d.b)));
+  if (in.field == F::TargetMass && d.kind != Distribution::Kind::Normal && !(std::min(d.a, d.b) > 0.0))
+    f.fail("a mass must be > 0 kg, but the range reaches 0");
+  return in;
+}
+
+/// A limit per joint: a number for all, or `urdf` (the URDF's limit of each joint, which all must have).
+std::vector<double> jointLimit(const Field& f, const FloatingModel& robot, bool torque) {
+  std::vector<double> limit(robot.nj());
+  if (f.isScalar() && f.text() == "urdf") {
+    for (unsigned int j = 0; j < robot.nj(); ++j) {
+      const JointProperties& p = robot.jointProperties()[j];
+      limit[j] = torque ? p.effort : p.velocity;
+      if (!(limit[j] > 0.0) || !std::isfinite(limit[j]))
+        f.fail("joint " + echo(robot.jointNames()[j]) + " has no " + (torque ? "effort" : "velocity") +
+               " limit in the URDF: give a number");
+    }
+    return limit;
+  }
+  const double v = f.number();
+  if (!(v > 0.0)) f.fail("must be > 0 (or urdf), got " + number(v));
+  std::fill(limit.begin(), limit.end(), v);
+  return limit;
+}
+
+void checkColumn(const Field& f, const std::vector<std::string>& columns, const std::string& what) {
+  const std::string name = f.text();
+  if (std::find(columns.begin(), columns.end(), name) == columns.end())
+    f.fail("is no " + what + " of this study (its columns: " + detail::listNames(columns) + ")");
+}
+
+}  // namespace
+
+Study loadStudy(const std::string& path) {
+  Study st;
+  st.file = path;
+  const YAML::Node root = fields::parseFile(path, "study file (YAML or JSON)");
+  const Field top(root, "", &st.file);
+  if (!root.IsMap()) top.fail("a study is a mapping with scenario, samples, seed and inputs, not " + fields::kindOf(root));
+  top.onlyKeys({"scenario", "samples", "seed", "sampling", "inputs", "motion", "limits", "objective", "heat_map"});
+  std::string scenario_path = top.at("scenario").text();
+  if (std::filesystem::path(scenario_path).is_relative())
+    scenario_path = (std::filesystem::path(path).parent_path() / scenario_path).lexically_normal().string();
+  try {
+    st.scenario = loadScenario(scenario_path);
+  } catch (const InputError& e) {
+    top.at("scenario").fail(e.what());
+  }
+  const Scenario& sc = st.scenario;
+  if (!sc.impact) top.at("scenario").fail("is a plain motion: a study samples captures (give the scenario a target and a law)");
+  if (sc.approach)
+    top.at("scenario").fail("has an approach: a study samples the captures themselves (remove the approach; vary "
+                            "`timing` for when along the tumble the hand closes)");
+  st.seed = whole(top.at("seed"), ~std::uint64_t{0}, "a whole number (0 to 2^64 - 1)");
+  if (top.has("sampling")) {
+    const std::string s = top.at("sampling").text();
+    if (s == "latin_hypercube") st.latin_hypercube = true;
+    else if (s != "random") top.at("sampling").fail(echo(s) + " is not one of random, latin_hypercube");
+  }
+  const Field inputs = top.at("inputs");
+  for (const std::string& name : inputs.keys()) st.inputs.push_back(input(inputs.at(name), name, sc));
+  if (st.inputs.empty()) inputs.fail("a study varies at least one input");
+  const std::uint64_t grid = sampling::gridSize(st);
+  if (grid > Study::max_samples) inputs.fail("its grid has " + std::to_string(grid) + " points, more than a study's 1e9 samples");
+  if (top.has("samples")) {
+    st.samples = whole(top.at("samples"), ~std::uint64_t{0}, "a whole number of samples >= 1");
+    if (st.samples == 0) top.at("samples").fail("must be >= 1, got 0");
+    if (st.samples > Study::max_samples)
+      top.at("samples").fail("must be at most 1e9 (split a larger study into several), got " + top.at("samples").text());
+  } else if (std::any_of(st.inputs.begin(), st.inputs.end(),
+                         [](const StudyInput& in) { return in.distribution.kind == Distribution::Kind::Grid; })) {
+    st.samples = grid;  // one sample per grid point
+  } else {
+    top.at("samples");  // reports it missing
+  }
+  if (top.has("motion")) {
+    const Field m = top.at("motion");
+    m.onlyKeys({"duration", "output_step"});
+    st.motion_duration = m.at("duration").number();
+    if (!(st.motion_duration > 0.0)) m.at("duration").fail("must be > 0 s, got " + number(st.motion_duration));
+    st.motion_output_step = m.has("output_step") ? m.at("output_step").number() : st.motion_duration / 100.0;
+    if (!(st.motion_output_step > 0.0)) m.at("output_step").fail("must be > 0 s, got " + number(st.motion_output_step));
+    try {
+      CaptureResult probe;
+      probe.contact_body_pose = KDL::Frame::Identity();
+      if (sc.capture.law.kind == ImpactKind::TranslationalCapture || !std::holds_alternative<RigidTarget>(sc.capture.target))
+        attachTarget(sc.capture, probe);  // refuses what no motion follows
+    } catch (const InputError& e) {
+      m.fail(std::string("no motion follows this scenario's capture: ") + e.what());
+    }
+  }
+  const FloatingModel& robot = *sc.capture.robot.model;
+  if (top.has("limits")) {
+    const Field l = top.at("limits");
+    l.onlyKeys({"joint_rate", "joint_torque", "base_rate"});
+    if (l.has("joint_rate")) st.limits.joint_rate = jointLimit(l.at("joint_rate"), robot, false);
+    if (l.has("joint_torque")) {
+      if (st.motion_duration <= 0.0) l.at("joint_torque").fail("the torques are those of the motion: give `motion` too");
+      st.limits.joint_torque = jointLimit(l.at("joint_torque"), robot, true);
+    }
+    if (l.has("base_rate")) {
+      st.limits.base_rate = l.at("base_rate").number();
+      if (!(*st.limits.base_rate > 0.0)) l.at("base_rate").fail("must be > 0 rad/s, got " + number(*st.limits.base_rate));
+    }
+  }
+  const std::vector<std::string> columns = studyColumns(st);
+  if (top.has("objective")) {
+    checkColumn(top.at("objective"), columns, "outcome");
+    st.objective = top.at("objective").text();
+  }
+  if (top.has("heat_map")) {
+    const Field h = top.at("heat_map");
+    h.onlyKeys({"x", "y", "outcome"});
+    for (const char* k : {"x", "y", "outcome"}) checkColumn(h.at(k), columns, "column");
+    st.heat_map = StudyHeatMap{h.at("x").text(), h.at("y").text(), h.at("outcome").text()};
+  }
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const std::string& file : {path, scenario_path, sc.robot_urdf, sc.target_urdf}) h = fold(h, file);
+  st.fingerprint = h;
+  return st;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,115 @@
+#include "study/study_sampling.hpp"
+
+#include <cmath>
+
+namespace kdl_space::sampling {
+
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+namespace {
+std::uint64_t key(std::uint64_t seed, std::uint64_t sample, std::uint64_t stream) {
+  return mix(mix(mix(seed) ^ sample) ^ (stream * 0xd1b54a32d192ed03ULL));
+}
+}  // namespace
+
+double unit(std::uint64_t seed, std::uint64_t sample, std::uint64_t stream) {
+  return (static_cast<double>(key(seed, sample, stream) >> 11) + 0.5) * 0x1.0p-53;
+}
+
+std::uint64_t permute(std::uint64_t i, std::uint64_t n, std::uint64_t seed, std::uint64_t stream) {
+  if (n <= 1) return 0;
+  int half = 1;
+  while (half < 32 && (std::uint64_t{1} << (2 * half)) < n) ++half;
+  const std::uint64_t mask = (std::uint64_t{1} << half) - 1;
+  const std::uint64_t k = key(seed, ~std::uint64_t{0}, stream);
+  std::uint64_t x = i;
+  do {  // cycle-walking: the network permutes [0, 4^half); iterate until the image is in [0, n)
+    std::uint64_t left = x >> half, right = x & mask;
+    for (std::uint64_t round = 0; round < 4; ++round) {
+      const std::uint64_t next = left ^ (mix(right ^ mix(k + round)) & mask);
+      left = right;
+      right = next;
+    }
+    x = (left << half) | right;
+  } while (x >= n);
+  return x;
+}
+
+double normalQuantile(double p) {
+  // Acklam's coefficients (relative error 1.15e-9), then one Halley step.
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01,  -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  const double p_low = 0.02425;
+  double x;
+  if (p < p_low) {
+    const double q = std::sqrt(-2.0 * std::log(p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  } else if (p <= 1.0 - p_low) {
+    const double q = p - 0.5, r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+  } else {
+    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  }
+  const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;  // Phi(x) - p
+  const double u = e * std::sqrt(2.0 * M_PI) * std::exp(0.5 * x * x);
+  return x - u / (1.0 + 0.5 * x * u);
+}
+
+std::uint64_t gridSize(const Study& study) {
+  std::uint64_t g = 1;
+  for (const StudyInput& in : study.inputs)
+    if (in.distribution.kind == Distribution::Kind::Grid) g *= static_cast<std::uint64_t>(in.distribution.count);
+  return g;
+}
+
+int valuesOf(const StudyInput& input) { return input.field == StudyInput::Field::TargetTumble ? 4 : 1; }
+
+void draw(const Study& study, std::uint64_t i, double* values) {
+  const std::uint64_t grid_index = i % gridSize(study);
+  for (std::size_t k = 0; k < study.inputs.size(); ++k) {
+    const StudyInput& in = study.inputs[k];
+    const Distribution& d = in.distribution;
+    const std::uint64_t stream = 4 * k;
+    double value;
+    if (d.kind == Distribution::Kind::Grid) {
+      // This input's grid coordinate: the last grid input varies fastest.
+      std::uint64_t stride = 1;
+      for (std::size_t later = k + 1; later < study.inputs.size(); ++later)
+        if (study.inputs[later].distribution.kind == Distribution::Kind::Grid)
+          stride *= static_cast<std::uint64_t>(study.inputs[later].distribution.count);
+      const std::uint64_t point = grid_index / stride % static_cast<std::uint64_t>(d.count);
+      value = d.count == 1 ? d.a : d.a + (d.b - d.a) * static_cast<double>(point) / static_cast<double>(d.count - 1);
+    } else {
+      double u = unit(study.seed, i, stream);
+      if (study.latin_hypercube)  // stratum permute(i) of `samples`, a uniform point inside it
+        u = (static_cast<double>(permute(i, study.samples, study.seed, stream)) + u) / static_cast<double>(study.samples);
+      value = d.kind == Distribution::Kind::Uniform ? d.a + (d.b - d.a) * u : d.a + d.b * normalQuantile(u);
+    }
+    *values++ = value;
+    if (in.field == StudyInput::Field::TargetTumble) {  // an axis uniform on the sphere
+      const double z = 2.0 * unit(study.seed, i, stream + 1) - 1.0;
+      const double phi = 2.0 * M_PI * unit(study.seed, i, stream + 2);
+      const double r = std::sqrt(1.0 - z * z);
+      *values++ = r * std::cos(phi);
+      *values++ = r * std::sin(phi);
+      *values++ = z;
+    }
+  }
+}
+
+}  // namespace kdl_space::sampling

@@ -1,0 +1,243 @@
+// Mimic joints (issue 12, item 5): a joint that follows another is not a coordinate; J*, H*, G*
+// and the velocity jump use the coupled coordinates (J T, T^T H T). Checked against the same
+// robot read without its <mimic> elements, with the coupling written out by hand.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <random>
+#include <string>
+
+#include "kdl_space/impact/collision.hpp"
+#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
+
+namespace kdl_space {
+namespace {
+
+std::string link(const std::string& name, double mass, double x) {
+  const std::string m = std::to_string(mass), c = std::to_string(x);
+  return R"(<link name=")" + name + R"("><inertial><origin xyz=")" + c + R"( 0.01 0" rpy="0.1 0.2 0.3"/><mass value=")" + m +
+         R"("/><inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0.001" ixz="0" iyz="0.002"/></inertial></link>)";
+}
+
+std::string joint(const std::string& name, const std::string& parent, const std::string& child, const std::string& xyz,
+                  const std::string& axis, const std::string& mimic = "") {
+  return R"(<joint name=")" + name + R"(" type="revolute"><parent link=")" + parent + R"("/><child link=")" + child +
+         R"("/><origin xyz=")" + xyz + R"(" rpy="0 0.3 0"/><axis xyz=")" + axis +
+         R"("/><limit lower="-2" upper="2" effort="10" velocity="1"/>)" + mimic + "</joint>";
+}
+
+/// A two-joint arm with a two-finger gripper; the right finger mimics the left (-1, +0.1), and
+/// the wrist camera's tilt mimics the elbow (0.5): two mimic joints on two branches.
+std::string gripper(bool with_mimic) {
+  const std::string right = with_mimic ? R"(<mimic joint="left_finger" multiplier="-1" offset="0.1"/>)" : "";
+  const std::string tilt = with_mimic ? R"(<mimic joint="elbow" multiplier="0.5"/>)" : "";
+  return R"(<?xml version="1.0"?><robot name="g">)" + link("base", 50.0, 0.0) +
+         joint("shoulder", "base", "upper", "0 0 0.5", "0 0 1") + link("upper", 3.0, 0.2) +
+         joint("elbow", "upper", "fore", "0.4 0 0", "0 1 0") + link("fore", 2.0, 0.2) +
+         joint("left_finger", "fore", "left", "0.4 0.05 0", "0 0 1") + link("left", 0.2, 0.05) +
+         joint("right_finger", "fore", "right", "0.4 -0.05 0", "0 0 1", right) + link("right", 0.2, 0.05) +
+         joint("camera_tilt", "upper", "camera", "0.1 0 0.1", "1 0 0", tilt) + link("camera", 0.5, 0.02) + "</robot>";
+}
+
+/// The coupling written out by hand from gripper()'s <mimic> elements: the free robot's joint
+/// values are T q + o of the coupled coordinates (shoulder, elbow, left_finger).
+struct Coupling {
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(5, 3);
+  Eigen::VectorXd o = Eigen::VectorXd::Zero(5);
+};
+
+Coupling handCoupling(const FloatingModel& free) {
+  Coupling c;
+  const auto at = [&](const std::string& name) { return free.jointIndex(name); };
+  c.T(at("shoulder"), 0) = 1.0;
+  c.T(at("elbow"), 1) = 1.0;
+  c.T(at("left_finger"), 2) = 1.0;
+  c.T(at("right_finger"), 2) = -1.0;
+  c.o(at("right_finger")) = 0.1;
+  c.T(at("camera_tilt"), 1) = 0.5;
+  return c;
+}
+
+/// A random state of the coupled robot and the same state of the free one.
+void randomStates(std::mt19937& rng, const Coupling& c, State& coupled, State& free) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  coupled.world_T_base = free.world_T_base =
+      KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+  for (int j = 0; j < 3; ++j) coupled.q(j) = u(rng);
+  free.q.data = c.T * coupled.q.data + c.o;
+}
+
+TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
+  ASSERT_EQ(coupled->jointNames(), (std::vector<std::string>{"shoulder", "elbow", "left_finger"}));
+  ASSERT_EQ(free->nj(), 5u);
+  const Coupling c = handCoupling(*free);
+  const Eigen::MatrixXd& T = c.T;
+  FreeFloatingSolver a(coupled), b(free);
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 5; ++trial) {
+    State sa(*coupled), sb(*free);
+    randomStates(rng, c, sa, sb);
+    ASSERT_EQ(a.compute(sa), 0);
+    ASSERT_EQ(b.compute(sb), 0);
+    const Eigen::MatrixXd H_star = T.transpose() * b.H_star().data * T;
+    EXPECT_TRUE(a.H_star().data.isApprox(H_star, 1e-12)) << a.H_star().data << "\n\n" << H_star;
+    EXPECT_TRUE(a.H().data.isApprox(T.transpose() * b.H().data * T, 1e-12));
+    for (const std::string& tip : {"right", "camera", "fore"}) {
+      const Contact ha = coupled->contact(tip, KDL::Vector(0.03, 0.0, 0.01));
+      const Contact hb = free->contact(tip, KDL::Vector(0.03, 0.0, 0.01));
+      KDL::Jacobian Ja(3), Jb(5);
+      ASSERT_EQ(a.J_star(ha, Ja), 0);
+      ASSERT_EQ(b.J_star(hb, Jb), 0);
+      const Eigen::MatrixXd J_star = Jb.data * T;
+      EXPECT_TRUE(Ja.data.isApprox(J_star, 1e-12)) << tip;
+      // G* = J* H*^-1 J*^T + R_h M_a^-1 R_h^T (eq. 11) in the coupled coordinates.
+      Matrix6d G_locked, Ga;
+      ASSERT_EQ(b.G_locked(hb, G_locked), 0);
+      const Eigen::MatrixXd G = J_star * H_star.ldlt().solve(J_star.transpose()) + G_locked;
+      ASSERT_EQ(a.G_star(ha, Ga), 0);
+      EXPECT_TRUE(Ga.isApprox(G, 1e-10)) << tip << "\n" << Ga << "\n\n" << G;
+      // A capture side on the coupled model takes the dense route by itself, and its velocity
+      // jump is H*^-1 J*^T F in the coupled coordinates (eq. 18).
+      FloatingVelocity v{KDL::Twist::Zero(), KDL::JntArray(3)};
+      FloatingSide side(coupled, sa, ha, v);
+      EXPECT_TRUE(side.G().isApprox(G, 1e-10)) << tip;
+      const Vector6d F = (Vector6d() << 1.0, -2.0, 0.5, 0.1, 0.2, -0.3).finished();
+      ASSERT_EQ(side.applyImpulse(F), 0);
+      const Eigen::VectorXd dq = H_star.ldlt().solve(J_star.transpose() * F);
+      EXPECT_TRUE(side.after().qdot.data.isApprox(dq, 1e-10)) << tip;
+    }
+  }
+}
+
+TEST(Mimic, TheRecursionsRefuseACoupledModelByName) {
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  for (int which = 0; which < 2; ++which) {  // the recursions; the simulation takes the dense route
+    try {
+      if (which == 0) RecursiveExIITSolver solver(coupled);
+      else ForwardDynamicsSolver solver(coupled);
+      ADD_FAILURE() << "a recursion accepted a model with mimic joints";
+    } catch (const ModelError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("'right_finger'"), std::string::npos) << what;
+      EXPECT_NE(what.find("'camera_tilt'"), std::string::npos) << what;
+    }
+  }
+  int notes = 0;
+  for (const Diagnostic& d : coupled->diagnostics()) notes += d.kind == "mimic_joint" || d.kind == "dense_route";
+  EXPECT_EQ(notes, 3);
+}
+
+TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
+  // M_c a_c + c_c = (0; tau_c) with M_c = T^T M T, c_c = T^T c (M, c: the robot without <mimic>,
+  // at the coupled state: q = T q_c + o, qdot = T qdot_c), T = diag(E_6, T_joints).
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  const auto free = std::make_shared<const FloatingModel>(loadUrdfString(gripper(false), "free.urdf"));
+  const Coupling c = handCoupling(*free);
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(11, 9);  // the base's six coordinates, then the joints'
+  T.topLeftCorner<6, 6>().setIdentity();
+  T.bottomRightCorner(5, 3) = c.T;
+  DenseForwardDynamics a(coupled), b(free);
+  ASSERT_EQ(a.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
+  ASSERT_EQ(b.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    State sa(*coupled), sb(*free);
+    randomStates(rng, c, sa, sb);
+    FloatingVelocity va{KDL::Twist(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng))),
+                        KDL::JntArray(3)};
+    for (int j = 0; j < 3; ++j) va.qdot(j) = u(rng);
+    FloatingVelocity vb{va.base_twist, KDL::JntArray(5)};
+    vb.qdot.data = T.bottomRightCorner(5, 3) * va.qdot.data;
+    KDL::JntArray tau(3), tau_free(5);
+    for (int j = 0; j < 3; ++j) tau(j) = u(rng);
+    FloatingAcceleration acc_a{Vector6d::Zero(), KDL::JntArray(3)}, acc_b{Vector6d::Zero(), KDL::JntArray(5)};
+    ASSERT_EQ(a.CartToJnt(sa, va, tau, {}, acc_a), 0);
+    ASSERT_EQ(b.CartToJnt(sb, vb, tau_free, {}, acc_b), 0);  // for M and c of the free robot
+    FreeFloatingSolver& k = b.kinematics();
+    Eigen::MatrixXd M(11, 11);
+    M << k.M_a(), k.A_m(), k.A_m().transpose(), k.H().data;
+    const Eigen::MatrixXd M_c = T.transpose() * M * T;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(9);
+    rhs.tail(3) = tau.data;
+    const Eigen::VectorXd a_c = M_c.ldlt().solve(rhs - T.transpose() * b.bias());
+    EXPECT_TRUE(acc_a.qddot.data.isApprox(a_c.tail(3), 1e-10)) << acc_a.qddot.data.transpose() << " vs "
+                                                               << a_c.tail(3).transpose();
+    // The base's acceleration at its origin from a_g at the CoM (the same kinematic identity).
+    const Vector3d P = k.r_g(), p_b = toEigen(sa.world_T_base.p);
+    const Vector3d w = toEigen(va.base_twist.rot), v_b = toEigen(va.base_twist.vel);
+    Vector6d base;
+    base << a_c.head<3>() + Vector3d(a_c.segment<3>(3)).cross(p_b - P) + w.cross(v_b), a_c.segment<3>(3);
+    EXPECT_TRUE(acc_a.base.isApprox(base, 1e-10)) << acc_a.base.transpose() << " vs " << base.transpose();
+  }
+}
+
+TEST(Mimic, TheMotionOfACoupledRobotKeepsItsEnergyAndMomentum) {
+  // In orbit, no torques: the coupled motion conserves energy and momentum (the simulation
+  // takes the dense route by itself).
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
+  Simulator simulator(coupled);
+  SimulationState s{0.0, State(*coupled), FloatingVelocity{KDL::Twist(KDL::Vector(0.01, 0.0, -0.02),
+                                                                      KDL::Vector(0.02, -0.01, 0.03)),
+                                                           KDL::JntArray(3)}};
+  s.velocity.qdot(0) = 0.4;
+  s.velocity.qdot(1) = -0.3;
+  s.velocity.qdot(2) = 0.8;
+  double T0 = 0.0, T1 = 0.0;
+  Vector6d h0, h1;
+  ASSERT_EQ(simulator.energyAndMomentum(s, T0, h0), 0);
+  ASSERT_EQ(simulator.run(s, 2.0, 0.5, [](const SimulationState&) {}), 0);
+  ASSERT_EQ(simulator.energyAndMomentum(s, T1, h1), 0);
+  EXPECT_NEAR(T1, T0, 1e-8 * T0);
+  EXPECT_LT((h1 - h0).norm(), 1e-8 * h0.norm());
+  EXPECT_GT((s.state.q.data).norm(), 0.1);  // it moved
+}
+
+TEST(Mimic, JointsThatFollowEachOtherAreRefused) {
+  // left_finger follows right_finger, which follows left_finger: no coordinate moves them.
+  std::string xml = gripper(true);
+  const std::string left = R"(<joint name="left_finger" type="revolute">)";
+  xml.insert(xml.find("</joint>", xml.find(left)), R"(<mimic joint="right_finger"/>)");
+  try {
+    loadUrdfString(xml, "cycle.urdf");
+    ADD_FAILURE() << "a cycle of mimic joints loaded";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("its <mimic> joints form a cycle"), std::string::npos) << e.what();
+  }
+  // check says so too, for each joint of the cycle (one set of rules).
+  const UrdfReport report = checkUrdfString(xml, "cycle.urdf");
+  ASSERT_EQ(report.errors.size(), 2u);
+  for (const Finding& f : report.errors) EXPECT_EQ(f.kind, "bad_mimic");
+  try {
+    loadUrdfString(xml, "cycle.urdf");
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), "cycle.urdf: " + describe(report.errors[0]));
+  }
+}
+
+TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
+  std::string xml = gripper(true);
+  xml.replace(xml.find(R"(mimic joint="elbow")"), 19, R"(mimic joint="elbo")");
+  try {
+    loadUrdfString(xml, "bad.urdf");
+    ADD_FAILURE() << "a mimic of an unknown joint loaded";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("joint 'camera_tilt': mimics 'elbo', which is no movable joint"),
+              std::string::npos) << e.what();
+    const UrdfReport report = checkUrdfString(xml, "bad.urdf");
+    ASSERT_EQ(report.errors.size(), 1u);
+    EXPECT_EQ(report.errors[0].kind, "bad_mimic");
+    EXPECT_EQ(std::string(e.what()), "bad.urdf: " + describe(report.errors[0]));
+  }
+}
+
+}  // namespace
+}  // namespace kdl_space

@@ -1,0 +1,275 @@
+// loadScenario (scenario.hpp): the bundled and test scenarios load into the library's types with
+// the values their files hold, and a broken file is refused with an InputError that names the
+// file, the line and the field (the same messages `kdl_space capture` prints: tests/cli checks
+// the whole corpus end to end; here a few through the library alone).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "test_util.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kShipped = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+const std::string kBroken = dataDir() + "/broken_scenarios/";
+
+TEST(LoadScenario, ARigidTargetInTheFilesTerms) {
+  const Scenario s = loadScenario(kShipped + "tumbling_box_capture.yaml");
+  EXPECT_EQ(s.file, kShipped + "tumbling_box_capture.yaml");
+  EXPECT_EQ(s.robot_urdf, fs::path(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/space_arm7.urdf").lexically_normal().string());
+  EXPECT_EQ(s.target_urdf, "");
+  const CaptureProblem& p = s.capture;
+  ASSERT_TRUE(p.robot.model);
+  EXPECT_EQ(p.robot.model->jointNames().size(), 7u);
+  EXPECT_EQ(p.robot.contact.body, p.robot.model->bodyIndex("end_effector"));
+  EXPECT_TRUE(near(toEigen(p.robot.contact.offset), Vector3d(0, 0, 0.05), 0.0, 0.0, "offset"));
+  EXPECT_EQ(p.robot.response, Response::FreeFloating);
+  EXPECT_EQ(p.robot.state.q(p.robot.model->jointIndex("joint3")), 0.9);
+  EXPECT_EQ(p.robot.state.q(p.robot.model->jointIndex("joint1")), 0.0);
+  EXPECT_EQ(p.robot.velocity.qdot(p.robot.model->jointIndex("joint4")), -0.03);
+  EXPECT_TRUE(near(toEigen(p.robot.velocity.base_twist), (Vector6d() << 0.002, 0, 0, 0, 0, 0.001).finished(), 0, 0, "twist"));
+  ASSERT_TRUE(std::holds_alternative<RigidTarget>(p.target));
+  const RigidTarget& t = std::get<RigidTarget>(p.target);
+  EXPECT_EQ(t.mass, 50.0);
+  EXPECT_TRUE(near(t.inertia, Vector3d(2.1, 2.6, 3.0).asDiagonal().toDenseMatrix(), 0, 0, "inertia in the target frame"));
+  EXPECT_TRUE(near(toEigen(t.pose.p), Vector3d(0.32, -2.88, 1.69), 0, 0, "pose.position"));
+  EXPECT_TRUE(near(toEigen(t.pose.M), toEigen(KDL::Rotation::RPY(0.3, -0.2, 0.5)), 0, 0, "pose.rpy"));
+  EXPECT_TRUE(near(t.com, Vector3d::Zero(), 0, 0, "com"));
+  EXPECT_TRUE(near(t.twist, (Vector6d() << 0.03, -0.02, 0.01, 0.05, 0.08, -0.06).finished(), 0, 0, "twist"));
+  EXPECT_EQ(p.law.kind, ImpactKind::Capture);
+  EXPECT_TRUE(p.has_normal);
+  EXPECT_TRUE(near(p.law.normal, Vector3d(0, -1, 0), 0, 0, "normal"));
+  EXPECT_EQ(p.method, ExIITMethod::Recursive);
+  // The simulation section.
+  EXPECT_EQ(s.simulation.duration, 20.0);
+  EXPECT_EQ(s.simulation.output_step, 0.05);
+  EXPECT_EQ(s.simulation.options.integrator, Integrator::DormandPrince54);
+  EXPECT_EQ(s.simulation.options.rtol, 1e-10);
+  ASSERT_EQ(s.simulation.joints.size(), 7u);
+  EXPECT_EQ(s.simulation.joints[1].first, static_cast<unsigned int>(p.robot.model->jointIndex("joint2")));
+  EXPECT_EQ(s.simulation.joints[1].second.mode, JointControl::Mode::PD);
+  EXPECT_EQ(s.simulation.joints[1].second.set_point, 0.7);
+  // It solves.
+  EXPECT_NO_THROW(solveCapture(p));
+}
+
+TEST(LoadScenario, AFreeFloatingTarget) {
+  const Scenario s = loadScenario(kShipped + "robot_to_robot_capture.yaml");
+  ASSERT_TRUE(std::holds_alternative<FloatingSystem>(s.capture.target));
+  const FloatingSystem& t = std::get<FloatingSystem>(s.capture.target);
+  ASSERT_TRUE(t.model);
+  EXPECT_EQ(t.model->jointNames(), (std::vector<std::string>{"joint1", "joint2"}));
+  EXPECT_EQ(t.contact.body, t.model->bodyIndex("hand"));
+  EXPECT_EQ(t.velocity.qdot(1), -0.02);
+  EXPECT_EQ(s.target_urdf,
+            fs::path(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/spacedyn_twolink.urdf").lexically_normal().string());
+  EXPECT_FALSE(s.capture.has_normal);
+  // No simulation section: the defaults.
+  EXPECT_EQ(s.simulation.duration, SimulationSpec().duration);
+  EXPECT_TRUE(s.simulation.joints.empty());
+  const CaptureResult r = solveCapture(s.capture);
+  EXPECT_TRUE(r.floating_target.has_value());
+}
+
+TEST(LoadScenario, BrakedJointsOfTheRobotAndOfAFreeFloatingTarget) {
+  const Scenario s = loadScenario(dataDir() + "/scenarios/braked_robot_to_robot.yaml");
+  const FloatingSystem& robot = s.capture.robot;
+  ASSERT_TRUE(std::holds_alternative<FloatingSystem>(s.capture.target));
+  const FloatingSystem& target = std::get<FloatingSystem>(s.capture.target);
+  EXPECT_EQ(robot.locked, (std::vector<bool>{false, false, false, false, false, true, true}));  // model order
+  EXPECT_EQ(target.locked, (std::vector<bool>{false, true}));
+  const CaptureResult r = solveCapture(s.capture);
+  ASSERT_TRUE(r.floating_target.has_value());
+  EXPECT_EQ(r.robot.after.qdot(robot.model->jointIndex("joint6")), 0.0);
+  EXPECT_EQ(r.robot.after.qdot(robot.model->jointIndex("joint7")), 0.0);
+  EXPECT_EQ(r.floating_target->after.qdot(target.model->jointIndex("joint2")), 0.0);
+  EXPECT_NE(r.robot.after.qdot(robot.model->jointIndex("joint5")), 0.0) << "an unbraked joint moves";
+  EXPECT_TRUE(near(r.momentum_after, r.momentum_before, 1e-9, 1e-9 * r.momentum_before.norm(), "momentum"));
+  // Without the brakes the same capture moves those joints.
+  CaptureProblem unbraked = s.capture;
+  unbraked.robot.locked.clear();
+  std::get<FloatingSystem>(unbraked.target).locked.clear();
+  EXPECT_NE(solveCapture(unbraked).robot.after.qdot(robot.model->jointIndex("joint7")), 0.0);
+}
+
+// simulation.joints and simulation.limits by name and pattern: "*" is the default, a later
+// pattern wins over an earlier one, a name over every pattern, in whatever order they are written.
+TEST(LoadScenario, JointPatternsResolveByPrecedence) {
+  const std::string path = (fs::path(::testing::TempDir()) / "patterns.yaml").string();
+  std::ofstream(path) << "robot:\n  urdf: " << urdfDir() << "/space_arm7.urdf\n  contact: {link: end_effector}\n"
+                      << "simulation:\n  joints:\n    joint6: locked\n    \"joint[5-7]\": free\n"
+                      << "    \"*\": {pd: {kp: 10, kd: 2, set_point: hold}}\n    \"joint?\": {pd: {kp: 20, kd: 3, set_point: 0.5}}\n"
+                      << "  limits: {\"*\": stop, \"joint[1-2]\": ignore, joint1: warn}\n";
+  const Scenario s = loadScenario(path);
+  EXPECT_FALSE(s.impact);
+  std::map<unsigned int, JointControl> c(s.simulation.joints.begin(), s.simulation.joints.end());
+  ASSERT_EQ(c.size(), 7u);
+  for (unsigned int j : {0u, 1u, 2u, 3u}) {  // "joint?" (written after "*") wins over "*"
+    EXPECT_EQ(c[j].mode, JointControl::Mode::PD);
+    EXPECT_EQ(c[j].kp, 20.0);
+    EXPECT_FALSE(c[j].hold);
+    EXPECT_EQ(c[j].set_point, 0.5);
+  }
+  // "joint[5-7]" and "joint?" both match joint5 and joint7: the one written later wins
+  EXPECT_EQ(c[4].mode, JointControl::Mode::PD);
+  EXPECT_EQ(c[6].mode, JointControl::Mode::PD);
+  EXPECT_EQ(c[5].mode, JointControl::Mode::Locked) << "a name wins over every pattern";
+  std::map<unsigned int, LimitMode> l(s.simulation.limits.begin(), s.simulation.limits.end());
+  EXPECT_EQ(l[0], LimitMode::Warn);
+  EXPECT_EQ(l[1], LimitMode::Ignore);
+  for (unsigned int j = 2; j < 7; ++j) EXPECT_EQ(l[j], LimitMode::Stop);
+}
+
+TEST(LoadScenario, EveryShippedAndTestScenarioLoadsAndSolves) {
+  int count = 0;
+  for (const std::string& folder : {kShipped, dataDir() + "/scenarios/"})
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".yaml" && ext != ".json") continue;
+      if (entry.path().filename().string().rfind("study_", 0) == 0) continue;  // a study (tests/study)
+      SCOPED_TRACE(entry.path().string());
+      const Scenario s = loadScenario(entry.path().string());
+      ASSERT_TRUE(s.capture.robot.model);
+      ++count;
+      if (!s.impact) continue;  // a plain motion: no impact to solve
+      const bool point = s.capture.law.kind == ImpactKind::PointImpact || s.capture.law.kind == ImpactKind::FrictionalImpact;
+      if (point) EXPECT_TRUE(s.capture.has_normal);
+      EXPECT_NO_THROW(solveCapture(s.capture));
+    }
+  EXPECT_GE(count, 10);
+}
+
+TEST(LoadScenario, PointImpactLaw) {
+  const Scenario s = loadScenario(kShipped + "restitution_bounce.yaml");
+  EXPECT_EQ(s.capture.law.kind, ImpactKind::PointImpact);
+  EXPECT_EQ(s.capture.law.restitution, 0.6);
+  EXPECT_TRUE(s.capture.has_normal);
+}
+
+/// The message loadScenario throws for `file`, or "" if it loads.
+std::string refusal(const std::string& file) {
+  try {
+    loadScenario(file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
+  EXPECT_EQ(refusal(kBroken + "valid.yaml"), "");
+  EXPECT_EQ(refusal(kBroken + "negative_mass.yaml"), kBroken + "negative_mass.yaml:10: target.mass: must be > 0 kg, got -3");
+  EXPECT_EQ(refusal(kBroken + "inertia_not_symmetric.yaml"),
+            kBroken + "inertia_not_symmetric.yaml:11: target.inertia: must be symmetric, but row 2 column 1 is 0 and "
+                      "row 1 column 2 is 0.2");
+  EXPECT_EQ(refusal(kBroken + "inertia_triangle_inequality.yaml"),
+            kBroken + "inertia_triangle_inequality.yaml:11: target.inertia: is no rigid body's inertia: its principal "
+                      "moments break the triangle inequality I1 + I2 >= I3 (principal moments 1, 1, 3 kg m^2)");
+  EXPECT_EQ(refusal(kBroken + "unknown_joint.yaml"),
+            kBroken + "unknown_joint.yaml:6: robot.q.elbow: the model has no movable joint 'elbow' (its movable "
+                      "joints: joint1, joint2)");
+  EXPECT_EQ(refusal(kBroken + "huge_number.yaml"),
+            kBroken + "huge_number.yaml:10: target.mass: '1e400' is too large (not a finite number)");
+  EXPECT_EQ(refusal(kBroken + "empty.yaml"), kBroken + "empty.yaml: the file is empty; expected a scenario file (YAML or JSON)");
+  EXPECT_EQ(refusal(kBroken + "locked_joint_moves.yaml"),
+            kBroken + "locked_joint_moves.yaml:9: robot.locked[1]: joint 'joint2' is braked, so its rate "
+                      "robot.qdot.joint2 must be 0, got 0.1");
+  EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
+}
+
+
+// --- A rigid target read from a URDF ---------------------------------------------------------
+
+/// A copy of the tumbling-box scenario whose target is `target` (YAML lines), in a scratch folder.
+std::string withTarget(const std::string& name, const std::string& target) {
+  std::ifstream in(kShipped + "tumbling_box_capture.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::size_t from = s.find("target:\n"), to = s.find("law:\n");
+  s.replace(from, to - from, "target:\n" + target);
+  const std::size_t urdf = s.find("../urdf/");
+  s.replace(urdf, 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_rigid_urdf";
+  fs::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << s;
+  return path;
+}
+
+TEST(LoadScenario, ARigidTargetFromAUrdfIsTheSameBodyAsByNumbers) {
+  // satellite_panel.urdf: a 100 kg hub (10, 12, 14 kg m^2) and a 5 kg panel (1, 0.1, 1.1) fixed
+  // 1.5 m along y. By hand: CoM 1.5 * 5 / 105 along y; parallel axes about it on x and z:
+  // 100 (1.5/21)^2 + 5 (1.5 * 20/21)^2 = 4725/441.
+  const double shift = 4725.0 / 441.0;
+  const std::string base = "  base: {position: [-0.6, -2.9, 1.7], rpy: [0.3, -0.2, 0.5], twist: [0.03, -0.02, 0.01, 0.05, 0.08, -0.06]}\n";
+  const Scenario from_urdf = loadScenario(withTarget("satellite_urdf.yaml", "  urdf: " + dataDir() + "/rigid_target/satellite_panel.urdf\n" + base));
+  ASSERT_TRUE(std::holds_alternative<RigidTarget>(from_urdf.capture.target));
+  const RigidTarget& t = std::get<RigidTarget>(from_urdf.capture.target);
+  EXPECT_NEAR(t.mass, 105.0, 1e-12);
+  EXPECT_TRUE(near(t.com, Vector3d(0, 7.5 / 105.0, 0), 1e-12, 1e-14, "CoM in the hub's frame"));
+  EXPECT_TRUE(near(t.inertia, Vector3d(11.0 + shift, 12.1, 15.1 + shift).asDiagonal().toDenseMatrix(), 1e-12, 1e-12, "inertia"));
+  // the same body by numbers: the twist of the base origin moved to the CoM by hand
+  const KDL::Frame pose(KDL::Rotation::RPY(0.3, -0.2, 0.5), KDL::Vector(-0.6, -2.9, 1.7));
+  const Vector3d c = toEigen(pose * KDL::Vector(0, 7.5 / 105.0, 0));
+  const Vector3d w(0.05, 0.08, -0.06), v_o(0.03, -0.02, 0.01);
+  const Vector3d v_c = v_o + w.cross(c - Vector3d(-0.6, -2.9, 1.7));
+  std::ostringstream numbers;
+  numbers.precision(17);
+  numbers << "  mass: 105\n  inertia: [[" << 11.0 + shift << ", 0, 0], [0, 12.1, 0], [0, 0, " << 15.1 + shift << "]]\n"
+          << "  pose: {position: [-0.6, -2.9, 1.7], rpy: [0.3, -0.2, 0.5]}\n  com: [0, " << 7.5 / 105.0 << ", 0]\n"
+          << "  twist: [" << v_c.x() << ", " << v_c.y() << ", " << v_c.z() << ", 0.05, 0.08, -0.06]\n";
+  const Scenario by_numbers = loadScenario(withTarget("satellite_numbers.yaml", numbers.str()));
+  const CaptureResult a = solveCapture(from_urdf.capture), b = solveCapture(by_numbers.capture);
+  EXPECT_TRUE(near(a.impulse.F, b.impulse.F, 1e-10, 1e-14, "impulse"));
+  // (1e-10: the inertia summed in another order, through the capture's conditioning)
+  EXPECT_TRUE(near(a.robot.after.qdot.data, b.robot.after.qdot.data, 1e-10, 1e-14, "joint rates after"));
+  EXPECT_TRUE(near(a.target_twist_after, b.target_twist_after, 1e-10, 1e-14, "target after"));
+  EXPECT_NEAR(a.energyLost(), b.energyLost(), 1e-12 * a.energy_before);
+}
+
+TEST(LoadScenario, ALinkSubtreeOfAUrdfIsOneRigidBodyAtItsJointAngles) {
+  // boom.urdf: the boom (2 kg, CoM 0.5 m out, 0.01/0.2/0.2) and a 1 kg gripper fixed 1 m out.
+  // By hand, in the boom's frame: CoM 2/3 m out; I_yy = I_zz = 0.2 + 0.01 + 2 (1/6)^2 + 1 (1/3)^2.
+  const Scenario s = loadScenario(withTarget(
+      "boom.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: boom\n  q: {boom_joint: 0.3}\n"
+                   "  base: {position: [-0.6, -2.9, 1.7]}\n"));
+  const RigidTarget& t = std::get<RigidTarget>(s.capture.target);
+  EXPECT_NEAR(t.mass, 3.0, 1e-12);
+  EXPECT_TRUE(near(t.com, Vector3d(2.0 / 3.0, 0, 0), 1e-12, 1e-14, "CoM"));
+  const double I = 0.21 + 2.0 / 36.0 + 1.0 / 9.0;
+  EXPECT_TRUE(near(t.inertia, Vector3d(0.02, I, I).asDiagonal().toDenseMatrix(), 1e-12, 1e-14, "inertia"));
+  EXPECT_TRUE(near(toEigen(t.pose.M), toEigen(KDL::Rotation::RotZ(0.3)), 1e-14, 1e-14, "the boom's frame"));
+  EXPECT_TRUE(near(toEigen(t.pose.p), Vector3d(-0.6, -2.9, 2.2), 1e-14, 1e-14, "at the joint"));
+  // the links from a fixed one down: the gripper alone
+  const Scenario gripper = loadScenario(withTarget(
+      "gripper.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: gripper\n  q: {boom_joint: 0.3}\n"));
+  EXPECT_NEAR(std::get<RigidTarget>(gripper.capture.target).mass, 1.0, 1e-12);
+  // a rigid URDF target has no contact of its own; a link that is not in the file is named
+  try {
+    loadScenario(withTarget("contact.yaml", "  urdf: " + dataDir() + "/rigid_target/satellite_panel.urdf\n  contact: {link: hub}\n"));
+    ADD_FAILURE() << "a contact on a rigid URDF target accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("target.contact: the target is read as one rigid body (its file has no movable joint)"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    loadScenario(withTarget("nolink.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: antenna\n"));
+    ADD_FAILURE() << "an unknown link accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("target.link: the model has no link 'antenna' (its links: hub, boom, gripper)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace kdl_space::test
