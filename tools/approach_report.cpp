@@ -42,15 +42,4 @@ void printApproach(std::ostream& out, const Scenario& sc, const ApproachOutcome&
       << r.base_rotation * 180 / M_PI << " deg\n\n";
 }
 
-std::string approachFailure(const Scenario& sc, const ApproachOutcome& o) {
-  const ApproachRecord& r = o.record;
-  std::ostringstream why;
-  why << std::setprecision(6) << sc.file << ": approach: the hand never reached the grasp point in "
-      << sc.approach->max_duration << " s (approach.max_duration): closest " << r.closest_distance << " m at t = "
-      << r.closest_time << " s, " << r.final_distance << " m at the end (tolerance " << sc.approach->position_tolerance
-      << " m); smallest singular value of J* " << r.min_sigma
-      << ": is the grasp point within the arm's reach, the gain high enough, the target slow enough?";
-  return why.str();
-}
-
 }  // namespace kdl_space::cli

@@ -5,21 +5,13 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
 
 namespace kdl_space::cli {
-
-/// The approach's outcome as the tool reports it.
-struct ApproachOutcome {
-  ApproachRecord record;
-  RigidTarget target_at_contact;  ///< the target at the end of the approach
-};
 
 /// The `approach` object of the JSON (keys are a contract: add, never rename).
 Json approachJson(const Scenario& scenario, const ApproachOutcome& outcome);
 /// The approach in a few lines of text.
 void printApproach(std::ostream& out, const Scenario& scenario, const ApproachOutcome& outcome);
-/// Why a run that never reached the grasp point failed (closest distance and when).
-std::string approachFailure(const Scenario& scenario, const ApproachOutcome& outcome);
 
 }  // namespace kdl_space::cli

@@ -19,7 +19,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
   out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity,phase,grasp_distance\n";
 }
 
-void CsvWriter::write(const Sample& s) {
+void CsvWriter::write(const MotionSample& s) {
   out_ << s.t;
   for (int i = 0; i < 3; ++i) out_ << ',' << s.p(i);
   for (int i = 0; i < 4; ++i) out_ << ',' << s.quat(i);
@@ -32,7 +32,7 @@ void CsvWriter::write(const Sample& s) {
   if (base_control_)
     for (int i = 0; i < 6; ++i) out_ << ',' << s.base_wrench(i);
   for (int i = 0; i < 6; ++i) out_ << ',' << s.work(i);
-  out_ << ',' << s.phase << ',';
+  out_ << ',' << toString(s.phase) << ',';
   if (!std::isnan(s.grasp_distance)) out_ << s.grasp_distance;  // empty outside the approach
   out_ << '\n';
 }

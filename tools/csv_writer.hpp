@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "sample.hpp"
+#include "kdl_space/operation/motion_sample.hpp"
 
 namespace kdl_space::cli {
 
@@ -16,7 +16,7 @@ class CsvWriter {
   /// Opens the temporary file and writes the header; throws InputError if it cannot.
   /// `base_control`: the base control's wrench columns are written.
   CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control);
-  void write(const Sample& s);
+  void write(const MotionSample& s);
   /// Flushes and closes the temporary file; throws InputError if a write failed.
   void close();
   /// The file, to commit (or retract) once every output is complete.

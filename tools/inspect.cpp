@@ -73,9 +73,20 @@ CLI::App* addInspect(CLI::App& app, InspectOptions& o) {
   return cmd;
 }
 
-void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& out) {
-  const std::vector<ContactRequest> requests = pairContacts(command, o);
+namespace {
+
+/// The model and the state `inspect` looks at, and the contact points, from the options; every
+/// refusal names its option.
+struct Inspected {
+  std::shared_ptr<const FloatingModel> model;
+  State state;
+  std::vector<Contact> contacts;
   std::map<std::string, double> q_by_name;
+};
+
+Inspected inspected(const InspectOptions& o, const std::vector<ContactRequest>& requests) {
+  Inspected in;
+  std::map<std::string, double>& q_by_name = in.q_by_name;
   for (const std::string& a : o.q) {
     const auto [name, value] = parseAssignment(a, "--q");
     if (!q_by_name.emplace(name, value).second) throw UsageError("--q " + name + " given twice");
@@ -83,9 +94,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   for (double v : o.base_pos) if (!std::isfinite(v)) throw UsageError("--base-pos: not a finite number");
   for (double v : o.base_rpy) if (!std::isfinite(v)) throw UsageError("--base-rpy: not a finite number");
 
-  std::shared_ptr<const FloatingModel> model;
-  State state;
-  std::vector<Contact> contacts;
+  std::shared_ptr<const FloatingModel>& model = in.model;
   checkInputFile(o.urdf, "URDF file");
   try {
     model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
@@ -109,14 +118,26 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     }
   }
   try {
-    state = State(*model);
-    state.q = jointsByName(*model, q_by_name);
-    for (const ContactRequest& r : requests) contacts.push_back(model->contact(r.link, r.offset));
+    in.state = State(*model);
+    in.state.q = jointsByName(*model, q_by_name);
+    for (const ContactRequest& r : requests) in.contacts.push_back(model->contact(r.link, r.offset));
   } catch (const ModelError& e) {
     throw InputError(e.what());
   }
-  state.world_T_base = basePose(KDL::Vector(o.base_pos[0], o.base_pos[1], o.base_pos[2]),
-                                o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
+  in.state.world_T_base = basePose(KDL::Vector(o.base_pos[0], o.base_pos[1], o.base_pos[2]),
+                                   o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
+  return in;
+}
+
+}  // namespace
+
+void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& out) {
+  const std::vector<ContactRequest> requests = pairContacts(command, o);
+  const Inspected in = inspected(o, requests);
+  const std::shared_ptr<const FloatingModel>& model = in.model;
+  const State& state = in.state;
+  const std::vector<Contact>& contacts = in.contacts;
+  const std::map<std::string, double>& q_by_name = in.q_by_name;
 
   FreeFloatingSolver solver(model);
   if (const int rc = solver.compute(state))

@@ -28,22 +28,22 @@ std::string plotTerminal(const std::string& path, std::size_t panels) {
 
 /// Base attitude, joint angles, momentum and energy error over time, drawn by gnuplot into
 /// out.tmp() (the caller commits it).
-void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
+void writePlot(const AtomicFile& out, const std::vector<MotionSample>& samples, const std::vector<std::string>& joints,
                const std::string& title, bool torques, double capture_time) {
   const std::string& path = out.path();
   const std::size_t groups = std::max<std::size_t>(1, (joints.size() + kJointsPerPanel - 1) / kJointsPerPanel);
   bool distance = false;  // an approach: its distance to the grasp point
-  for (const Sample& s : samples) distance = distance || !std::isnan(s.grasp_distance);
+  for (const MotionSample& s : samples) distance = distance || !std::isnan(s.grasp_distance);
   const std::size_t panels = 2 + groups * (torques ? 2 : 1) + (distance ? 1 : 0);
   const std::string terminal = plotTerminal(path, panels);
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
   {
     std::ofstream d(data.path());
     d << std::setprecision(12);
-    const Sample* first = &samples.front();  // of the phase: the balance restarts at the capture
-    for (const Sample& s : samples) {
-      if (std::string(s.phase) == "post" && std::string(first->phase) != "post") first = &s;
-      const Sample& s0 = *first;
+    const MotionSample* first = &samples.front();  // of the phase: the balance restarts at the capture
+    for (const MotionSample& s : samples) {
+      if (s.phase == Phase::Post && first->phase != Phase::Post) first = &s;
+      const MotionSample& s0 = *first;
       const double h_scale = std::max(s0.h.norm(), 1e-300);
       double roll, pitch, yaw;
       KDL::Rotation::Quaternion(s.quat(0), s.quat(1), s.quat(2), s.quat(3)).GetRPY(roll, pitch, yaw);

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "sample.hpp"
+#include "kdl_space/operation/motion_sample.hpp"
 
 namespace kdl_space::cli {
 
@@ -24,7 +24,7 @@ std::string plotTerminal(const std::string& path, std::size_t panels = 3);
 /// `torques`: draw the joint torques too. `capture_time` (finite): a vertical line marks the
 /// capture on every panel. With samples of the approach, a panel shows the hand-to-grasp distance.
 /// The momentum and energy balance of each phase is measured from the phase's first sample.
-void writePlot(const AtomicFile& out, const std::vector<Sample>& samples, const std::vector<std::string>& joints,
+void writePlot(const AtomicFile& out, const std::vector<MotionSample>& samples, const std::vector<std::string>& joints,
                const std::string& title, bool torques,
                double capture_time = std::numeric_limits<double>::quiet_NaN());
 

@@ -99,5 +99,6 @@ void bindCapture(py::module_& m);
 void bindForwardDynamics(py::module_& m);
 void bindSimulation(py::module_& m);
 void bindStudy(py::module_& m);
+void bindOperation(py::module_& m);
 
 }  // namespace kdl_space::python

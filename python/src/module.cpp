@@ -16,4 +16,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindForwardDynamics(m);
   bindSimulation(m);
   bindStudy(m);
+  bindOperation(m);
 }

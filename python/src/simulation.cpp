@@ -2,11 +2,8 @@
 // base controls, scheduled wrenches, and run(): the samples as NumPy arrays, with a Python
 // controller called at a control rate (zero-order hold) or at every derivative evaluation.
 //
-// The zero-order hold is one C++ run whose output instants are a grid of step delta on which both
-// the control instants t0 + k / rate and the samples t0 + m output_dt lie: no step straddles a
-// control instant, so the torque callback returns the command held since the last one, and the
-// observer, which sees the exact state at each instant, calls the controller there (the sample
-// at a control instant shows the new command: Simulator::actuation).
+// The zero-order hold is the library's (runSampled, simulation/sampled_control.hpp); here only the
+// Python controller's call and its conversions.
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -16,7 +13,7 @@
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
-#include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/simulation/sampled_control.hpp"
 #include "simulation_types.hpp"
 
 namespace kdl_space::python {
@@ -73,32 +70,6 @@ struct PySimulator {
   }
 };
 
-/// Control instants and samples on one grid: the grid step delta, a control every `a` grid
-/// instants (0: none), a sample every `b`.
-struct Grid {
-  double delta;
-  long a = 0, b = 1;
-};
-
-Grid gridOf(double output_dt, double period) {
-  Grid g{output_dt};
-  if (!(output_dt > 0.0) || !std::isfinite(output_dt)) return g;  // run() refuses it with its code
-  const double r = period / output_dt;
-  for (long b = 1; b <= 1000; ++b) {
-    const double x = r * b;
-    const long a = std::lround(x);
-    if (a >= 1 && std::abs(x - a) <= 1e-9 * x) {
-      g.a = a, g.b = b;
-      g.delta = a == 1 ? period : b == 1 ? output_dt : period / a;
-      return g;
-    }
-  }
-  std::ostringstream why;
-  why << "output_dt: " << output_dt << " s and the control period 1 / control_rate = " << period
-      << " s are not commensurate (their ratio is no fraction a / b with b <= 1000)";
-  throw py::value_error(why.str());
-}
-
 [[noreturn]] void raiseRunError(int rc, const SimulationState& s, double t0, double t_end, py::object partial) {
   std::ostringstream what;
   what << "Simulator.run: " << strError(rc) << " at t = " << s.t << " s (the run was from " << t0 << " to " << t_end
@@ -121,64 +92,46 @@ PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, 
   if (!controller.is_none() && !PyCallable_Check(controller.ptr()))
     throw py::type_error("controller: expected a callable controller(t, q, qdot, base_pose, base_twist) -> tau");
   if (controller.is_none() && !control_rate.is_none()) throw py::value_error("control_rate: given without a controller");
-  const bool hold = !control_rate.is_none();
-  Grid grid{output_dt};
-  if (hold) {
-    const double rate = py::cast<double>(control_rate);
+  double rate = 0.0;  // 0: the controller at every evaluation
+  if (!control_rate.is_none()) {
+    rate = py::cast<double>(control_rate);
     if (!(rate > 0.0) || !std::isfinite(rate))
       throw py::value_error("control_rate: expected a finite rate > 0 [Hz], got " + std::to_string(rate));
-    grid = gridOf(output_dt, 1.0 / rate);
+    try {
+      controlGrid(output_dt, 1.0 / rate);
+    } catch (const InputError& e) {
+      throw py::value_error(e.what());  // a bad argument of this call
+    }
   }
-  Eigen::VectorXd command = Eigen::VectorXd::Zero(model.nj());
-  bool commanded = false;
-  const auto call = [&](const SimulationState& x) {
-    py::gil_scoped_acquire gil;
-    const py::object r = controller(x.t, toNumpyVec(x.state.q.data), toNumpyVec(x.velocity.qdot.data),
-                                    frameToNumpy(x.state.world_T_base), toNumpy6(toEigen(x.velocity.base_twist)));
-    const KDL::JntArray tau = jointValues(model, r, "controller: tau");
-    if (!tau.data.allFinite())
-      throw py::value_error("controller: returned a torque that is not finite at t = " + std::to_string(x.t) + " s");
-    command = tau.data;
-    commanded = true;
-  };
+  // The library's zero-order hold (runSampled) around the Python controller.
+  SampledController sampled;
+  if (!controller.is_none())
+    sampled = [&](const SimulationState& x, Eigen::VectorXd& tau) {
+      py::gil_scoped_acquire gil;
+      const py::object r = controller(x.t, toNumpyVec(x.state.q.data), toNumpyVec(x.velocity.qdot.data),
+                                      frameToNumpy(x.state.world_T_base), toNumpy6(toEigen(x.velocity.base_twist)));
+      tau = jointValues(model, r, "controller: tau").data;
+      if (!tau.allFinite())
+        throw py::value_error("controller: returned a torque that is not finite at t = " + std::to_string(x.t) + " s");
+    };
   Samples samples;
-  long outputs = 0;
   int sample_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x) {
-    const long i = outputs++;
-    const bool last = x.t >= t_end;
-    const SimulationState* row = &x;
-    SimulationState now;
-    if (grid.a > 0 && i > 0 && i % grid.a == 0 && (!last || std::abs(t0 + i * grid.delta - t_end) <= 1e-9 * grid.delta)) {
-      call(x);  // the command held from this instant on
-      now = x;
-      if (const int rc = w.sim->actuation(now)) sample_rc = rc;
-      row = &now;
-    }
-    if (i % grid.b != 0 && !last) return;
     double T = std::nan("");
     Vector6d h = Vector6d::Constant(std::nan(""));
-    if (const int rc = w.sim->energyAndMomentum(*row, T, h)) sample_rc = sample_rc ? sample_rc : rc;
-    samples.add(*row, T, h);
+    if (const int rc = w.sim->energyAndMomentum(x, T, h)) sample_rc = sample_rc ? sample_rc : rc;
+    samples.add(x, T, h);
   };
   int rc;
   {
     py::gil_scoped_release nogil;
     std::lock_guard<std::mutex> lock(w.mutex);
-    struct Guard {  // the callback refers to this frame: it goes when the run ends, however it ends
+    struct Guard {  // whoever runs: cleared when the run ends, however it ends
       PySimulator& w;
-      ~Guard() {
-        w.sim->setTorqueCallback(nullptr);
-        w.runner = std::thread::id();
-      }
+      ~Guard() { w.runner = std::thread::id(); }
     } guard{w};
     w.runner = std::this_thread::get_id();
-    if (!controller.is_none())
-      w.sim->setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
-        if (!hold || !commanded) call(x);  // zero-order hold: the first command at the start
-        tau.data = command;
-      });
-    rc = w.sim->run(s, t_end, grid.delta, observer);
+    rc = runSampled(*w.sim, s, t_end, output_dt, sampled, rate, observer);
   }
   PyRun result(samples, PyState{w.model.ptr, s.state, s.velocity}, PyStats{w.sim->stats(), model.jointNames()});
   if (rc || sample_rc) raiseRunError(rc ? rc : sample_rc, s, t0, t_end, py::cast(result));
@@ -272,6 +225,27 @@ void setBaseControl(PySimulator& w, py::object attitude, py::object position) {
   w.locked([&] { w.sim->setBaseControl(c); });
 }
 
+void setJointControl(PySimulator& w, py::object joint, const std::string& mode, double kp, double kd, double set_point) {
+  const unsigned int j = jointArgument(*w.model.ptr, joint, "joint");
+  JointControl c;
+  if (mode == "free") c.mode = JointControl::Mode::Free;
+  else if (mode == "locked") c.mode = JointControl::Mode::Locked;
+  else if (mode == "pd" || mode == "hold") c.mode = JointControl::Mode::PD, c.hold = mode == "hold";
+  else throw py::value_error("mode: expected 'free', 'locked', 'pd' or 'hold', got '" + mode + "'");
+  c.kp = kp, c.kd = kd, c.set_point = set_point;
+  w.locked([&] { w.sim->setJointControl(j, c); });
+}
+
+void setLimitMode(PySimulator& w, py::object joint, const std::string& mode) {
+  const unsigned int j = jointArgument(*w.model.ptr, joint, "joint");
+  LimitMode l;
+  if (mode == "ignore") l = LimitMode::Ignore;
+  else if (mode == "warn") l = LimitMode::Warn;
+  else if (mode == "stop") l = LimitMode::Stop;
+  else throw py::value_error("mode: expected 'ignore', 'warn' or 'stop', got '" + mode + "'");
+  w.locked([&] { w.sim->setLimitMode(j, l); });
+}
+
 }  // namespace
 
 void bindSimulation(py::module_& m) {
@@ -306,17 +280,7 @@ void bindSimulation(py::module_& m) {
         r["friction_velocity"] = o.friction_velocity, r["friction_rate"] = o.friction_rate;
         return r;
       }, "The options, as a dict of the constructor's keywords.")
-      .def("set_joint_control", [](PySimulator& w, py::object joint, const std::string& mode, double kp, double kd,
-                                   double set_point) {
-        const unsigned int j = jointArgument(*w.model.ptr, joint, "joint");
-        JointControl c;
-        if (mode == "free") c.mode = JointControl::Mode::Free;
-        else if (mode == "locked") c.mode = JointControl::Mode::Locked;
-        else if (mode == "pd" || mode == "hold") c.mode = JointControl::Mode::PD, c.hold = mode == "hold";
-        else throw py::value_error("mode: expected 'free', 'locked', 'pd' or 'hold', got '" + mode + "'");
-        c.kp = kp, c.kd = kd, c.set_point = set_point;
-        w.locked([&] { w.sim->setJointControl(j, c); });
-      }, py::arg("joint"), py::arg("mode"), py::kw_only(), py::arg("kp") = 0.0, py::arg("kd") = 0.0,
+      .def("set_joint_control", &setJointControl, py::arg("joint"), py::arg("mode"), py::kw_only(), py::arg("kp") = 0.0, py::arg("kd") = 0.0,
          py::arg("set_point") = 0.0,
          "Joint (name or index): 'free' (zero torque), 'locked' (brakes on), 'pd' (tau = kp (set_point - q) - kd "
          "qdot) or 'hold' (PD to the joint's position at the start of each run). ModelError for a negative gain.")
@@ -329,15 +293,7 @@ void bindSimulation(py::module_& m) {
                        py::arg("set_point") = cs[j].set_point);
         return r;
       }, "Joint name -> {'mode', 'kp', 'kd', 'set_point'}.")
-      .def("set_limit_mode", [](PySimulator& w, py::object joint, const std::string& mode) {
-        const unsigned int j = jointArgument(*w.model.ptr, joint, "joint");
-        LimitMode l;
-        if (mode == "ignore") l = LimitMode::Ignore;
-        else if (mode == "warn") l = LimitMode::Warn;
-        else if (mode == "stop") l = LimitMode::Stop;
-        else throw py::value_error("mode: expected 'ignore', 'warn' or 'stop', got '" + mode + "'");
-        w.locked([&] { w.sim->setLimitMode(j, l); });
-      }, py::arg("joint"), py::arg("mode"),
+      .def("set_limit_mode", &setLimitMode, py::arg("joint"), py::arg("mode"),
          "What the joint's position limits do: 'ignore', 'warn' (recorded in stats; the default) or 'stop' (hard "
          "stops). ModelError for 'stop' on a joint without finite limits.")
       .def_property_readonly("limit_modes", [](const PySimulator& w) {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 #include "study/study_sampling.hpp"
 #include "study/study_self_motion.hpp"
@@ -58,40 +59,37 @@ KDL::Frame handFrame(const Kinematics& kin, const Contact& h) {
   return KDL::Frame(body.M, body * h.offset);
 }
 
-/// The motion after the capture (the scenario's simulation section, its PD servos holding the
-/// capture configuration): each joint's largest |torque|, the base's largest |w| and the largest
-/// |qdot_j| / limit_j, at the output steps.
+/// The motion after the capture (runMotionAfterCapture: the scenario's simulation section, its PD
+/// servos holding the capture configuration): each joint's largest |torque|, the base's largest
+/// |w| and the largest |qdot_j| / limit_j, at the output steps.
 int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureResult& r, std::vector<double>& peak,
                 double& peak_base_rate, double& rate_ratio) {
-  std::unique_ptr<Simulator> sim;
-  std::shared_ptr<const FloatingModel> model;
-  try {
-    model = attachTarget(problem, r);
-    sim = makeSimulator(st.scenario, model, false);
-    for (unsigned int j = 0; j < model->nj(); ++j) {
-      JointControl c = sim->jointControls()[j];
-      if (c.mode != JointControl::Mode::PD) continue;
-      c.hold = true;
-      sim->setJointControl(j, c);
+  const FloatingModel& robot = *problem.robot.model;
+  std::vector<unsigned int> in_model;  // the robot's joints in the system after the capture
+  OperationOptions o;
+  o.duration = st.motion_duration;
+  o.output_step = st.motion_output_step;
+  o.hold_servos = true;
+  o.keep_samples = false;
+  o.observer = [&](const OperationResult& so_far, const MotionSample& x) {
+    if (in_model.size() != robot.nj())
+      for (unsigned int j = 0; j < robot.nj(); ++j)
+        in_model.push_back(static_cast<unsigned int>(so_far.model->jointIndex(robot.jointNames()[j])));
+    for (unsigned int j = 0; j < robot.nj(); ++j) {
+      peak[j] = std::max(peak[j], std::abs(x.tau(in_model[j])));
+      if (st.limits.joint_rate) rate_ratio = std::max(rate_ratio, std::abs(x.qd(in_model[j])) / (*st.limits.joint_rate)[j]);
     }
+    peak_base_rate = std::max(peak_base_rate, x.twist.tail<3>().norm());
+  };
+  OperationResult motion;
+  try {
+    runMotionAfterCapture(st.scenario, problem, r, 0.0, o, motion);
+  } catch (const OperationError& e) {
+    return e.code() != E_NOERROR ? e.code() : E_BAD_ARGUMENT;
   } catch (const std::exception&) {
     return E_BAD_ARGUMENT;
   }
-  const FloatingModel& robot = *problem.robot.model;
-  std::vector<unsigned int> in_model(robot.nj());
-  for (unsigned int j = 0; j < robot.nj(); ++j) in_model[j] = static_cast<unsigned int>(model->jointIndex(robot.jointNames()[j]));
-  SimulationState s;
-  s.state = problem.robot.state;
-  s.velocity = r.robot.after;
-  const auto observe = [&](const SimulationState& x) {
-    for (unsigned int j = 0; j < robot.nj(); ++j) {
-      peak[j] = std::max(peak[j], std::abs(x.tau(in_model[j])));
-      if (st.limits.joint_rate)
-        rate_ratio = std::max(rate_ratio, std::abs(x.velocity.qdot(in_model[j])) / (*st.limits.joint_rate)[j]);
-    }
-    peak_base_rate = std::max(peak_base_rate, x.velocity.base_twist.rot.Norm());
-  };
-  return sim->run(s, st.motion_duration, st.motion_output_step, observe);
+  return E_NOERROR;
 }
 
 }  // namespace

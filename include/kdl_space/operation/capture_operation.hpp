@@ -1,0 +1,112 @@
+// The capture operation as one call: from a scenario, the approach (the hand reaches the grasp
+// point on the moving target), the capture at the contact instant (the paper's impulsive law), the
+// system that moves on after it (the robot with a payload, the captured robot joined into one
+// tree, or both sides apart) and its motion: what `kdl_space simulate` runs, what a study's motion
+// after a capture runs, and `kdl_space.run_operation` in Python.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/impact/joined_system.hpp"
+#include "kdl_space/operation/motion_record.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/simulation/sampled_control.hpp"
+
+namespace kdl_space {
+
+struct OperationResult;
+
+/// What to run, and what to see while it runs.
+struct OperationOptions {
+  std::optional<double> duration;     ///< of the motion after the capture [s]; unset: the scenario's
+  std::optional<double> output_step;  ///< [s]; unset: the scenario's simulation.output_step
+  bool approach = true;  ///< run the scenario's approach (false: the capture at the scenario's states)
+  bool motion = true;    ///< integrate the motion after the capture (false: stop at the capture)
+  /// PD joints hold the configuration at the start of the motion (their set points taken from it),
+  /// whatever the scenario's set points: a study's motion after a capture.
+  bool hold_servos = false;
+  /// Every output sample in time order, with the result so far (its `model` is the system the
+  /// sample's joints belong to). The approach's samples come once the capture has told which
+  /// system moves on (the target's joints, if it joins, are NaN in them). It may throw: the run
+  /// stops there and the exception propagates.
+  std::function<void(const OperationResult& so_far, const MotionSample& sample)> observer;
+  bool keep_samples = true;  ///< keep the samples in the result (false: the observer and the record only)
+  /// A controller of the motion after the capture (its torques add to the scenario's joint modes),
+  /// called at control_rate [Hz] with a zero-order hold, or at every evaluation when 0.
+  SampledController controller;
+  double control_rate = 0.0;
+};
+
+/// What the approach did.
+struct ApproachOutcome {
+  ApproachRecord record;
+  RigidTarget target_at_contact;  ///< the target at the end of the approach
+};
+
+/// A free-floating target that separated after a point impact, moved on by itself.
+struct TargetMotion {
+  SimulationState end;
+  double dP = 0.0, dL = 0.0, T = 0.0;  ///< momentum drift over the run, kinetic energy after the impact
+};
+
+/// Everything the operation did (what `kdl_space simulate --json` prints).
+struct KDL_SPACE_EXPORT OperationResult {
+  double duration = 0.0;     ///< of the motion after the capture [s]
+  double output_step = 0.0;  ///< [s]
+  std::optional<ApproachOutcome> approach;
+  /// The capture problem at the contact instant (after an approach: the states then).
+  CaptureProblem at_contact;
+  std::optional<CaptureResult> capture;  ///< unset for a plain motion
+  std::optional<JoinedSystem> joined;    ///< the captured target joined to the robot's tree
+  std::shared_ptr<const FloatingModel> model;  ///< what moves after the capture
+  bool payload_attached = false;  ///< model is the robot with the target as a payload, or joined
+  double t_capture = 0.0;         ///< the contact instant (0 without an approach) [s]
+  std::vector<MotionSample> approach_samples;  ///< the last one: the contact instant
+  std::vector<MotionSample> samples;           ///< of the motion after the capture (keep_samples)
+  MotionRecord record;            ///< the motion's records and aggregates (also without samples)
+  SimulationState end;            ///< the state at the end of the motion
+  std::optional<TargetMotion> target_motion;  ///< a free-floating target that separated
+  double min_chart_margin = 1.0;  ///< a ball joint's least distance from its chart's singularity
+};
+
+/// \brief A failed operation: the scenario's terms (what grew, when, what to try), the code of the
+/// failed computation (0 when none: an approach that never reached its grasp), and what had been
+/// done until then (`partial`: the approach's samples of an approach that failed, say).
+class KDL_SPACE_EXPORT OperationError : public InputError {
+ public:
+  OperationError(const std::string& what, int code, std::shared_ptr<const OperationResult> partial)
+      : InputError(what), code_(code), partial_(std::move(partial)) {}
+  int code() const { return code_; }
+  const std::shared_ptr<const OperationResult>& partial() const { return partial_; }
+
+ private:
+  int code_;
+  std::shared_ptr<const OperationResult> partial_;
+};
+
+/// \brief Runs the scenario's operation: its approach (if it has one and options.approach), the
+/// capture (if it has a target), then options.duration of motion after it (options.motion).
+/// \throws InputError naming the scenario's file and field for what the scenario asks that cannot
+/// be done (a run beyond its step budget, a grounded base given a twist, a joint outside its hard
+/// stop); OperationError for a phase that failed (an approach that never reached its grasp, a
+/// motion that blew up), with what was done until then.
+KDL_SPACE_EXPORT OperationResult runCaptureOperation(const Scenario& scenario, const OperationOptions& options = {});
+
+/// \brief The motion after a capture alone: `capture` solved for `at_contact` (a scenario's
+/// problem, or one a study drew from it), the system that moves on after it, and its motion from
+/// t_capture. `result` gets everything of that (approach and the rest untouched).
+/// \throws as runCaptureOperation.
+KDL_SPACE_EXPORT void runMotionAfterCapture(const Scenario& scenario, const CaptureProblem& at_contact,
+                                            const std::optional<CaptureResult>& capture, double t_capture,
+                                            const OperationOptions& options, OperationResult& result);
+
+/// \brief After a capture that joins the target to the robot (a free-floating target captured
+/// rigidly or translationally, a rigid target captured translationally): the joined system.
+KDL_SPACE_EXPORT std::optional<JoinedSystem> joinedAfterCapture(const CaptureProblem& problem, const CaptureResult& capture);
+
+}  // namespace kdl_space

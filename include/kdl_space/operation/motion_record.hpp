@@ -1,0 +1,51 @@
+// What a motion did beyond its samples: the simulator's records (limits, saturation, steps), the
+// set-up that produced them, and the running aggregates of its samples (drift of the invariants,
+// the momentum balance, the energy split), kept as the samples go by: nothing grows with the run.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/operation/motion_sample.hpp"
+
+namespace kdl_space {
+
+struct KDL_SPACE_EXPORT MotionRecord {
+  std::shared_ptr<const FloatingModel> model;  ///< the system that moved
+  SimulationOptions options;
+  SimulationStats stats;                       ///< of the run
+  std::vector<JointControl> controls;          ///< model order
+  std::vector<LimitMode> limit_modes;          ///< model order
+  BaseControl base_control;
+  std::vector<double> friction_velocities;     ///< v_s per joint (SimulationOptions::friction_rate)
+  Stiffness stiffness;                         ///< the servos' at the start of the run
+  double output_step = 0.0;
+  double t_start = 0.0, t_reached = 0.0;       ///< the run's start, and how far it got [s]
+
+  // The samples' aggregates (add):
+  long samples = 0;
+  MotionSample first, last;
+  double max_linear_momentum_change = 0.0;   ///< max |P - P_0| [N s]
+  double max_angular_momentum_change = 0.0;  ///< max |L - L_0| [N m s]
+  double max_energy_change = 0.0;            ///< max |T - T_0| [J]
+  /// The momentum balance: max |h - h_0 - impulse| (P and L parts).
+  double balance_linear = 0.0, balance_angular = 0.0;
+  bool torques = false;  ///< some joint torque acted (a controller, friction)
+
+  /// The simulator's set-up and records after (or during) its run.
+  void takeFrom(const Simulator& sim);
+  /// One more sample, in time order.
+  void add(const MotionSample& x);
+  /// Mean accepted step [s] (0 before any).
+  double meanStep() const;
+  /// The joints braked through the motion (JointControl::Mode::Locked), by name.
+  std::vector<std::string> lockedJoints() const;
+};
+
+/// \brief Whether the run was held back by a stiff servo, and what to try (empty: it was not):
+/// an RK4 step above the servos' stable step, or dopri5's steps far below the output step.
+KDL_SPACE_EXPORT std::string stiffnessAdvice(const MotionRecord& r);
+
+}  // namespace kdl_space

@@ -1,0 +1,120 @@
+// kdl_space.run_operation: the capture operation of a scenario (runCaptureOperation: approach,
+// capture, the system after it, its motion) as one call; the result is the dict that
+// `kdl_space simulate --json` prints (the same writer: tools/operation_report), plus the samples
+// as NumPy arrays, with an optional controller at a control rate and an observer per sample.
+#include <cmath>
+
+#include "capture_types.hpp"
+#include "conversions.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
+#include "operation_report.hpp"
+
+namespace kdl_space::python {
+namespace {
+
+/// The samples (the approach's, then the motion's), column by column.
+py::dict samplesDict(const OperationResult& r) {
+  std::vector<const MotionSample*> rows;
+  for (const MotionSample& x : r.approach_samples) rows.push_back(&x);
+  for (const MotionSample& x : r.samples) rows.push_back(&x);
+  const Eigen::Index k = static_cast<Eigen::Index>(rows.size()), n = r.model->nj();
+  Eigen::MatrixXd t(k, 1), p(k, 3), quat(k, 4), twist(k, 6), q(k, n), qd(k, n), tau(k, n), h(k, 6), T(k, 1),
+      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1);
+  py::list phase;
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const MotionSample& x = *rows[static_cast<std::size_t>(i)];
+    t(i) = x.t, T(i) = x.T, distance(i) = x.grasp_distance;
+    p.row(i) = x.p.transpose(), quat.row(i) = x.quat.transpose(), twist.row(i) = x.twist.transpose();
+    q.row(i) = x.q.transpose(), qd.row(i) = x.qd.transpose(), tau.row(i) = x.tau.transpose();
+    h.row(i) = x.h.transpose(), wrench.row(i) = x.base_wrench.transpose(), work.row(i) = x.work.transpose();
+    impulse.row(i) = x.impulse.transpose();
+    phase.append(toString(x.phase));
+  }
+  py::dict d;
+  d["joint_names"] = r.model->jointNames();
+  d["t"] = toNumpy(t, true);
+  d["phase"] = phase;
+  d["base_position"] = toNumpy(p);
+  d["base_quaternion"] = toNumpy(quat);
+  d["base_twist"] = toNumpy(twist);
+  d["q"] = toNumpy(q);
+  d["qdot"] = toNumpy(qd);
+  d["tau"] = toNumpy(tau);
+  d["momentum"] = toNumpy(h);
+  d["energy"] = toNumpy(T, true);
+  d["base_wrench"] = toNumpy(wrench);
+  d["work"] = toNumpy(work);
+  d["impulse"] = toNumpy(impulse);
+  d["grasp_distance"] = toNumpy(distance, true);
+  return d;
+}
+
+py::dict runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
+                      py::object observer, py::object controller, py::object control_rate) {
+  const Scenario& sc = ps.scenario;
+  OperationOptions o;
+  if (!duration.is_none()) {
+    o.duration = py::cast<double>(duration);
+    if (!(*o.duration > 0.0) || !std::isfinite(*o.duration))
+      throw py::value_error("duration: expected a finite duration > 0 s, got " + std::to_string(*o.duration));
+  }
+  if (!output_step.is_none()) {
+    o.output_step = py::cast<double>(output_step);
+    if (!(*o.output_step > 0.0) || !std::isfinite(*o.output_step))
+      throw py::value_error("output_step: expected a finite step > 0 s, got " + std::to_string(*o.output_step));
+  }
+  o.approach = approach, o.motion = motion;
+  if (!controller.is_none() && !PyCallable_Check(controller.ptr()))
+    throw py::type_error("controller: expected a callable controller(t, q, qdot, base_pose, base_twist) -> tau");
+  if (!observer.is_none() && !PyCallable_Check(observer.ptr()))
+    throw py::type_error("observer: expected a callable observer(t, phase, q, qdot)");
+  if (controller.is_none() && !control_rate.is_none()) throw py::value_error("control_rate: given without a controller");
+  if (!control_rate.is_none()) {
+    o.control_rate = py::cast<double>(control_rate);
+    if (!(o.control_rate > 0.0) || !std::isfinite(o.control_rate))
+      throw py::value_error("control_rate: expected a finite rate > 0 [Hz], got " + std::to_string(o.control_rate));
+  }
+  if (!controller.is_none())
+    o.controller = [&](const SimulationState& x, Eigen::VectorXd& tau) {
+      py::gil_scoped_acquire gil;
+      const py::object r = controller(x.t, toNumpyVec(x.state.q.data), toNumpyVec(x.velocity.qdot.data),
+                                      frameToNumpy(x.state.world_T_base), toNumpy6(toEigen(x.velocity.base_twist)));
+      if (r.is_none()) throw py::value_error("controller: tau: expected an array of the joint torques, got None");
+      tau = fromNumpy(r, "controller: tau", static_cast<Eigen::Index>(tau.size()));
+      if (!tau.allFinite())
+        throw py::value_error("controller: returned a torque that is not finite at t = " + std::to_string(x.t) + " s");
+    };
+  // Every sample: the observer if any, and Ctrl-C (a KeyboardInterrupt ends the run there).
+  o.observer = [&](const OperationResult&, const MotionSample& x) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!observer.is_none()) observer(x.t, toString(x.phase), toNumpyVec(x.q), toNumpyVec(x.qd));
+  };
+  OperationResult r;
+  {
+    py::gil_scoped_release nogil;
+    r = runCaptureOperation(sc, o);
+  }
+  const py::dict d = py::module_::import("json").attr("loads")(cli::operationJson(sc, r).dump());
+  d["samples"] = samplesDict(r);
+  return d;
+}
+
+}  // namespace
+
+void bindOperation(py::module_& m) {
+  m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
+        py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,
+        py::arg("observer") = py::none(), py::arg("controller") = py::none(), py::arg("control_rate") = py::none(),
+        "The scenario's capture operation as `kdl_space simulate` runs it: the approach (if any), the capture at "
+        "the contact instant, the system after it and `duration` s of its motion (None: the scenario's). Returns "
+        "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
+        "'samples': the approach's and the motion's samples as NumPy arrays (t, phase, base_position, "
+        "base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, work, impulse, grasp_distance; "
+        "joint_names). `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
+        "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
+        "`observer(t, phase, q, qdot)` sees every sample. InputError naming the scenario's file for what cannot "
+        "be run or failed.");
+}
+
+}  // namespace kdl_space::python

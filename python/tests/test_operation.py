@@ -1,0 +1,110 @@
+"""kdl_space.run_operation: the capture operation as one call. Its dict against `kdl_space simulate
+--json` of the same build (1e-12), the tool against the outputs the tool printed before the
+operation moved into the library (tests/data/golden/simulate: `simulate --json --duration 2` of
+the binary before, kept as they were), the samples against the dict's final state, a zero
+controller at a control rate, the observer, and bad arguments."""
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import kdl_space
+from conftest import SOURCE_DIR
+
+GOLDEN = SOURCE_DIR / "tests" / "data" / "golden" / "simulate"
+SCENARIOS = {p.stem: p for p in [*(SOURCE_DIR / "scenarios").glob("*.yaml"), *(SOURCE_DIR / "tests" / "data" / "scenarios").glob("*")]}
+
+
+def assert_same(a, b, rel, abs_tol, path="$"):
+    """The same JSON value: keys, strings, booleans and nulls equal, numbers within rel / abs."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and sorted(a) == sorted(b), f"{path}: keys {sorted(a)} != {sorted(b) if isinstance(b, dict) else b}"
+        for k in a:
+            assert_same(a[k], b[k], rel, abs_tol, f"{path}.{k}")
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), f"{path}: {a} != {b}"
+        for i, (x, y) in enumerate(zip(a, b)):
+            assert_same(x, y, rel, abs_tol, f"{path}[{i}]")
+    elif isinstance(a, bool) or a is None or isinstance(a, str):
+        assert a == b, f"{path}: {a!r} != {b!r}"
+    else:
+        assert isinstance(b, (int, float)) and not isinstance(b, bool), f"{path}: {a!r} != {b!r}"
+        assert math.isclose(a, b, rel_tol=rel, abs_tol=abs_tol), f"{path}: {a!r} != {b!r}"
+
+
+def simulate_json(cli, scenario, *args):
+    out = subprocess.run([cli, "simulate", str(scenario), "--json", *args], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in GOLDEN.glob("*.json")))
+def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library(cli, name):
+    before = json.loads((GOLDEN / f"{name}.json").read_text())
+    now = simulate_json(cli, SCENARIOS[name], "--duration", "2")
+    # The same build type on the same kind of machine: the same floating-point code, so the same
+    # numbers but for the last bits of a long adaptive run.
+    assert_same(before, now, rel=1e-9, abs_tol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["approach_tumbling_box", "robot_to_robot_capture", "translational_capture",
+                                  "tumbling_box_capture", "braked_robot_to_robot", "restitution_bounce"])
+def test_run_operation_is_the_tools_json(cli, name):
+    scenario = kdl_space.load_scenario(str(SCENARIOS[name]))
+    r = kdl_space.run_operation(scenario, duration=1.0)
+    tool = simulate_json(cli, SCENARIOS[name], "--duration", "1")
+    samples = r.pop("samples")
+    assert_same(tool, r, rel=1e-12, abs_tol=0.0)
+    # The samples: the approach's, then the motion's; the last one is the final state.
+    k = len(samples["t"])
+    n = len(tool["simulation"]["joint_names"])
+    assert samples["joint_names"] == tool["simulation"]["joint_names"]
+    assert samples["q"].shape == (k, n) and samples["base_twist"].shape == (k, 6) and samples["momentum"].shape == (k, 6)
+    final = tool["simulation"]["final"]
+    np.testing.assert_array_equal(samples["q"][-1], final["q"])
+    np.testing.assert_array_equal(samples["base_quaternion"][-1], final["base_quaternion"])
+    assert samples["t"][-1] == final["t"]
+    assert np.all(np.diff(samples["t"]) > 0)
+    phases = samples["phase"]
+    if tool["approach"] is not None:
+        assert phases[0] == "approach" and "capture" in phases and phases[-1] == "post"
+        contact = phases.index("capture")
+        assert samples["t"][contact] == tool["approach"]["t_contact"]
+        assert np.all(np.isfinite(samples["grasp_distance"][:contact + 1]))
+        assert np.all(np.isnan(samples["grasp_distance"][contact + 1:]))
+    else:
+        assert set(phases) == {"post"}
+    # The first sample after the impact carries the capture's momentum after it (no external force).
+    post = phases.index("post")
+    np.testing.assert_allclose(samples["momentum"][post], samples["momentum"][-1], rtol=1e-9, atol=1e-9)
+
+
+def test_controller_observer_and_options():
+    scenario = kdl_space.load_scenario(str(SCENARIOS["tumbling_box_capture"]))
+    plain = kdl_space.run_operation(scenario, duration=0.5)
+    calls, seen = [], []
+
+    def zero(t, q, qdot, pose, twist):
+        calls.append(t)
+        assert pose.shape == (4, 4) and q.shape == (7,)
+        return np.zeros(7)
+
+    r = kdl_space.run_operation(scenario, duration=0.5, controller=zero, control_rate=10.0,
+                                observer=lambda t, phase, q, qdot: seen.append((t, phase)))
+    np.testing.assert_allclose(r["simulation"]["final"]["q"], plain["simulation"]["final"]["q"], rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(calls, np.arange(6) * 0.1, atol=1e-12)  # t = 0, 0.1, ..., 0.5: held between
+    assert [t for t, _ in seen] == list(r["samples"]["t"])
+    # A controller that pushes changes the motion; its work is the controller's share of the energy.
+    pushed = kdl_space.run_operation(scenario, duration=0.5, controller=lambda *a: np.full(7, 5.0), control_rate=100.0)
+    assert pushed["simulation"]["energy_split"]["controller"] != plain["simulation"]["energy_split"]["controller"]
+    # Stop at the capture: no samples after it.
+    at_capture = kdl_space.run_operation(scenario, motion=False)
+    assert at_capture["capture"] == plain["capture"]
+    with pytest.raises(ValueError, match="control_rate: given without a controller"):
+        kdl_space.run_operation(scenario, control_rate=10.0)
+    with pytest.raises(ValueError, match="duration"):
+        kdl_space.run_operation(scenario, duration=-1.0)
+    with pytest.raises(ValueError, match=r"controller: tau"):
+        kdl_space.run_operation(scenario, duration=0.2, controller=lambda *a: np.zeros(3))

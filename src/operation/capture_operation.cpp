@@ -1,0 +1,222 @@
+#include "kdl_space/operation/capture_operation.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "operation/phases.hpp"
+
+namespace kdl_space {
+namespace {
+
+/// A run that cannot fit its step budget is refused before it starts, not after max_steps steps:
+/// every step is at most max_step (dopri5) or step (rk4) long, and each output row ends a step.
+void checkStepBudget(const Scenario& sc, double duration, double output_step) {
+  const SimulationSpec& spec = sc.simulation;
+  const bool rk4 = spec.options.integrator == Integrator::RK4;
+  const double longest = std::min(rk4 ? spec.options.step : spec.options.max_step, output_step);
+  const double needed = std::ceil(duration / longest * (1.0 - 1e-12));
+  if (needed > static_cast<double>(spec.options.max_steps)) {
+    std::ostringstream why;
+    why << std::setprecision(12) << sc.file << ": simulation: " << duration << " s in steps of at most " << longest << " s ("
+        << (longest == output_step ? "simulation.output_step" : rk4 ? "simulation.step" : "simulation.max_step")
+        << ") needs " << needed << " steps, more than simulation.max_steps = " << spec.options.max_steps;
+    throw InputError(why.str());
+  }
+}
+
+/// Why a simulation stopped, in the scenario's terms: what grew, when, and what to try. `s` is
+/// the last accepted state.
+std::string simulationFailure(int rc, const SimulationSpec& spec, const MotionRecord& r, const SimulationState& s) {
+  const std::string advice = stiffnessAdvice(r);
+  switch (rc) {
+    case E_MAX_STEPS:
+      return "the step budget simulation.max_steps = " + std::to_string(spec.options.max_steps) +
+             " is spent (an unstable controller? raise max_steps, or loosen rtol and atol)" +
+             (advice.empty() ? std::string() : "; " + advice);
+    case E_STEP_UNDERFLOW:
+      return std::string(strError(rc)) + " (loosen simulation.rtol and atol)" +
+             (advice.empty() ? std::string() : "; " + advice);
+    case E_NOT_FINITE: {
+      std::ostringstream why;
+      why << std::setprecision(3) << "the motion blew up to NaN or infinite values (unstable PD gains, or too large an "
+          << "rk4 step?)";
+      const std::vector<std::string>& joints = r.model->jointNames();
+      Eigen::Index j = 0;
+      if (s.velocity.qdot.rows() > 0 && s.velocity.qdot.data.allFinite()) {
+        const double fastest = s.velocity.qdot.data.cwiseAbs().maxCoeff(&j);
+        why << ": by t = " << s.t << " s joint '" << joints[j] << "' moved at " << fastest
+            << " rad/s (or m/s), the base at " << toEigen(s.velocity.base_twist.rot).norm() << " rad/s";
+      }
+      const Stiffness& st = r.stiffness;
+      if (st.fastest_joint >= 0)
+        why << "; the servo of joint '" << joints[st.fastest_joint] << "' (closed-loop rate " << st.fastest_rate
+            << " 1/s) needs explicit steps below " << st.explicit_step
+            << " s: lower simulation.step or the gains, or use integrator: rosenbrock";
+      return why.str();
+    }
+    default:
+      return strError(rc);
+  }
+}
+
+/// The robot's joint j in `model` (the same model, or the robot with a payload, or joined).
+unsigned int jointIn(const FloatingModel& model, const FloatingModel& robot, unsigned int j) {
+  return static_cast<unsigned int>(model.jointIndex(robot.jointNames()[j]));
+}
+
+/// The approach's samples in the joints of the system after the capture: a target that joined
+/// brought joints, NaN in the approach's rows.
+void widenApproachSamples(const FloatingModel& robot, OperationResult& r) {
+  const FloatingModel& model = *r.model;
+  if (model.nj() == robot.nj()) return;
+  for (MotionSample& x : r.approach_samples) {
+    Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nj(), NAN), qd = q, tau = q;
+    for (unsigned int j = 0; j < robot.nj(); ++j) {
+      const unsigned int k = jointIn(model, robot, j);
+      q(k) = x.q(j), qd(k) = x.qd(j), tau(k) = x.tau(j);
+    }
+    x.q = q, x.qd = qd, x.tau = tau;
+  }
+}
+
+/// The joint modes of the system after the capture: the target keeps its own joints' (its
+/// brakes, the controls of simulation.target_joints); with hold_servos the PD joints hold.
+void setModesAfter(const Scenario& sc, const CaptureProblem& problem, const OperationResult& r, bool hold_servos,
+                   Simulator& sim) {
+  if (r.joined)
+    if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) {
+      const JoinedSystem& joint = *r.joined;
+      JointControl locked;
+      locked.mode = JointControl::Mode::Locked;
+      for (std::size_t j = 0; j < joint.target_joints.size(); ++j)
+        if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
+          sim.setJointControl(static_cast<unsigned int>(joint.target_joints[j]), locked);
+      for (auto [j, control] : sc.simulation.target_joints) {
+        control.set_point *= joint.target_joint_sign[j];  // a reversed joint's coordinate is negated
+        try {
+          sim.setJointControl(static_cast<unsigned int>(joint.target_joints[j]), control);
+        } catch (const ModelError& e) {
+          throw InputError(sc.file + ": simulation.target_joints: " + e.what());
+        }
+      }
+    }
+  if (hold_servos)
+    for (unsigned int j = 0; j < r.model->nj(); ++j) {
+      JointControl c = sim.jointControls()[j];
+      if (c.mode != JointControl::Mode::PD) continue;
+      c.hold = true;
+      sim.setJointControl(j, c);
+    }
+}
+
+/// What the start of the motion must satisfy: a grounded base at rest, joints inside their hard
+/// stops; then the brakes engage.
+void checkStart(const Scenario& sc, Simulator& sim, SimulationState& s) {
+  const FloatingModel& model = sim.model();
+  if (sim.options().grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) {
+    std::ostringstream why;
+    why << sc.file << ": simulation: the base is grounded (held still), but its twist at the start of the motion is "
+        << toEigen(s.velocity.base_twist).transpose().format(Eigen::IOFormat(6, Eigen::DontAlignCols, ", ", ", ", "", "", "[", "]"))
+        << ": give robot.base.twist zero, or simulation.base: free";
+    throw InputError(why.str());
+  }
+  for (unsigned int j = 0; j < model.nj(); ++j) {  // a hard stop holds a joint inside its limits only
+    const JointProperties& p = model.jointProperties()[j];
+    const double q = s.state.q(j);
+    if (sim.limitModes()[j] == LimitMode::Stop && (q > p.upper || q < p.lower)) {
+      std::ostringstream why;
+      why << sc.file << ": simulation.limits: joint '" << model.jointNames()[j] << "' starts at " << q
+          << ", outside its limits [" << p.lower << ", " << p.upper
+          << "] (a hard stop keeps it inside them): start it inside, or let its limits warn";
+      throw InputError(why.str());
+    }
+  }
+  if (const int rc = sim.engageBrakes(s)) throw InputError(sc.file + ": simulation: cannot engage the brakes: " + strError(rc));
+}
+
+}  // namespace
+
+void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, const std::optional<CaptureResult>& capture,
+                           double t_capture, const OperationOptions& o, OperationResult& r) {
+  using operation::inScenario;
+  r.duration = o.duration.value_or(sc.simulation.duration);
+  r.output_step = o.output_step.value_or(sc.simulation.output_step);
+  r.at_contact = problem;
+  r.capture = capture;
+  r.t_capture = t_capture;
+  r.model = problem.robot.model;
+  if (capture) {
+    r.joined = inScenario(sc, [&] {
+      try {
+        return joinedAfterCapture(problem, *capture);
+      } catch (const ModelError& e) {
+        throw InputError(std::string("target: cannot join the captured target to the robot: ") + e.what());
+      }
+    });
+    r.model = r.joined ? r.joined->model : inScenario(sc, [&] { return attachTarget(problem, *capture); });
+  }
+  r.payload_attached = r.model != problem.robot.model;
+  widenApproachSamples(*problem.robot.model, r);
+  if (!o.motion) return;
+
+  std::unique_ptr<Simulator> simulator = operation::simulatorFor(sc, r.model, false);
+  Simulator& sim = *simulator;
+  SimulationState s;
+  s.t = t_capture;
+  s.state = r.joined ? r.joined->state : problem.robot.state;
+  s.velocity = r.joined ? r.joined->velocity : capture ? capture->robot.after : problem.robot.velocity;
+  setModesAfter(sc, problem, r, o.hold_servos, sim);
+  checkStart(sc, sim, s);
+  const SimulationState start = s;
+  r.record = MotionRecord{};
+  r.record.model = r.model;
+  r.record.output_step = r.output_step;
+  r.record.t_start = start.t;
+  if (o.observer)
+    for (const MotionSample& x : r.approach_samples) o.observer(r, x);
+  int observer_rc = E_NOERROR;
+  const Phase phase = sc.impact ? Phase::Post : Phase::Motion;
+  const bool spherical = r.joined && r.joined->grasp == GraspJoint::Spherical;
+  const auto observer = [&](const SimulationState& x) {
+    MotionSample smp;
+    if (const int rc = sampleOf(sim, x, phase, smp)) observer_rc = rc;
+    if (spherical) r.min_chart_margin = std::min(r.min_chart_margin, sphericalChartMargin(*r.joined, x.state));
+    r.record.add(smp);
+    if (o.observer) o.observer(r, smp);
+    if (o.keep_samples) r.samples.push_back(std::move(smp));
+  };
+  const int rc = runSampled(sim, s, t_capture + r.duration, r.output_step, o.controller, o.control_rate, observer);
+  r.end = s;
+  r.record.takeFrom(sim);
+  r.record.t_reached = s.t;
+  // The servos' stiffness at the start, with the friction's regularisation of the run.
+  if (const int src = sim.stiffness(start, r.record.stiffness))
+    throw OperationError(sc.file + ": simulation: " + strError(src), src, std::make_shared<const OperationResult>(r));
+  if (rc || observer_rc) {
+    std::ostringstream why;
+    why << sc.file << ": simulation failed at t = " << s.t << " s of " << r.duration << " s: "
+        << simulationFailure(rc ? rc : observer_rc, sc.simulation, r.record, s);
+    throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(r));
+  }
+  if (!r.joined)
+    r.target_motion = operation::separatedTarget(sc, problem, capture, t_capture, t_capture + r.duration, r.output_step);
+}
+
+OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& o) {
+  using operation::inScenario;
+  OperationResult r;
+  r.duration = o.duration.value_or(sc.simulation.duration);
+  r.output_step = o.output_step.value_or(sc.simulation.output_step);
+  if (o.motion) checkStepBudget(sc, r.duration, r.output_step);
+  r.at_contact = sc.capture;
+  SimulationState s;
+  if (sc.approach && o.approach) operation::approach(sc, r.output_step, r, s);
+  std::optional<CaptureResult> capture;
+  if (sc.impact) capture = inScenario(sc, [&] { return solveCapture(r.at_contact); });
+  const CaptureProblem at_contact = r.at_contact;
+  runMotionAfterCapture(sc, at_contact, capture, r.t_capture, o, r);
+  return r;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,68 @@
+#include "kdl_space/operation/motion_record.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace kdl_space {
+
+void MotionRecord::takeFrom(const Simulator& sim) {
+  options = sim.options();
+  stats = sim.stats();
+  controls = sim.jointControls();
+  limit_modes = sim.limitModes();
+  base_control = sim.baseControl();
+  friction_velocities = sim.frictionVelocities();
+}
+
+void MotionRecord::add(const MotionSample& x) {
+  if (samples++ == 0) first = x;
+  last = x;
+  max_linear_momentum_change = std::max(max_linear_momentum_change, (x.h.head<3>() - first.h.head<3>()).norm());
+  max_angular_momentum_change = std::max(max_angular_momentum_change, (x.h.tail<3>() - first.h.tail<3>()).norm());
+  max_energy_change = std::max(max_energy_change, std::abs(x.T - first.T));
+  const Vector6d e = x.h - first.h - x.impulse;
+  balance_linear = std::max(balance_linear, e.head<3>().norm());
+  balance_angular = std::max(balance_angular, e.tail<3>().norm());
+  torques = torques || (x.tau.size() > 0 && x.tau.cwiseAbs().maxCoeff() > 0.0);
+}
+
+double MotionRecord::meanStep() const {
+  const long steps = stats.accepted_steps;
+  return steps == 0 ? 0.0 : (t_reached - t_start) / static_cast<double>(steps);
+}
+
+std::vector<std::string> MotionRecord::lockedJoints() const {
+  std::vector<std::string> out;
+  for (std::size_t j = 0; j < controls.size(); ++j)
+    if (controls[j].mode == JointControl::Mode::Locked) out.push_back(model->jointNames()[j]);
+  return out;
+}
+
+std::string stiffnessAdvice(const MotionRecord& r) {
+  const Stiffness& st = r.stiffness;
+  const SimulationOptions& o = r.options;
+  if (st.fastest_joint < 0) return {};
+  const std::string joint = "'" + r.model->jointNames()[st.fastest_joint] + "'";
+  std::ostringstream why;
+  why.precision(3);
+  if (o.integrator == Integrator::RK4 && o.step > st.explicit_step) {
+    why << "simulation.step = " << o.step << " s is above the stable step " << st.explicit_step
+        << " s of joint " << joint << " (closed-loop rate " << st.fastest_rate
+        << " 1/s): lower the step or the gains, or use integrator: rosenbrock";
+    return why.str();
+  }
+  // An explicit adaptive run whose steps are far below the output step, with a servo fast enough
+  // to hold them there.
+  const double mean = r.meanStep();
+  if (o.integrator == Integrator::DormandPrince54 && mean > 0.0 && mean < 0.01 * r.output_step &&
+      st.explicit_step < 0.01 * r.output_step) {
+    why << "stiff: the servo of joint " << joint << " (closed-loop rate " << st.fastest_rate
+        << " 1/s) holds dopri5's step near " << mean << " s (" << r.stats.accepted_steps
+        << " steps): try integrator: rosenbrock (an rtol of 1e-6 or looser suits it)";
+    return why.str();
+  }
+  return {};
+}
+
+}  // namespace kdl_space

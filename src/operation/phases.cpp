@@ -1,0 +1,150 @@
+#include "operation/phases.hpp"
+
+#include <iomanip>
+#include <sstream>
+
+#include "detail/text.hpp"
+
+namespace kdl_space::operation {
+
+std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                        bool approach) {
+  try {
+    return makeSimulator(sc, model, approach);
+  } catch (const ModelError& e) {
+    throw InputError(sc.file + ": " + e.what());
+  }
+}
+
+namespace {
+
+/// Why an approach never reached its grasp point (closest distance and when).
+std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
+  std::ostringstream why;
+  why << std::setprecision(6) << sc.file << ": approach: the hand never reached the grasp point in "
+      << sc.approach->max_duration << " s (approach.max_duration): closest " << r.closest_distance << " m at t = "
+      << r.closest_time << " s, " << r.final_distance << " m at the end (tolerance " << sc.approach->position_tolerance
+      << " m); smallest singular value of J* " << r.min_sigma
+      << ": is the grasp point within the arm's reach, the gain high enough, the target slow enough?";
+  return why.str();
+}
+
+}  // namespace
+
+void approach(const Scenario& sc, double output_step, OperationResult& result, SimulationState& s) {
+  const FloatingSystem& robot = sc.capture.robot;
+  std::unique_ptr<Simulator> sim = simulatorFor(sc, robot.model, true);
+  const auto controller = inScenario(sc, [&] {
+    try {
+      return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach,
+                                                  FreeRigidMotion(std::get<RigidTarget>(sc.capture.target)));
+    } catch (const ModelError& e) {
+      throw InputError(std::string("approach: ") + e.what());
+    }
+  });
+  s.state = robot.state;
+  s.velocity = robot.velocity;
+  if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
+  ApproachOutcome outcome;
+  std::vector<MotionSample>& samples = result.approach_samples;
+  int observer_rc = E_NOERROR;
+  const auto observer = [&](const SimulationState& x, const ApproachCommand& cmd) {
+    MotionSample smp;
+    if (const int rc = sampleOf(*sim, x, Phase::Approach, smp)) observer_rc = rc;
+    smp.grasp_distance = cmd.error.head<3>().norm();
+    samples.push_back(std::move(smp));
+  };
+  const int rc = runApproach(*sim, *controller, s, output_step, observer, outcome.record);
+  if (rc || observer_rc) {
+    std::ostringstream why;
+    why << sc.file << ": the approach failed at t = " << s.t << " s: " << strError(rc ? rc : observer_rc);
+    throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(result));
+  }
+  if (const int e = controller->target(s.t, outcome.target_at_contact))
+    throw InputError(sc.file + ": approach: the target's motion: " + strError(e));
+  if (outcome.record.reached && !samples.empty()) samples.back().phase = Phase::Capture;
+  result.at_contact.robot.state = s.state;
+  result.at_contact.robot.velocity = s.velocity;
+  result.at_contact.target = outcome.target_at_contact;
+  result.approach = outcome;
+  result.t_capture = s.t;
+  if (!outcome.record.reached)  // what happened is the caller's to show (the CSV, the plot) with the refusal
+    throw OperationError(approachFailure(sc, outcome.record), E_NOERROR, std::make_shared<const OperationResult>(result));
+}
+
+namespace {
+/// A rigid target as a free-floating system of one body (no joints), its frame at the CoM with
+/// the inertia's axes of the target's frame: what a ball joint can join to the robot.
+FloatingSystem oneBody(const RigidTarget& t, const Vector3d& contact_point, const Vector6d& twist_at_com) {
+  const Matrix3d& I = t.inertia;
+  FloatingSystem s;
+  s.model = std::make_shared<const FloatingModel>(
+      KDL::Tree("target"), KDL::RigidBodyInertia(t.mass, KDL::Vector::Zero(),
+                                                 KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2))));
+  s.state = State(*s.model);
+  s.state.world_T_base = KDL::Frame(t.pose.M, t.pose * toKDL(t.com));
+  s.velocity = FloatingVelocity(*s.model);
+  s.velocity.base_twist = toTwist(twist_at_com);
+  s.contact = Contact{0, s.state.world_T_base.Inverse() * toKDL(contact_point)};
+  return s;
+}
+
+}  // namespace
+
+std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
+                                            const std::optional<CaptureResult>& capture, double t0, double t_end,
+                                            double output_step) {
+  const auto* target = std::get_if<FloatingSystem>(&problem.target);
+  if (!target || !capture || !capture->floating_target) return std::nullopt;
+  SimulationOptions options = sc.simulation.options;
+  options.grounded = target->response == Response::Grounded;
+  Simulator sim(target->model, options);
+  JointControl locked;
+  locked.mode = JointControl::Mode::Locked;
+  for (unsigned int j = 0; j < target->model->nj(); ++j)
+    if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
+      sim.setJointControl(j, locked);
+  TargetMotion m;
+  m.end.t = t0;
+  m.end.state = target->state;
+  m.end.velocity = capture->floating_target->after;
+  if (options.grounded) m.end.velocity.base_twist = KDL::Twist::Zero();
+  Vector6d h0 = Vector6d::Zero();
+  int observer_rc = E_NOERROR;
+  const auto observer = [&](const SimulationState& x) {
+    double T;
+    Vector6d h;
+    if (const int rc = sim.energyAndMomentum(x, T, h)) observer_rc = rc;
+    if (x.t == t0) h0 = h, m.T = T;
+    m.dP = std::max(m.dP, (h.head<3>() - h0.head<3>()).norm());
+    m.dL = std::max(m.dL, (h.tail<3>() - h0.tail<3>()).norm());
+  };
+  int rc = sim.engageBrakes(m.end);
+  if (rc == E_NOERROR) rc = sim.run(m.end, t_end, output_step, observer);
+  if (rc || observer_rc)
+    throw OperationError(sc.file + ": the target's motion after the impact failed at t = " + detail::number(m.end.t) +
+                             " s: " + strError(rc ? rc : observer_rc),
+                         rc ? rc : observer_rc, nullptr);
+  return m;
+}
+
+}  // namespace kdl_space::operation
+
+namespace kdl_space {
+
+std::optional<JoinedSystem> joinedAfterCapture(const CaptureProblem& problem, const CaptureResult& capture) {
+  const ImpactKind kind = problem.law.kind;
+  if (kind != ImpactKind::Capture && kind != ImpactKind::TranslationalCapture) return std::nullopt;
+  const GraspJoint grasp = kind == ImpactKind::Capture ? GraspJoint::Rigid : GraspJoint::Spherical;
+  if (const auto* target = std::get_if<FloatingSystem>(&problem.target))
+    return joinAtGrasp(problem.robot, capture.robot.after, *target, capture.floating_target->after, grasp,
+                       problem.touch_tolerance);
+  if (grasp == GraspJoint::Rigid) return std::nullopt;  // the payload route (attachTarget)
+  const RigidTarget& rigid = std::get<RigidTarget>(problem.target);
+  FloatingSystem body = operation::oneBody(rigid, capture.contact_point, capture.target_twist_before);
+  FloatingVelocity after = body.velocity;
+  after.base_twist = toTwist(capture.target_twist_after);
+  return joinAtGrasp(problem.robot, capture.robot.after, body, after, grasp, problem.touch_tolerance);
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,41 @@
+// The phases of the capture operation that runCaptureOperation puts in order (private): the
+// approach, and the motion of a free-floating target that separated after a point impact.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "kdl_space/operation/capture_operation.hpp"
+
+namespace kdl_space::operation {
+
+/// \brief The approach: from the robot's initial state until the hand holds the grasp point; its
+/// samples (the last one: the contact instant, Phase::Capture) go to result.approach_samples,
+/// the robot's and the target's states at the contact instant to result.at_contact, the robot's
+/// to s. \throws InputError (the scenario's terms) when the approach cannot run or fails.
+void approach(const Scenario& sc, double output_step, OperationResult& result, SimulationState& s);
+
+/// \brief A free-floating target that separated after a point impact, moved on by itself from
+/// t0 to t_end (its own modes: braked joints stay braked; gravity as the robot's); nothing
+/// unless such a target separated.
+std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
+                                            const std::optional<CaptureResult>& capture, double t0, double t_end,
+                                            double output_step);
+
+/// The simulator as the scenario says, or its refusal in the scenario's words.
+std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
+                                        bool approach);
+
+/// `f()`, an InputError it throws with the scenario's file in front ("FILE: target: ...").
+template <typename F>
+auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const OperationError&) {
+    throw;
+  } catch (const InputError& e) {
+    throw InputError(scenario.file + ": " + e.what());
+  }
+}
+
+}  // namespace kdl_space::operation

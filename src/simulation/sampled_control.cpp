@@ -1,0 +1,89 @@
+#include "kdl_space/simulation/sampled_control.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace kdl_space {
+
+ControlGrid controlGrid(double output_dt, double period) {
+  ControlGrid g{output_dt};
+  if (period == 0.0) return g;
+  if (!(period > 0.0) || !std::isfinite(period)) {
+    std::ostringstream why;
+    why << "control period: expected a finite period > 0 s (1 / control_rate), got " << period;
+    throw InputError(why.str());
+  }
+  if (!(output_dt > 0.0) || !std::isfinite(output_dt)) return g;  // run() refuses it with its code
+  const double r = period / output_dt;
+  for (long b = 1; b <= 1000; ++b) {
+    const double x = r * static_cast<double>(b);
+    const long a = std::lround(x);
+    if (a >= 1 && std::abs(x - static_cast<double>(a)) <= 1e-9 * x) {
+      g.a = a, g.b = b;
+      g.delta = a == 1 ? period : b == 1 ? output_dt : period / static_cast<double>(a);
+      return g;
+    }
+  }
+  std::ostringstream why;
+  why << "output_dt: " << output_dt << " s and the control period 1 / control_rate = " << period
+      << " s are not commensurate (their ratio is no fraction a / b with b <= 1000)";
+  throw InputError(why.str());
+}
+
+int runSampled(Simulator& sim, SimulationState& s, double t_end, double output_dt, const SampledController& controller,
+               double control_rate, const std::function<void(const SimulationState&)>& observer) {
+  const bool hold = control_rate != 0.0;
+  const ControlGrid grid = controlGrid(output_dt, hold ? 1.0 / control_rate : 0.0);
+  const double t0 = s.t;
+  const Eigen::Index n = sim.model().nj();
+  Eigen::VectorXd command = Eigen::VectorXd::Zero(n);
+  bool commanded = false;
+  int controller_rc = E_NOERROR;
+  const auto call = [&](const SimulationState& x) {
+    Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
+    controller(x, tau);
+    if (tau.size() != n) controller_rc = E_SIZE_MISMATCH;
+    else if (!tau.allFinite()) controller_rc = E_NOT_FINITE;
+    else command = tau;
+    commanded = true;
+  };
+  long outputs = 0;
+  int sample_rc = E_NOERROR;
+  const auto sampled = [&](const SimulationState& x) {
+    const long i = outputs++;
+    const bool last = x.t >= t_end;
+    const SimulationState* row = &x;
+    SimulationState now;
+    if (grid.a > 0 && i > 0 && i % grid.a == 0 &&
+        (!last || std::abs(t0 + static_cast<double>(i) * grid.delta - t_end) <= 1e-9 * grid.delta)) {
+      call(x);  // the command held from this instant on
+      now = x;
+      if (const int rc = sim.actuation(now)) sample_rc = rc;
+      row = &now;
+    }
+    if (i % grid.b != 0 && !last) return;
+    if (observer) observer(*row);
+  };
+  struct Guard {  // the callbacks refer to this frame: they go when the run ends, however it ends
+    Simulator& sim;
+    bool set = false;
+    ~Guard() {
+      if (!set) return;
+      sim.setTorqueCallback(nullptr);
+      sim.setStopCondition(nullptr);
+    }
+  } guard{sim};
+  if (controller) {
+    guard.set = true;
+    sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
+      if (!hold || !commanded) call(x);  // zero-order hold: the first command at the start
+      tau.data = command;
+    });
+    // A controller that answered with a wrong size or a non-finite torque ends the run there.
+    sim.setStopCondition([&](const SimulationState&) { return controller_rc != E_NOERROR; });
+  }
+  const int rc = sim.run(s, t_end, grid.delta, sampled);
+  return controller_rc ? controller_rc : rc ? rc : sample_rc;
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,193 @@
+#include "operation_report.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "approach_report.hpp"
+#include "capture.hpp"
+#include "detail/text.hpp"
+#include "motion_report.hpp"
+
+namespace kdl_space::cli {
+
+/// The scene at the start, at the contact (the impact, at t_contact) and at the end of the run.
+std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const OperationResult& r) {
+  const CaptureProblem& at_contact = r.at_contact;
+  const std::optional<CaptureResult>& capture = r.capture;
+  const bool joined = r.joined.has_value();
+  const std::shared_ptr<const FloatingModel>& model = r.model;
+  const SimulationState& end = r.end;
+  const double t_contact = r.t_capture;
+  const SimulationState* target_end = r.target_motion ? &r.target_motion->end : nullptr;
+  // The grasp point of an approach: fixed in the (rigid) target's frame.
+  const auto grasp = [&](const CaptureTarget& target) -> std::optional<Vector3d> {
+    const auto* rigid = std::get_if<RigidTarget>(&target);
+    if (!sc.approach || !rigid) return std::nullopt;
+    return toEigen(rigid->pose * sc.approach->grasp.p);
+  };
+  const auto at = [&](const CaptureProblem& problem, const char* label, double t) {
+    Scenario then = sc;
+    then.capture = problem;
+    SceneSnapshot snap = impactSnapshot(then);
+    if (!sc.impact) snap.target_body.reset();  // a plain motion: no target
+    if (const std::optional<Vector3d> g = grasp(problem.target)) snap.grasp_point = g;
+    snap.label = label;
+    snap.t = t;
+    return snap;
+  };
+  std::vector<SceneSnapshot> out;
+  if (sc.approach || !sc.impact) out.push_back(at(sc.capture, "start", 0.0));
+  if (sc.impact) out.push_back(at(at_contact, sc.approach ? "contact" : "impact", t_contact));
+  SceneSnapshot last;
+  last.label = "end";
+  last.t = end.t;
+  last.robot = model;  // the joined system, the robot with its payload, or the robot alone
+  last.robot_state = end.state;
+  last.robot_contact = joined ? Contact{-1, KDL::Vector::Zero()} : at_contact.robot.contact;
+  if (capture && model == at_contact.robot.model) {  // the target separated: a rigid one tumbles on
+    if (const auto* rigid = std::get_if<RigidTarget>(&at_contact.target)) {
+      RigidTarget after = *rigid;
+      after.twist = capture->target_twist_after;
+      RigidTarget later;
+      if (FreeRigidMotion(after).at(end.t - t_contact, later) == E_NOERROR) {
+        last.target_body = later.toWorld();
+        last.target_frame = later.pose;
+      }
+    }
+  }
+  if (const auto* floating = std::get_if<FloatingSystem>(&at_contact.target); floating && target_end) {
+    last.target_robot = floating->model;  // separated after a point impact: where it went
+    last.target_state = target_end->state;
+  }
+  out.push_back(last);
+  return out;
+}
+
+/// The target's joints in the joined model, by their name there, and the sign of their coordinate
+/// (-1: reversed by the re-rooting).
+Json targetSigns(const JoinedSystem& joint, const std::shared_ptr<const FloatingModel>& model) {
+  Json signs = Json::object();
+  for (std::size_t j = 0; j < joint.target_joints.size(); ++j)
+    signs[model->jointNames()[joint.target_joints[j]]] = joint.target_joint_sign[j];
+  return signs;
+}
+
+namespace {
+
+Json targetMotionJson(const OperationResult& r) {
+  if (!r.target_motion) return nullptr;  // else a free-floating target that separated: its own motion
+  const SimulationState& e = r.target_motion->end;
+  Eigen::Vector4d quat;
+  e.state.world_T_base.M.GetQuaternion(quat(0), quat(1), quat(2), quat(3));
+  return Json{{"final", Json{{"t", e.t},
+                             {"base_position", toJson(toEigen(e.state.world_T_base.p))},
+                             {"base_quaternion", toJson(quat)},
+                             {"base_twist", toJson(toEigen(e.velocity.base_twist))},
+                             {"q", toJson(e.state.q.data)},
+                             {"qdot", toJson(e.velocity.qdot.data)}}},
+              {"joint_names", std::get<FloatingSystem>(r.at_contact.target).model->jointNames()},
+              {"energy", r.target_motion->T},
+              {"max_linear_momentum_change", r.target_motion->dP},
+              {"max_angular_momentum_change", r.target_motion->dL}};
+}
+
+const char* integratorName(Integrator i) {
+  return i == Integrator::RK4 ? "rk4" : i == Integrator::Rosenbrock ? "rosenbrock" : "dopri5";
+}
+
+}  // namespace
+
+Json operationJson(const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
+  const MotionRecord& record = r.record;
+  const MotionSample& last = record.last;
+  const bool grounded = record.options.grounded;
+  Json j;
+  j["capture"] = r.capture ? captureJson(sc, *r.capture) : Json(nullptr);
+  j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
+  j["target_motion"] = targetMotionJson(r);
+  const Json final_state{{"t", last.t},
+                         {"base_position", toJson(last.p)},
+                         {"base_quaternion", toJson(last.quat)},
+                         {"base_twist", toJson(last.twist)},
+                         {"q", toJson(last.q)},
+                         {"qdot", toJson(last.qd)}};
+  const Json joined = r.joined ? Json{{"grasp", r.joined->grasp == GraspJoint::Rigid ? "rigid" : "spherical"},
+                                      {"target_prefix", r.joined->target_prefix},
+                                      {"target_joint_signs", targetSigns(*r.joined, r.model)},
+                                      {"min_chart_margin", r.min_chart_margin}}
+                               : Json(nullptr);
+  j["simulation"] = Json{{"duration", r.duration},
+                         {"integrator", integratorName(record.options.integrator)},
+                         {"accepted_steps", record.stats.accepted_steps},
+                         {"rejected_steps", record.stats.rejected_steps},
+                         {"payload_attached", r.payload_attached},
+                         {"target_joined", joined},
+                         {"joint_names", r.model->jointNames()},
+                         {"joints_treated_as_fixed", fixedJointsJson(*r.model)},
+                         {"final", final_state},
+                         {"max_linear_momentum_change", record.max_linear_momentum_change},
+                         {"max_angular_momentum_change", record.max_angular_momentum_change},
+                         {"max_energy_change", record.max_energy_change},
+                         {"energy", record.first.T},
+                         {"csv", files.csv.empty() ? Json(nullptr) : Json(files.csv)},
+                         {"plot", files.plot.empty() ? Json(nullptr) : Json(files.plot)},
+                         {"base", grounded ? "grounded" : "free"},
+                         {"locked_joints", record.lockedJoints()},
+                         {"momentum_balance_error", grounded ? Json(nullptr)
+                                                             : Json{{"linear", record.balance_linear},
+                                                                    {"angular", record.balance_angular}}},
+                         {"limit_violations", limitViolationsJson(record)},
+                         {"saturation", saturationJson(record)},
+                         {"energy_split", energySplitJson(record)},
+                         {"base_control", baseControlJson(record)},
+                         {"stiffness", stiffnessJson(record)},
+                         {"friction", frictionJson(record)}};
+  return j;
+}
+
+void printOperation(std::ostream& out, const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
+  const MotionRecord& record = r.record;
+  const std::vector<std::string>& joints = r.model->jointNames();
+  if (r.approach) printApproach(out, sc, *r.approach);
+  if (r.capture) {
+    printCaptureSummary(out, sc, *r.capture);
+    const std::string& contact_link = r.at_contact.robot.model->bodies()[r.at_contact.robot.contact.body].name;
+    out << "\nAfter the impact: "
+        << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by a " +
+                           (r.joined->grasp == GraspJoint::Rigid ? "fixed joint" : "ball joint (grasp_rz, grasp_ry, grasp_rx)")
+            : r.payload_attached ? "the target is attached to link '" + contact_link + "'"
+            : r.target_motion    ? std::string("the target separates; both move on")
+                                 : std::string("the target separates; the robot alone"));
+  } else {
+    out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
+  }
+  out << ", " << r.duration << " s with " << integratorName(record.options.integrator) << " ("
+      << record.stats.accepted_steps << " steps, " << record.stats.rejected_steps << " rejected)"
+      << (record.options.grounded ? ", base grounded" : "") << "\n";
+  const std::vector<std::string> locked_joints = record.lockedJoints();
+  if (!locked_joints.empty()) out << "Braked joints: " << locked_joints.size() << " (" << detail::listNames(locked_joints) << ")\n";
+  const MotionSample& last = record.last;
+  double roll, pitch, yaw;
+  KDL::Rotation::Quaternion(last.quat(0), last.quat(1), last.quat(2), last.quat(3)).GetRPY(roll, pitch, yaw);
+  out << "Final base position [m]: " << last.p.transpose() << "\n"
+      << "Final base attitude (roll, pitch, yaw) [deg]: " << roll * 180 / M_PI << ", " << pitch * 180 / M_PI << ", "
+      << yaw * 180 / M_PI << "\n"
+      << "Final base twist (v; w): " << last.twist.transpose() << "\n";
+  printMatrix(out, "Joints at the end", (Eigen::MatrixXd(joints.size(), 2) << last.q, last.qd).finished(), joints,
+              {"position", "rate"});
+  out << "Largest change over the run: linear momentum " << record.max_linear_momentum_change << " N s, angular momentum "
+      << record.max_angular_momentum_change << " N m s, kinetic energy " << record.max_energy_change << " J (of "
+      << record.first.T << " J)\n";
+  printMotionReport(out, record);
+  if (r.target_motion)
+    out << "The target after the impact: base at " << toEigen(r.target_motion->end.state.world_T_base.p).transpose()
+        << " m at t = " << r.target_motion->end.t << " s; its momentum changed by at most " << r.target_motion->dP
+        << " N s, " << r.target_motion->dL << " N m s\n";
+  if (r.joined && r.joined->grasp == GraspJoint::Spherical && r.min_chart_margin < 0.1)
+    out << "Warning: the ball joint came within " << r.min_chart_margin
+        << " of its chart's singularity (|cos grasp_ry|): its angles are ill-conditioned there\n";
+  if (!files.csv.empty()) out << "CSV: " << files.csv << "\n";
+  if (!files.plot.empty()) out << "Plot: " << files.plot << "\n";
+}
+
+}  // namespace kdl_space::cli
