@@ -105,6 +105,10 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   j["capture"] = r.capture ? captureJson(sc, *r.capture) : Json(nullptr);
   j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
   j["target_motion"] = targetMotionJson(r);
+  if (record.samples == 0) {  // stopped at the capture (OperationOptions::motion false)
+    j["simulation"] = nullptr;
+    return j;
+  }
   const Json final_state{{"t", last.t},
                          {"base_position", toJson(last.p)},
                          {"base_quaternion", toJson(last.quat)},
@@ -149,8 +153,9 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   const MotionRecord& record = r.record;
   const std::vector<std::string>& joints = r.model->jointNames();
   if (r.approach) printApproach(out, sc, *r.approach);
+  if (r.capture) printCaptureSummary(out, sc, *r.capture);
+  if (record.samples == 0) return;  // stopped at the capture
   if (r.capture) {
-    printCaptureSummary(out, sc, *r.capture);
     const std::string& contact_link = r.at_contact.robot.model->bodies()[r.at_contact.robot.contact.body].name;
     out << "\nAfter the impact: "
         << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by a " +

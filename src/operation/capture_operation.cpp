@@ -158,6 +158,10 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   }
   r.payload_attached = r.model != problem.robot.model;
   widenApproachSamples(*problem.robot.model, r);
+  r.record = MotionRecord{};
+  r.record.model = r.model;
+  r.record.output_step = r.output_step;
+  r.record.t_start = r.record.t_reached = t_capture;
   if (!o.motion) return;
 
   std::unique_ptr<Simulator> simulator = operation::simulatorFor(sc, r.model, false);
@@ -169,10 +173,6 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   setModesAfter(sc, problem, r, o.hold_servos, sim);
   checkStart(sc, sim, s);
   const SimulationState start = s;
-  r.record = MotionRecord{};
-  r.record.model = r.model;
-  r.record.output_step = r.output_step;
-  r.record.t_start = start.t;
   if (o.observer)
     for (const MotionSample& x : r.approach_samples) o.observer(r, x);
   int observer_rc = E_NOERROR;

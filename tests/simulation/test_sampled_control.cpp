@@ -12,6 +12,9 @@
 namespace kdl_space {
 namespace {
 
+using test::near;
+using test::urdfDir;
+
 TEST(ControlGrid, CommonGridOfSamplesAndControls) {
   // samples every 0.05 s, control at 100 Hz: a grid of 0.01 s, a control every step, a sample every 5
   ControlGrid g = controlGrid(0.05, 0.01);

@@ -68,7 +68,9 @@ struct KDL_SPACE_EXPORT OperationResult {
   double t_capture = 0.0;         ///< the contact instant (0 without an approach) [s]
   std::vector<MotionSample> approach_samples;  ///< the last one: the contact instant
   std::vector<MotionSample> samples;           ///< of the motion after the capture (keep_samples)
-  MotionRecord record;            ///< the motion's records and aggregates (also without samples)
+  /// The motion's records and aggregates (also without kept samples; none without a motion:
+  /// record.samples is 0)
+  MotionRecord record;
   SimulationState end;            ///< the state at the end of the motion
   std::optional<TargetMotion> target_motion;  ///< a free-floating target that separated
   double min_chart_margin = 1.0;  ///< a ball joint's least distance from its chart's singularity
