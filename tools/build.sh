@@ -1,8 +1,21 @@
 #!/usr/bin/env bash
-# Configures and builds kdl_space into build/ (or $KDL_SPACE_BUILD_DIR). Extra args go to cmake.
+# tools/build.sh [--target TARGET]... [CMAKE_ARGS...]: installs what is missing, configures kdl_space
+# into build/ (or $KDL_SPACE_BUILD_DIR) and builds it: everything (library, tool, tests, benchmark,
+# Python module), or only the given targets and what they need (tools/demo.sh: --target
+# kdl_space_cli). The other arguments go to cmake's configure step. Configuring is always the same,
+# so a later build of everything (tools/test.sh) reuses what a build of some targets compiled.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${KDL_SPACE_BUILD_DIR:-$root/build}"
+targets=()
+while (($#)); do
+  case "$1" in
+    --target) (($# >= 2)) || { echo "tools/build.sh: --target needs a name" >&2; exit 2; }
+              targets+=(--target "$2"); shift 2 ;;
+    --target=*) targets+=(--target "${1#--target=}"); shift ;;
+    *) break ;;
+  esac
+done
 "$root/tools/deps.sh"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
-cmake --build "$build" -j"$(nproc)" >/dev/null
+cmake --build "$build" -j"$(nproc)" ${targets[@]+"${targets[@]}"} >/dev/null
