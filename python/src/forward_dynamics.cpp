@@ -163,7 +163,7 @@ void bindForwardDynamics(py::module_& m) {
       "Free-floating forward dynamics in O(n) (Featherstone's articulated-body algorithm with a floating base): "
       "base and joint accelerations from a state, joint torques and external wrenches, with the velocity "
       "products, gravity, brakes and a grounded base. One thread at a time per solver.");
-  bindFD<DenseForwardDynamics>(
+  bindFD<DenseForwardDynamicsSolver>(
       m, "DenseForwardDynamicsSolver",
       "The same accelerations by the composite-rigid-body route: the dense (6+n)^2 system, O(n^3); models with "
       "mimic joints too. One thread at a time per solver.");

@@ -151,7 +151,7 @@ std::unique_ptr<PySimulator> makeSimulator(const Model& model, py::object integr
   return std::make_unique<PySimulator>(model, o);
 }
 
-/// The simulator as `kdl_space simulate` builds it from a scenario (tools/capture_operation.cpp).
+/// The simulator as `kdl_space simulate` builds it from a scenario (makeSimulator, parsers/scenario/scenario.hpp).
 std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model_obj) {
   const Scenario& sc = ps.scenario;
   const FloatingSystem& robot = sc.capture.robot;

@@ -19,7 +19,7 @@ int inputs(const FloatingModel& m, const FloatingVelocity& velocity, const KDL::
 
 }  // namespace
 
-DenseForwardDynamics::DenseForwardDynamics(std::shared_ptr<const FloatingModel> model) : solver_(std::move(model)) {
+DenseForwardDynamicsSolver::DenseForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model) : solver_(std::move(model)) {
   const std::size_t nb = this->model().bodies().size();
   const unsigned int n = this->model().nj();
   locked_.assign(n, false);
@@ -32,33 +32,33 @@ DenseForwardDynamics::DenseForwardDynamics(std::shared_ptr<const FloatingModel> 
   M_llt_.compute(Eigen::MatrixXd::Identity(6 + n, 6 + n));  // sized
 }
 
-int DenseForwardDynamics::setGravity(const Vector3d& g) {
+int DenseForwardDynamicsSolver::setGravity(const Vector3d& g) {
   if (!g.allFinite()) return E_NOT_FINITE;
   gravity_ = g;
   return E_NOERROR;
 }
 
-int DenseForwardDynamics::setLocked(const std::vector<bool>& locked) {
+int DenseForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
   if (locked.size() != model().nj()) return E_SIZE_MISMATCH;
   locked_ = locked;
   return E_NOERROR;
 }
 
-int DenseForwardDynamics::CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+int DenseForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                                     const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {
   if (const int rc = inputs(model(), velocity, tau, f_ext, acceleration)) return rc;
   if (const int rc = solver_.compute(state)) return rc;
   return solve(toEigen(state.world_T_base.p), velocity, tau, f_ext, acceleration);
 }
 
-int DenseForwardDynamics::CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+int DenseForwardDynamicsSolver::CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                                     const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {
   if (const int rc = inputs(model(), velocity, tau, f_ext, acceleration)) return rc;
   if (const int rc = solver_.compute(kin)) return rc;
   return solve(kin.p_b, velocity, tau, f_ext, acceleration);
 }
 
-int DenseForwardDynamics::solve(const Vector3d& p_b, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+int DenseForwardDynamicsSolver::solve(const Vector3d& p_b, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {
   const std::vector<Body>& bodies = model().bodies();
   const unsigned int n = model().nj();

@@ -102,7 +102,7 @@ int RosenbrockStepper::step(const Rhs& f, double t, double h, const Eigen::Vecto
     K_.col(i).noalias() = lu_.solve(rhs_);
   }
 
-  // x_new and the estimate err = sum e_i K_i (kept in y_), scaled as stepDP54 scales it.
+  // x_new and the estimate err = sum e_i K_i (kept in y_), scaled as DOPRI5 scales it (simulation/steppers).
   x_new = x;
   y_.setZero();
   for (int i = 0; i < kStages; ++i) {

@@ -49,7 +49,7 @@ class RosenbrockStepper {
 
   /// One step of size h > 0 from (t, x): x_new and the error estimate
   ///   error = sqrt(mean_i (err_i / (atol + rtol max(|x_i|, |x_new_i|)))^2),
-  /// the scaled RMS norm of Simulator::stepDP54; a step is acceptable when error <= 1.
+  /// the scaled RMS norm of the simulator's DOPRI5 (simulation/steppers); acceptable when error <= 1.
   /// Returns 0; E_SIZE_MISMATCH (x or x_new not of size(), or f resized dx); E_BAD_ARGUMENT
   /// (h <= 0, rtol or atol < 0, or both 0); E_NOT_FINITE (t, h or x not finite, or a result that
   /// is not, e.g. from a singular W); or the first nonzero code of f. On an error x_new and error

@@ -10,6 +10,17 @@ namespace kdl_space::detail {
 /// 'name', as every message quotes a link, joint or file.
 inline std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
+/// A text from an input, quoted for a message: at most 40 characters, anything but printable
+/// ASCII shown as '?' (a binary file must not flood the terminal).
+inline std::string echo(const std::string& text) {
+  std::string shown;
+  for (std::size_t i = 0; i < text.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    shown += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
+  }
+  return "'" + shown + (text.size() > 40 ? "...'" : "'");
+}
+
 /// A number as a message shows it: 6 significant digits, the stream's default ("0.2", "1e+06").
 inline std::string number(double x) {
   std::ostringstream s;

@@ -1,12 +1,14 @@
 #include "kdl_space/parsers/input_file.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <locale>
+#include <sstream>
 
 namespace kdl_space {
 
@@ -23,25 +25,65 @@ void checkInputFile(const std::string& path, const std::string& kind) {
   if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(path + ": the file is empty; expected a " + kind);
 }
 
+NumberText readNumber(const std::string& text, double& value, bool space_before) {
+  std::size_t i = space_before ? text.find_first_not_of(" \t\n\r\f\v") : 0;
+  if (i == std::string::npos || i == text.size()) return NumberText::NotANumber;
+  const std::size_t start = i;
+  if (text[i] == '+' || text[i] == '-') ++i;
+  const std::size_t after_sign = i;
+  const auto digits = [&] {
+    const std::size_t from = i;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
+    return i - from;
+  };
+  std::size_t mantissa = digits();
+  if (i < text.size() && text[i] == '.') {
+    ++i;
+    mantissa += digits();
+  }
+  bool decimal = mantissa > 0;
+  if (decimal && i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+    decimal = digits() > 0;
+  }
+  if (decimal && i == text.size()) {
+    // The C locale's reading, as urdfdom's (a stream extraction); well formed, it fails only
+    // beyond the range of a double (an underflow reads as the nearest double).
+    std::istringstream in(text.substr(start));
+    in.imbue(std::locale::classic());
+    double v = 0.0;
+    in >> v;
+    if (in.fail() || !std::isfinite(v)) return NumberText::TooLarge;
+    value = v;
+    return NumberText::Finite;
+  }
+  // The names strtod reads as no finite number.
+  std::string word;
+  for (std::size_t k = after_sign; k < text.size(); ++k)
+    word += static_cast<char>(std::tolower(static_cast<unsigned char>(text[k])));
+  if (word == "nan" || word == "inf" || word == "infinity") return NumberText::NotFinite;
+  if (word.size() >= 5 && word.compare(0, 4, "nan(") == 0 && word.back() == ')' &&
+      std::all_of(word.begin() + 4, word.end() - 1, [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+    return NumberText::NotFinite;
+  return NumberText::NotANumber;
+}
+
 bool parseFiniteNumber(const std::string& text, double& value, std::string& why) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double v = text.empty() || std::isspace(static_cast<unsigned char>(text[0])) ? 0.0 : std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size()) {
-    why = "'" + text + "' is not a number";
-    return false;
+  switch (readNumber(text, value)) {
+    case NumberText::Finite:
+      return true;
+    case NumberText::TooLarge:
+      why = "'" + text + "' is too large (not a finite number)";
+      return false;
+    case NumberText::NotFinite:
+      why = "'" + text + "' is not a finite number";
+      return false;
+    case NumberText::NotANumber:
+      break;
   }
-  if (errno == ERANGE && std::isinf(v)) {
-    why = "'" + text + "' is too large (not a finite number)";
-    return false;
-  }
-  if (!std::isfinite(v)) {
-    why = "'" + text + "' is not a finite number";
-    return false;
-  }
-  value = v;  // (a denormal underflow to 0 or a tiny value is a number: accepted)
-  return true;
+  why = "'" + text + "' is not a number";
+  return false;
 }
 
 }  // namespace kdl_space

@@ -4,39 +4,29 @@
 #include <cmath>
 #include <limits>
 
+#include "simulation/dynamics.hpp"
 #include "simulation/simulation_layout.hpp"
+#include "simulation/steppers.hpp"
 
 namespace kdl_space {
 namespace {
 
-// Dormand & Prince (1980) RK5(4)7M tableau.
-constexpr double kC[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
-constexpr double kA[7][6] = {
-    {},
-    {1.0 / 5},
-    {3.0 / 40, 9.0 / 40},
-    {44.0 / 45, -56.0 / 15, 32.0 / 9},
-    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
-    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
-    {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
-constexpr double kB5[7] = {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0.0};
-constexpr double kB4[7] = {5179.0 / 57600, 0.0, 7571.0 / 16695, 393.0 / 640, -92097.0 / 339200, 187.0 / 2100, 1.0 / 40};
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// The forward dynamics of a motion: the O(n) recursion, or the dense route when joints are
-/// coupled (mimic), which the recursion cannot carry.
-detail::Dynamics dynamicsFor(const std::shared_ptr<const FloatingModel>& model) {
-  if (!model->mimic().empty()) return detail::Dynamics(std::in_place_type<DenseForwardDynamics>, model);
-  return detail::Dynamics(std::in_place_type<ForwardDynamicsSolver>, model);
-}
-
 }  // namespace
+
+/// The steppers' one call into the simulator: x' = f(t, x) is derivative().
+struct Simulator::Equations final : detail::Derivative {
+  explicit Equations(Simulator& simulator) : sim(simulator) {}
+  int f(double t, const Vector& x, Vector& dx) override { return sim.derivative(t, x, dx); }
+  Simulator& sim;
+};
 
 Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptions options)
     : model_(model ? std::move(model) : throw ModelError("simulation: null model")),
       kin_(*model_),
       momentum_(model_),
-      dynamics_(dynamicsFor(model_)),
+      dynamics_(std::make_unique<detail::Dynamics>(model_)),
       options_(options) {
   const unsigned int n = this->model().nj();
   controls_.assign(n, JointControl{});
@@ -55,8 +45,8 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   tau_extra_ = KDL::JntArray(n);
   acc_.qddot = KDL::JntArray(n);
   f_ext_.assign(this->model().bodies().size(), KDL::Wrench::Zero());
-  const int size = detail::StateLayout(n).size;
-  k_.assign(7, Vector::Zero(size));
+  const detail::StateLayout layout(n);
+  const int size = layout.size;
   x_.setZero(size);
   x_tmp_.setZero(size);
   x_new_.setZero(size);
@@ -67,13 +57,12 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
       !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity) || !positive(options_.friction_rate))
     throw ModelError(
         "simulation: step, rtol, atol, max_step, max_steps, friction_velocity and friction_rate must be finite and > 0");
-  if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54 &&
-      options_.integrator != Integrator::Rosenbrock)
-    throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54, Rosenbrock");
-  if (std::visit([&](auto& d) { return d.setGravity(options_.gravity); }, dynamics_) != E_NOERROR)
-    throw ModelError("simulation: gravity must be finite");
-  std::visit([&](auto& d) { d.setGrounded(options_.grounded); }, dynamics_);
-  if (options_.integrator == Integrator::Rosenbrock) makeStiffStepper();
+  equations_ = std::make_unique<Equations>(*this);
+  // ModelError for an integrator that is no enumerator.
+  stepper_ = detail::makeStepper(options_.integrator, *equations_, size,
+                                 detail::ErrorControl{options_.rtol, options_.atol, layout.work});
+  if (dynamics_->setGravity(options_.gravity) != E_NOERROR) throw ModelError("simulation: gravity must be finite");
+  dynamics_->setGrounded(options_.grounded);
 }
 
 Simulator::~Simulator() = default;
@@ -142,7 +131,7 @@ void Simulator::addWrench(const ScheduledWrench& w) {
 void Simulator::applyLocks() {
   for (std::size_t j = 0; j < controls_.size(); ++j)
     locked_now_[j] = controls_[j].mode == JointControl::Mode::Locked || at_stop_[j];
-  std::visit([&](auto& d) { d.setLocked(locked_now_); }, dynamics_);
+  dynamics_->setLocked(locked_now_);
 }
 
 int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
@@ -210,9 +199,7 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   if (const int rc = actuate(t, x)) return rc;
   const bool external = base_control_.on() || !wrenches_.empty();
   static const std::vector<KDL::Wrench> none;
-  if (const int rc = std::visit(
-          [&](auto& d) { return d.CartToJnt(kin_, scratch_.velocity, scratch_.tau, external ? f_ext_ : none, acc_); },
-          dynamics_))
+  if (const int rc = dynamics_->CartToJnt(kin_, scratch_.velocity, scratch_.tau, external ? f_ext_ : none, acc_))
     return rc;
   const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
   const Eigen::Vector4d quat = x.segment<4>(3);
@@ -229,50 +216,14 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   return E_NOERROR;
 }
 
-int Simulator::stepRK4(double t, double h, Vector& x) {
+int Simulator::step(double t, double h, const Vector& x, Vector& x_new, double& error, bool& trial_failed) {
   const detail::WrenchClock clock(wrench_clock_, t, h);
-  if (int rc = derivative(t, x, k_[0])) return rc;
-  x_tmp_ = x + 0.5 * h * k_[0];
-  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[1])) return rc;
-  x_tmp_ = x + 0.5 * h * k_[1];
-  if (int rc = derivative(t + 0.5 * h, x_tmp_, k_[2])) return rc;
-  x_tmp_ = x + h * k_[2];
-  if (int rc = derivative(t + h, x_tmp_, k_[3])) return rc;
-  x += h / 6.0 * (k_[0] + 2.0 * k_[1] + 2.0 * k_[2] + k_[3]);
-  return E_NOERROR;
+  return stepper_->step(t, h, x, x_new, error, trial_failed);
 }
 
-double Simulator::errorNorm(const Vector& x, const Vector& x_new, const Vector& difference) const {
-  // The motion's own components; the work and impulse integrals follow and do not steer the step.
-  const Eigen::Index size = detail::StateLayout(model().nj()).work;
-  double sum = 0.0;
-  for (Eigen::Index i = 0; i < size; ++i) {
-    const double scale = options_.atol + options_.rtol * std::max(std::abs(x(i)), std::abs(x_new(i)));
-    sum += (difference(i) / scale) * (difference(i) / scale);
-  }
-  return std::sqrt(sum / static_cast<double>(size));
-}
-
-int Simulator::stepDP54(double t, double h, const Vector& x, double& error, bool& trial_failed) {
+int Simulator::retake(double t, double h, const Vector& x, Vector& result) {
   const detail::WrenchClock clock(wrench_clock_, t, h);
-  trial_failed = false;
-  for (int i = 0; i < 7; ++i) {
-    x_tmp_ = x;
-    for (int j = 0; j < i; ++j) x_tmp_ += h * kA[i][j] * k_[j];
-    if (int rc = derivative(t + kC[i] * h, x_tmp_, k_[i])) {
-      trial_failed = i > 0;  // a stage away from x: a smaller step may not reach that state
-      return rc;
-    }
-  }
-  x_new_ = x;
-  x_tmp_.setZero();  // the error estimate
-  for (int i = 0; i < 7; ++i) {
-    x_new_ += h * kB5[i] * k_[i];
-    x_tmp_ += h * (kB5[i] - kB4[i]) * k_[i];
-  }
-  error = errorNorm(x, x_new_, x_tmp_);
-  trial_failed = !std::isfinite(error);
-  return trial_failed ? E_NOT_FINITE : E_NOERROR;
+  return stepper_->retake(t, h, x, result);
 }
 
 int Simulator::publish(const Vector& x, double t, SimulationState& s) {
@@ -321,13 +272,13 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   Vector& x = x_;
   pack(s, h_O, x);
   // The start must be evaluable; every later failure of the dynamics is the motion's.
-  if (const int rc = derivative(s.t, x, k_[0])) return rc;
+  if (const int rc = derivative(s.t, x, x_new_)) return rc;
   if (const int rc = publish(x, s.t, s)) return rc;
   if (observer) observer(s);
   if (stop_ && stop_(s)) return E_NOERROR;
 
   // RK4 takes `step` as given; max_step bounds only the adaptive methods.
-  const bool adaptive = options_.integrator != Integrator::RK4;
+  const bool adaptive = stepper_->adaptive();
   double t = s.t, h = adaptive ? std::min(options_.step, options_.max_step) : options_.step;
   long outputs = 1;
   const double t0 = s.t;
@@ -348,28 +299,23 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
     const bool lands = t_next - t <= h * (1.0 + 1e-9);
     const double h_try = lands ? t_next - t : h;
     x_prev_ = x;
-    if (options_.integrator == Integrator::RK4) {
-      if (const int rc = stepRK4(t, h_try, x)) return failed(rc);
-    } else {
-      double error = 0.0;
-      bool trial_failed = false;
-      const int rc = options_.integrator == Integrator::Rosenbrock ? stepRosenbrock(t, h_try, x, error, trial_failed)
-                                                                   : stepDP54(t, h_try, x, error, trial_failed);
-      if (rc) {
-        if (!trial_failed) return failed(rc);
-        error = kInf;  // the trial step went where the dynamics are undefined: a rejected step
-      }
-      const double exponent = options_.integrator == Integrator::Rosenbrock ? stiffErrorExponent() : -0.2;
-      const double factor = error == 0.0 ? 5.0 : std::clamp(0.9 * std::pow(error, exponent), 0.2, 5.0);
+    double error = 0.0;
+    bool trial_failed = false;
+    if (const int rc = step(t, h_try, x, x_new_, error, trial_failed)) {
+      if (!trial_failed) return failed(rc);
+      error = kInf;  // the trial step went where the dynamics are undefined: a rejected step
+    }
+    if (adaptive) {
+      const double factor = stepper_->stepFactor(error);
       if (error > 1.0) {
         ++stats_.rejected_steps;
         h = h_try * factor;
         if (h < 1e-14 * std::max(1.0, std::abs(t))) return failed(E_STEP_UNDERFLOW);
         continue;
       }
-      x = x_new_;
       if (!lands || factor < 1.0) h = std::min(h_try * factor, options_.max_step);
     }
+    x = x_new_;
     ++stats_.accepted_steps;
     x.segment<4>(3).normalize();  // the orientation stays a unit quaternion
     double t_new = lands ? t_next : t + h_try;

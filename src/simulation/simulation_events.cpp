@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kdl_space/simulation/simulation.hpp"
+#include "simulation/dynamics.hpp"
 #include "simulation/simulation_layout.hpp"
 
 namespace kdl_space {
@@ -118,10 +119,11 @@ int Simulator::stopJoints(SimulationState& s, const std::vector<unsigned int>& j
   // The columns of M^-1 G^T are the accelerations from rest of a unit torque on each joint, by
   // the forward dynamics of the system with those joints free and no gravity (at rest the base's
   // classical acceleration is its spatial one at p_b).
-  detail::Dynamics free = dynamics_;
+  detail::Dynamics free = *dynamics_;
   std::vector<bool> locks = locked_now_;
   for (unsigned int j : joints) locks[j] = false;
-  std::visit([&](auto& d) { d.setLocked(locks); d.setGravity(Vector3d::Zero()); }, free);
+  free.setLocked(locks);
+  free.setGravity(Vector3d::Zero());
   const FloatingVelocity rest(*model_);
   KDL::JntArray unit(n);
   FloatingAcceleration acc{Vector6d::Zero(), KDL::JntArray(n)};
@@ -130,7 +132,7 @@ int Simulator::stopJoints(SimulationState& s, const std::vector<unsigned int>& j
   Eigen::MatrixXd X(6 + n, k), GX(k, k);
   for (std::size_t i = 0; i < k; ++i) {
     unit(joints[i]) = 1.0;
-    if (const int rc = std::visit([&](auto& d) { return d.CartToJnt(kin_, rest, unit, none, acc); }, free)) return rc;
+    if (const int rc = free.CartToJnt(kin_, rest, unit, none, acc)) return rc;
     unit(joints[i]) = 0.0;
     X.col(i) << acc.base, acc.qddot.data;
   }
@@ -283,15 +285,13 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
   // in the step that stopped them: each stop holds for a step at least, so the run moves on).
   if (std::find(at_stop_.begin(), at_stop_.end(), true) != at_stop_.end()) {
     for (int j = 0; j < L.n; ++j) locked_now_[j] = controls_[j].mode == JointControl::Mode::Locked;
-    std::visit([&](auto& d) { d.setLocked(locked_now_); }, dynamics_);
+    dynamics_->setLocked(locked_now_);
     static const std::vector<KDL::Wrench> none;
     int rc = unpack(x, t, scratch_);
     if (!rc) rc = actuate(t, x);
     if (!rc)
-      rc = std::visit([&](auto& d) {
-        return d.CartToJnt(kin_, scratch_.velocity, scratch_.tau,
-                           base_control_.on() || !wrenches_.empty() ? f_ext_ : none, acc_);
-      }, dynamics_);
+      rc = dynamics_->CartToJnt(kin_, scratch_.velocity, scratch_.tau,
+                                base_control_.on() || !wrenches_.empty() ? f_ext_ : none, acc_);
     if (rc) {
       applyLocks();
       return rc;
@@ -319,28 +319,12 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
   return E_NOERROR;
 }
 
-int Simulator::retake(double t, double h, const Vector& x, Vector& result) {
-  if (options_.integrator == Integrator::RK4) {
-    result = x;
-    return stepRK4(t, h, result);
-  }
-  double error = 0.0;
-  bool trial_failed = false;
-  const int rc = options_.integrator == Integrator::Rosenbrock ? stepRosenbrock(t, h, x, error, trial_failed)
-                                                               : stepDP54(t, h, x, error, trial_failed);
-  if (rc) return rc;
-  result = x_new_;
-  return E_NOERROR;
-}
-
 int Simulator::apparentInertia(unsigned int j, double& m) {
   static const std::vector<KDL::Wrench> none;
   const FloatingVelocity rest(*model_);  // set-up calls only: allocates
   KDL::JntArray unit(model().nj());
   FloatingAcceleration base_line{Vector6d::Zero(), KDL::JntArray(model().nj())}, acc = base_line;
-  const auto solve = [&](FloatingAcceleration& a) {
-    return std::visit([&](auto& d) { return d.CartToJnt(kin_, rest, unit, none, a); }, dynamics_);
-  };
+  const auto solve = [&](FloatingAcceleration& a) { return dynamics_->CartToJnt(kin_, rest, unit, none, a); };
   if (const int rc = solve(base_line)) return rc;  // gravity alone: subtracted below
   unit(j) = 1.0;
   if (const int rc = solve(acc)) return rc;

@@ -1,12 +1,8 @@
 // Private to the simulator: where each part of the integrated state lies in its vector, and the
-// forward dynamics it runs.
+// clock the scheduled wrenches read during a step.
 #pragma once
 
 #include <limits>
-#include <variant>
-
-#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
-#include "kdl_space/algorithm/forward_dynamics.hpp"
 
 namespace kdl_space::detail {
 
@@ -18,9 +14,6 @@ struct StateLayout {
         size(25 + 2 * n) {}
   int n, q, h, qdot, work, impulse, size;
 };
-
-/// The articulated-body recursion; the dense route for a model with mimic joints.
-using Dynamics = std::variant<ForwardDynamicsSolver, DenseForwardDynamics>;
 
 /// Sets Simulator's wrench clock to a step's midpoint for the step's duration (NaN after it).
 struct WrenchClock {

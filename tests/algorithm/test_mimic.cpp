@@ -144,7 +144,7 @@ TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(11, 9);  // the base's six coordinates, then the joints'
   T.topLeftCorner<6, 6>().setIdentity();
   T.bottomRightCorner(5, 3) = c.T;
-  DenseForwardDynamics a(coupled), b(free);
+  DenseForwardDynamicsSolver a(coupled), b(free);
   ASSERT_EQ(a.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
   ASSERT_EQ(b.setGravity(Vector3d(0.0, 0.0, -9.81)), 0);
   std::mt19937 rng(11);

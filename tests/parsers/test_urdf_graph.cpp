@@ -1,4 +1,4 @@
-// The links and joints of a URDF as a graph (src/urdf_graph.hpp), the one walk the loader and the
+// The links and joints of a URDF as a graph (src/parsers/urdf/urdf_graph.hpp), the one walk the loader and the
 // checker share: from urdfdom's model (the loader's reader) and from the document (the
 // checker's), it finds the same roots, loops, links not connected and depth; and the loader
 // refuses what the checker reports about the graph.

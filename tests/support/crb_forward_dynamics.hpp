@@ -1,6 +1,6 @@
 // The composite-rigid-body route of free-floating forward dynamics, the tests' (and the
 // benchmark's) second route beside the library's articulated-body algorithm: the library's
-// DenseForwardDynamics (include/kdl_space/algorithm/dense_forward_dynamics.hpp; the route the simulation
+// DenseForwardDynamicsSolver (include/kdl_space/algorithm/dense_forward_dynamics.hpp; the route the simulation
 // takes for coupled joints), which shares only FreeFloatingSolver (and through it
 // forwardKinematics) with the articulated-body route.
 //
@@ -19,9 +19,9 @@
 
 namespace kdl_space::test {
 
-/// The dense route, the library's (DenseForwardDynamics): the tests' second route beside the
+/// The dense route, the library's (DenseForwardDynamicsSolver): the tests' second route beside the
 /// articulated-body algorithm.
-using CrbForwardDynamics = DenseForwardDynamics;
+using CrbForwardDynamics = DenseForwardDynamicsSolver;
 
 /// \brief Simulator::run's loop on the dense route (free, locked and PD joints; no callback, no
 /// observer, no brakes): for the benchmark and for a cross-check of the Simulator.

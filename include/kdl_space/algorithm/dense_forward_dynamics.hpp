@@ -22,9 +22,9 @@ namespace kdl_space {
 /// Locked joints: their rows and columns replaced by the identity, qddot = 0. The same contract
 /// and codes as ForwardDynamicsSolver; O(n^2) to build, O(n^3) to solve. Allocation-free after
 /// construction; never throws from CartToJnt.
-class KDL_SPACE_EXPORT DenseForwardDynamics {
+class KDL_SPACE_EXPORT DenseForwardDynamicsSolver {
  public:
-  explicit DenseForwardDynamics(std::shared_ptr<const FloatingModel> model);
+  explicit DenseForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model);
 
   const FloatingModel& model() const { return solver_.model(); }
   int setGravity(const Vector3d& g);
@@ -54,5 +54,9 @@ class KDL_SPACE_EXPORT DenseForwardDynamics {
   Eigen::MatrixXd M_;
   Eigen::LLT<Eigen::MatrixXd> M_llt_;
 };
+
+/// The class's name before it was the Python module's (DenseForwardDynamicsSolver), kept for one
+/// release. Deprecated: use DenseForwardDynamicsSolver.
+using DenseForwardDynamics [[deprecated("use DenseForwardDynamicsSolver")]] = DenseForwardDynamicsSolver;
 
 }  // namespace kdl_space

@@ -15,9 +15,24 @@ namespace kdl_space {
 /// InputError "PATH: what is wrong"; `kind` names what the file should be ("URDF file").
 KDL_SPACE_EXPORT void checkInputFile(const std::string& path, const std::string& kind);
 
-/// \brief Parses a whole text as a finite double ("1e400", "nan", "1.5x", " 1" are refused).
-/// \return false, with `why` saying what is wrong ("'abc' is not a number", "'1e400' is too large
-/// (not a finite number)", "'inf' is not a finite number"); `value` is untouched then.
+/// What a text is as a number (readNumber).
+enum class NumberText {
+  Finite,      ///< a finite double, in `value`
+  TooLarge,    ///< well formed, beyond the range of a double ("1e400")
+  NotFinite,   ///< a name of no finite number: nan, inf, infinity (any case, signed), nan(chars)
+  NotANumber,  ///< anything else ("abc", "1.5x", "0x5", "5,0", "5 ", "")
+};
+
+/// \brief The library's one reader of a number: the whole text in decimal form, [+|-] digits
+/// [. digits] [(e|E) [+|-] digits] with a digit before or after the point, read in the C locale
+/// whatever the program's (no hexadecimal, nothing after the number). White space before it only
+/// if `space_before` (urdfdom reads so: a stream extraction). A number too small for a double reads
+/// as the nearest one (a denormal, or 0). `value` is set only for Finite.
+KDL_SPACE_EXPORT NumberText readNumber(const std::string& text, double& value, bool space_before = false);
+
+/// \brief Parses a whole text as a finite double by readNumber ("1e400", "nan", "1.5x", " 1" are
+/// refused). \return false, with `why` saying what is wrong ("'abc' is not a number", "'1e400' is
+/// too large (not a finite number)", "'inf' is not a finite number"); `value` is untouched then.
 KDL_SPACE_EXPORT bool parseFiniteNumber(const std::string& text, double& value, std::string& why);
 
 }  // namespace kdl_space

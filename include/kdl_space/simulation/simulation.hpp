@@ -6,10 +6,10 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <variant>
 #include <vector>
 
 #include "kdl_space/simulation/actuation.hpp"
+#include "kdl_space/simulation/integrator.hpp"
 #include "kdl_space/export.hpp"
 #include "kdl_space/algorithm/dense_forward_dynamics.hpp"
 #include "kdl_space/algorithm/forward_dynamics.hpp"
@@ -18,15 +18,9 @@
 
 namespace kdl_space {
 namespace detail {
-class RosenbrockStepper;
-}
-
-/// Time integration schemes.
-enum class Integrator {
-  RK4,              ///< classical fixed-step Runge-Kutta, order 4
-  DormandPrince54,  ///< adaptive embedded Runge-Kutta 5(4) with error control (Dormand & Prince 1980)
-  Rosenbrock,       ///< adaptive linearly implicit (stiff) method: see detail/rosenbrock.hpp
-};
+class Dynamics;
+class Stepper;
+}  // namespace detail
 
 /// Integration settings and what acts on every joint; all are the user's.
 struct SimulationOptions {
@@ -221,21 +215,16 @@ class KDL_SPACE_EXPORT Simulator {
   /// The joint torques (controls limited, then friction) and the external wrenches at scratch_,
   /// unpacked from x (whose momentum gives gravity's power on a free base).
   int actuate(double t, const Vector& x);
+  /// x' = f(t, x), the equations of motion the steppers integrate (through Equations).
   int derivative(double t, const Vector& x, Vector& dx);
-  int stepRK4(double t, double h, Vector& x);
-  /// One trial step; `trial_failed` when a stage away from x (or the error estimate) could not be
-  /// evaluated, which the caller treats as a rejected step.
-  int stepDP54(double t, double h, const Vector& x, double& error, bool& trial_failed);
-  int stepRosenbrock(double t, double h, const Vector& x, double& error, bool& trial_failed);
-  /// The step of length h from (t, x) again (RK4: in place of result; adaptive: the solution
-  /// without error control), to locate an event inside it.
+  /// One step of the integrator from (t, x) into x_new (detail::Stepper::step), with the wrench
+  /// clock at the step's midpoint.
+  int step(double t, double h, const Vector& x, Vector& x_new, double& error, bool& trial_failed);
+  /// The step of length h from (t, x) again, without error control, to locate an event inside it.
   int retake(double t, double h, const Vector& x, Vector& result);
-  void makeStiffStepper();
-  double stiffErrorExponent() const;
   /// Set-up of a run at s: hold set points, hard stops checked (E_BAD_ARGUMENT for a joint
   /// outside one), joints at a stop and moving into it stopped.
   int startRun(SimulationState& s);
-  double errorNorm(const Vector& x, const Vector& x_new, const Vector& difference) const;
   void applyLocks();
   /// The rates of `joints` stopped by an internal impulse (momentum kept; the base held when
   /// grounded). s.velocity changed; E_ codes as engageBrakes.
@@ -253,7 +242,7 @@ class KDL_SPACE_EXPORT Simulator {
   Kinematics kin_;             ///< the state of the last unpack() / energyAndMomentum()
   MomentumSolver momentum_;
   /// The articulated-body recursion; the dense route for a model with mimic joints.
-  std::variant<ForwardDynamicsSolver, DenseForwardDynamics> dynamics_;
+  std::unique_ptr<detail::Dynamics> dynamics_;
   SimulationOptions options_;
   std::vector<JointControl> controls_;
   std::vector<LimitMode> limit_modes_;
@@ -279,12 +268,10 @@ class KDL_SPACE_EXPORT Simulator {
   double wrench_clock_ = std::numeric_limits<double>::quiet_NaN();
   double external_power_[3] = {0.0, 0.0, 0.0};  ///< base control, wrenches, gravity [W]
   FloatingAcceleration acc_;
-  std::vector<Vector> k_;
   Vector x_, x_tmp_, x_new_, x_prev_, x_event_;
-  struct StiffDeleter {
-    void operator()(detail::RosenbrockStepper* p) const;
-  };
-  std::unique_ptr<detail::RosenbrockStepper, StiffDeleter> stiff_;  ///< the Rosenbrock method's workspace
+  struct Equations;  ///< derivative() as the steppers call it (detail::Derivative)
+  std::unique_ptr<Equations> equations_;
+  std::unique_ptr<detail::Stepper> stepper_;  ///< options().integrator's, on equations_
 };
 
 }  // namespace kdl_space

@@ -7,15 +7,17 @@
 #include "kdl_space/parsers/input_file.hpp"
 
 namespace kdl_space::fields {
+namespace {
 
-std::string echo(const std::string& text) {
-  std::string shown;
-  for (std::size_t i = 0; i < text.size() && i < 40; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    shown += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
-  }
-  return "'" + shown + (text.size() > 40 ? "...'" : "'");
+/// YAML's names of the numbers that are not finite: .inf, .nan (and their signed and capitalised
+/// forms: .Inf, -.INF, .NaN, ...).
+bool yamlNotFinite(const std::string& text) {
+  std::string t = text.empty() || (text[0] != '+' && text[0] != '-') ? text : text.substr(1);
+  if (t == ".inf" || t == ".Inf" || t == ".INF") return true;
+  return t == ".nan" || t == ".NaN" || t == ".NAN";
 }
+
+}  // namespace
 
 YAML::Node parseFile(const std::string& file, const std::string& kind) {
   checkInputFile(file, kind);
@@ -94,17 +96,13 @@ std::string Field::text() const {
 
 double Field::number() const {
   if (!node_.IsScalar()) fail("expected a number, got " + kindOf(node_));
+  const std::string& text = node_.Scalar();
   double v = 0.0;
-  try {
-    v = node_.as<double>();  // YAML's forms too: .inf, .nan
-  } catch (const YAML::Exception&) {
-    std::string why;
-    if (!parseFiniteNumber(node_.Scalar(), v, why))
-      fail(echo(node_.Scalar()) + (why.find("too large") != std::string::npos ? " is too large (not a finite number)"
-                                                                               : " is not a number"));
-  }
-  if (!std::isfinite(v)) fail(echo(node_.Scalar()) + " is not a finite number");
-  return v;
+  const NumberText read = readNumber(text, v);
+  if (read == NumberText::Finite) return v;
+  if (read == NumberText::TooLarge) fail(echo(text) + " is too large (not a finite number)");
+  if (read == NumberText::NotFinite || yamlNotFinite(text)) fail(echo(text) + " is not a finite number");
+  fail(echo(text) + " is not a number");
 }
 
 Eigen::VectorXd Field::vector(int size) const {

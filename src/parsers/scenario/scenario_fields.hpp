@@ -11,11 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "detail/text.hpp"
+
 namespace kdl_space::fields {
 
-/// A text from the file, quoted for a message: at most 40 characters, anything but printable
-/// ASCII shown as '?' (a binary file must not flood the terminal).
-std::string echo(const std::string& text);
+/// A text from the file, quoted for a message (detail/text.hpp).
+using detail::echo;
 
 /// A file's YAML (or JSON, which YAML reads), or an InputError "FILE[:LINE]: what is wrong";
 /// `kind` names what the file should be ("scenario file (YAML or JSON)").
@@ -42,7 +43,7 @@ class Field {
   std::vector<std::string> keys() const;
 
   std::string text() const;
-  /// A finite number (YAML's forms too: .inf and .nan are read, then refused).
+  /// A finite number, read by readNumber (input_file.hpp); YAML's .inf and .nan are refused as not finite.
   double number() const;
   /// A list of `size` finite numbers.
   Eigen::VectorXd vector(int size) const;

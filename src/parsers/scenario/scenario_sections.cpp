@@ -153,11 +153,12 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot, const Floa
     s.options.max_steps = static_cast<long>(budget);
   }
   if (f.has("integrator")) {
-    const std::string name = f.at("integrator").text();
-    if (name == "rk4") s.options.integrator = Integrator::RK4;
-    else if (name == "dopri5") s.options.integrator = Integrator::DormandPrince54;
-    else if (name == "rosenbrock") s.options.integrator = Integrator::Rosenbrock;
-    else f.at("integrator").fail(echo(name) + " is not one of rk4, dopri5, rosenbrock");
+    const Field integrator = f.at("integrator");
+    try {
+      s.options.integrator = integratorFromName(integrator.text());
+    } catch (const InputError& e) {
+      integrator.fail(e.what());  // the file, line and field in front of the library's message
+    }
   }
   if (f.has("gravity")) s.options.gravity = f.at("gravity").vector(3);
   if (f.has("base")) {

@@ -9,8 +9,8 @@
 #include <set>
 
 #include "detail/text.hpp"
-#include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_numbers.hpp"
+#include "parsers/urdf/urdf_rules.hpp"
 
 namespace kdl_space::detail {
 namespace {
@@ -86,17 +86,18 @@ bool Reader::readNumbers(const TiXmlElement* e, const char* attribute, std::size
   }
   for (std::size_t i = 0; i < count; ++i) {
     const std::string& v = values[i];
-    switch (parseNumber(v, out[i])) {
-      case Parsed::Ok:
+    switch (urdfNumber(v, out[i])) {
+      case NumberText::Finite:
         break;
-      case Parsed::NotFinite:
+      case NumberText::TooLarge:  // urdfdom refuses both alike
+      case NumberText::NotFinite:
         error("not_finite", owner, where + detail::quoted(shown(v)) + " is not a finite number");
         return false;
-      case Parsed::Bad: {
+      case NumberText::NotANumber: {
         double trimmed = 0.0;
         const std::size_t last = v.find_last_not_of(" \t\n\r\f\v");
         const bool trailing_space = last != std::string::npos && last + 1 < v.size() &&
-                                    parseNumber(v.substr(0, last + 1), trimmed) == Parsed::Ok;
+                                    urdfNumber(v.substr(0, last + 1), trimmed) == NumberText::Finite;
         error("bad_number", owner,
               where + detail::quoted(shown(v)) +
                   (trailing_space ? " is not a number for urdfdom (no space may follow a number)"

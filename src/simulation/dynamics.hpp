@@ -1,0 +1,42 @@
+// Private to the simulator: the forward dynamics a motion runs, chosen once per model.
+#pragma once
+
+#include <memory>
+#include <variant>
+#include <vector>
+
+#include "kdl_space/algorithm/dense_forward_dynamics.hpp"
+#include "kdl_space/algorithm/forward_dynamics.hpp"
+
+namespace kdl_space::detail {
+
+/// \brief The accelerations of a motion: the O(n) articulated-body recursion, or the dense
+/// composite-rigid-body route when joints are coupled (mimic), which the recursion cannot carry.
+/// Both keep ForwardDynamicsSolver's contract, so the simulator never asks which route it runs.
+/// A copy is an independent solver (stopJoints' with other locks and no gravity).
+class Dynamics {
+ public:
+  explicit Dynamics(const std::shared_ptr<const FloatingModel>& model)
+      : route_(model->mimic().empty() ? Route(std::in_place_type<ForwardDynamicsSolver>, model)
+                                      : Route(std::in_place_type<DenseForwardDynamicsSolver>, model)) {}
+
+  int setGravity(const Vector3d& g) {
+    return std::visit([&](auto& d) { return d.setGravity(g); }, route_);
+  }
+  void setGrounded(bool grounded) {
+    std::visit([&](auto& d) { d.setGrounded(grounded); }, route_);
+  }
+  int setLocked(const std::vector<bool>& locked) {
+    return std::visit([&](auto& d) { return d.setLocked(locked); }, route_);
+  }
+  int CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
+                const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {
+    return std::visit([&](auto& d) { return d.CartToJnt(kin, velocity, tau, f_ext, acceleration); }, route_);
+  }
+
+ private:
+  using Route = std::variant<ForwardDynamicsSolver, DenseForwardDynamicsSolver>;
+  Route route_;
+};
+
+}  // namespace kdl_space::detail
