@@ -8,10 +8,6 @@ namespace {
 
 Json finiteOrNull(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
-const char* integratorName(Integrator i) {
-  return i == Integrator::RK4 ? "rk4" : i == Integrator::Rosenbrock ? "rosenbrock" : "dopri5";
-}
-
 }  // namespace
 
 Json limitViolationsJson(const MotionRecord& r) {
@@ -84,7 +80,7 @@ Json stiffnessJson(const MotionRecord& r) {
   return Json{{"fastest_rate", st.fastest_rate},
               {"fastest_joint", st.fastest_joint < 0 ? Json(nullptr) : Json(r.model->jointNames()[st.fastest_joint])},
               {"explicit_stable_step", finiteOrNull(st.explicit_step)},
-              {"integrator", integratorName(r.options.integrator)},
+              {"integrator", toString(r.options.integrator)},
               {"min_step", stats.min_step},
               {"max_step", stats.max_step},
               {"mean_step", r.meanStep()},

@@ -91,10 +91,6 @@ Json targetMotionJson(const OperationResult& r) {
               {"max_angular_momentum_change", r.target_motion->dL}};
 }
 
-const char* integratorName(Integrator i) {
-  return i == Integrator::RK4 ? "rk4" : i == Integrator::Rosenbrock ? "rosenbrock" : "dopri5";
-}
-
 }  // namespace
 
 Json operationJson(const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
@@ -121,7 +117,7 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                                       {"min_chart_margin", r.min_chart_margin}}
                                : Json(nullptr);
   j["simulation"] = Json{{"duration", r.duration},
-                         {"integrator", integratorName(record.options.integrator)},
+                         {"integrator", toString(record.options.integrator)},
                          {"accepted_steps", record.stats.accepted_steps},
                          {"rejected_steps", record.stats.rejected_steps},
                          {"payload_attached", r.payload_attached},
@@ -166,7 +162,7 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   } else {
     out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
   }
-  out << ", " << r.duration << " s with " << integratorName(record.options.integrator) << " ("
+  out << ", " << r.duration << " s with " << toString(record.options.integrator) << " ("
       << record.stats.accepted_steps << " steps, " << record.stats.rejected_steps << " rejected)"
       << (record.options.grounded ? ", base grounded" : "") << "\n";
   const std::vector<std::string> locked_joints = record.lockedJoints();

@@ -19,17 +19,13 @@
 namespace kdl_space::python {
 namespace {
 
-const char* integratorName(Integrator i) {
-  return i == Integrator::RK4 ? "rk4" : i == Integrator::Rosenbrock ? "rosenbrock" : "dopri5";
-}
-
 Integrator integratorOf(py::handle obj) {
   if (!py::isinstance<py::str>(obj)) return py::cast<Integrator>(obj);
-  const std::string s = py::cast<std::string>(obj);
-  if (s == "rk4") return Integrator::RK4;
-  if (s == "dopri5") return Integrator::DormandPrince54;
-  if (s == "rosenbrock") return Integrator::Rosenbrock;
-  throw py::value_error("integrator: expected 'rk4', 'dopri5' or 'rosenbrock', got '" + s + "'");
+  try {
+    return integratorFromName(py::cast<std::string>(obj));
+  } catch (const InputError& e) {
+    throw py::value_error(std::string("integrator: ") + e.what());  // a bad argument of this call
+  }
 }
 
 const char* modeName(const JointControl& c) {
@@ -274,7 +270,7 @@ void bindSimulation(py::module_& m) {
       .def_property_readonly("options", [](const PySimulator& w) {
         const SimulationOptions& o = w.sim->options();
         py::dict r;
-        r["integrator"] = integratorName(o.integrator), r["step"] = o.step, r["rtol"] = o.rtol, r["atol"] = o.atol;
+        r["integrator"] = toString(o.integrator), r["step"] = o.step, r["rtol"] = o.rtol, r["atol"] = o.atol;
         r["max_step"] = o.max_step, r["max_steps"] = o.max_steps, r["gravity"] = toNumpy(o.gravity, true);
         r["grounded"] = o.grounded, r["effort_limits"] = o.effort_limits, r["joint_friction"] = o.joint_friction;
         r["friction_velocity"] = o.friction_velocity, r["friction_rate"] = o.friction_rate;
@@ -360,7 +356,7 @@ void bindSimulation(py::module_& m) {
       .def("__repr__", [](const PySimulator& w) {
         std::ostringstream s;
         s << "<kdl_space.Simulator of " << w.model.source << ": " << w.model.ptr->nj() << " joints, "
-          << integratorName(w.sim->options().integrator) << (w.sim->options().grounded ? ", grounded" : "") << ">";
+          << toString(w.sim->options().integrator) << (w.sim->options().grounded ? ", grounded" : "") << ">";
         return s.str();
       });
 }

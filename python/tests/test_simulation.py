@@ -182,7 +182,7 @@ def test_options_controls_and_queries(arm):
         sim.set_limit_mode(7, "warn")
     with pytest.raises(ValueError, match="mode: expected"):
         sim.set_joint_control("joint2", "servo")
-    with pytest.raises(ValueError, match="integrator: expected"):
+    with pytest.raises(ValueError, match="integrator: 'euler' is not one of rk4, dopri5, rosenbrock"):
         kdl_space.Simulator(arm, integrator="euler")
     with pytest.raises(kdl_space.ModelError):
         kdl_space.Simulator(arm, step=-1.0)
