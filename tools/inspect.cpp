@@ -94,7 +94,8 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     const UrdfReport report = checkUrdfFile(o.urdf);
     std::string all;
     for (const Finding& f : report.errors) all += (all.empty() ? "" : "\n") + report.source + ": error: " + describe(f);
-    throw InputError(all.empty() ? e.what() : all);
+    if (all.empty()) throw;
+    throw ModelError(all);
   }
   for (const auto& [name, value] : q_by_name)
     if (model->jointIndex(name) < 0)
@@ -108,13 +109,9 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
                        listNames(links) + ")");
     }
   }
-  try {
-    state = State(*model);
-    state.q = jointsByName(*model, q_by_name);
-    for (const ContactRequest& r : requests) contacts.push_back(model->contact(r.link, r.offset));
-  } catch (const ModelError& e) {
-    throw InputError(e.what());
-  }
+  state = State(*model);  // ModelError naming the joint or link (main prints it)
+  state.q = jointsByName(*model, q_by_name);
+  for (const ContactRequest& r : requests) contacts.push_back(model->contact(r.link, r.offset));
   state.world_T_base = basePose(KDL::Vector(o.base_pos[0], o.base_pos[1], o.base_pos[2]),
                                 o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
 

@@ -70,8 +70,8 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   if (options_.integrator != Integrator::RK4 && options_.integrator != Integrator::DormandPrince54 &&
       options_.integrator != Integrator::Rosenbrock)
     throw ModelError("simulation: the integrator is not one of RK4, DormandPrince54, Rosenbrock");
-  if (std::visit([&](auto& d) { return d.setGravity(options_.gravity); }, dynamics_) != E_NOERROR)
-    throw ModelError("simulation: gravity must be finite");
+  if (!options_.gravity.allFinite()) throw ModelError("simulation: gravity must be finite");
+  std::visit([&](auto& d) { d.setGravity(options_.gravity); }, dynamics_);
   std::visit([&](auto& d) { d.setGrounded(options_.grounded); }, dynamics_);
   if (options_.integrator == Integrator::Rosenbrock) makeStiffStepper();
 }

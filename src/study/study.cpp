@@ -180,7 +180,7 @@ void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
   const CaptureResult* r = nullptr;
   try {
     r = &w.capture.solve(w.problem);
-  } catch (const InputError&) {
+  } catch (const Error&) {  // the problem's InputError, or a side's ModelError
     return fail(E_BAD_ARGUMENT);
   }
   const Vector6d F_h = r->impulse.F;
