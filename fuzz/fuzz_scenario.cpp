@@ -1,6 +1,7 @@
 // libFuzzer target: scenario text (YAML or JSON) -> kdl_space::loadScenario, the library's
 // loader that `kdl_space capture` and `simulate` call.
-// Expected outcomes: a scenario, or kdl_space::InputError naming the file and the field
+// Expected outcomes: a scenario, or kdl_space::InputError naming the file and the field (a
+// URDF it names that loads no model: the loader's ModelError, the same file and field in front)
 // (scenario.hpp's contract). Anything else -- a crash, another exception, a sanitizer report, a
 // hang -- is a bug. Built by KDL_SPACE_FUZZ=ON, run by tools/fuzz.sh on fuzz/corpus/scenario/.
 //
@@ -57,8 +58,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   try {
     kdl_space::loadScenario(g_input);
-  } catch (const kdl_space::InputError&) {
-    // A refused scenario: the expected outcome for most inputs.
+  } catch (const kdl_space::Error&) {
+    // A refused scenario (InputError, or a URDF's ModelError): the expected outcome for most inputs.
   }
   return 0;
 }

@@ -19,14 +19,15 @@ struct CaptureOptions {
   bool json = false;
 };
 
-/// \brief Runs `f` (a library call on the scenario's capture problem); an InputError it throws
-/// ("target: ...") comes back with the scenario's file in front ("FILE: target: ...").
+/// \brief Runs `f` (a library call on the scenario's capture problem); an Error it throws
+/// ("target: ...") comes back of the same kind with the scenario's file in front ("FILE: target:
+/// ...").
 template <typename F>
 auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
   try {
     return f();
-  } catch (const InputError& e) {
-    throw InputError(scenario.file + ": " + e.what());
+  } catch (const kdl_space::Error& e) {
+    e.rethrowWithContext(scenario.file + ": ");
   }
 }
 

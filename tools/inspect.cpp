@@ -103,7 +103,8 @@ Inspected inspected(const InspectOptions& o, const std::vector<ContactRequest>& 
     const UrdfReport report = checkUrdfFile(o.urdf);
     std::string all;
     for (const Finding& f : report.errors) all += (all.empty() ? "" : "\n") + report.source + ": error: " + describe(f);
-    throw InputError(all.empty() ? e.what() : all);
+    if (all.empty()) throw;
+    throw ModelError(all);
   }
   for (const auto& [name, value] : q_by_name)
     if (model->jointIndex(name) < 0)
@@ -117,13 +118,9 @@ Inspected inspected(const InspectOptions& o, const std::vector<ContactRequest>& 
                        listNames(links) + ")");
     }
   }
-  try {
-    in.state = State(*model);
-    in.state.q = jointsByName(*model, q_by_name);
-    for (const ContactRequest& r : requests) in.contacts.push_back(model->contact(r.link, r.offset));
-  } catch (const ModelError& e) {
-    throw InputError(e.what());
-  }
+  in.state = State(*model);  // ModelError naming the joint or link (main prints it)
+  in.state.q = jointsByName(*model, q_by_name);
+  for (const ContactRequest& r : requests) in.contacts.push_back(model->contact(r.link, r.offset));
   in.state.world_T_base = basePose(KDL::Vector(o.base_pos[0], o.base_pos[1], o.base_pos[2]),
                                    o.base_rpy[0], o.base_rpy[1], o.base_rpy[2]);
   return in;

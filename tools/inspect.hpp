@@ -21,7 +21,7 @@ struct InspectOptions {
 /// Registers the subcommand and its options on `app`.
 CLI::App* addInspect(CLI::App& app, InspectOptions& options);
 
-/// Runs it after parsing; throws UsageError or InputError.
+/// Runs it after parsing; throws UsageError, or the library's Error (InputError, ModelError).
 void runInspect(const CLI::App& command, const InspectOptions& options, std::ostream& out);
 
 }  // namespace kdl_space::cli

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";
     return kUsage;
-  } catch (const InputError& e) {
+  } catch (const kdl_space::Error& e) {  // a model or an input the library refused: its message
     std::cerr << "kdl_space: " << e.what() << "\n";
     return kUnusable;
   } catch (const std::exception& e) {

@@ -67,7 +67,11 @@ Json digests(const std::vector<SampleDigest>& list) {
 
 void printSummary(std::ostream& out, const Study& st, const StudySummary& s, const std::string& table) {
   out << st.file << ": " << s.samples << " captures (" << s.failed << " could not be computed), seed " << st.seed
-      << "; table " << table << "\n\n";
+      << "; table " << table << "\n";
+  for (const StudyFailure& f : s.failures)
+    out << "  status " << f.status << ": " << f.count << " sample" << (f.count > 1 ? "s" : "") << ", the first " << f.first_sample
+        << ": " << f.message << "\n";
+  out << "\n";
   out << std::left << std::setw(28) << "outcome" << std::right;
   for (const char* h : {"min", "5%", "25%", "median", "75%", "95%", "max"}) out << std::setw(12) << h;
   out << "\n" << std::setprecision(4);
@@ -119,13 +123,15 @@ std::vector<double> mergeParts(const std::vector<std::string>& paths, const Stud
 }  // namespace
 
 Json studySummaryJson(const Study& st, const StudySummary& s, const std::string& table) {
-  Json outcomes = Json::object(), probabilities = Json::object();
+  Json outcomes = Json::object(), probabilities = Json::object(), failures = Json::array();
   for (const OutcomeSummary& o : s.outcomes) outcomes[o.name] = quantiles(o);
   for (const auto& [name, p] : s.probabilities) probabilities[name] = p;
+  for (const StudyFailure& f : s.failures)
+    failures.push_back(Json{{"status", f.status}, {"count", f.count}, {"first_sample", f.first_sample}, {"message", f.message}});
   return Json{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
               {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
               {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
-              {"best", digests(s.best)}, {"worst", digests(s.worst)}};
+              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures}};
 }
 
 void runStudyCommand(const StudyOptions& o, std::ostream& out) {

@@ -18,9 +18,10 @@ every vector and matrix in the world frame, twists (v; w), wrenches (f; n); 6x6 
     result = kdl_space.study("scenarios/study_grasp_configuration.yaml")  # or engine="dask"
     result["base_rate"], result.summary["probabilities"]      # a column, the summary
 
-Errors: ModelError and InputError (the library's message), ComputeError (``.code``, the
-return code of a compute call: E_NOT_FINITE for NaN inputs, ...), ValueError for an argument of
-the wrong shape (naming it and the shape expected).
+Errors: Error (the C++ library's kdl_space::Error) and its subclasses ModelError and InputError
+(the library's message), ComputeError (``.code``, the return code of a compute call: E_NOT_FINITE
+for NaN inputs, ...), ValueError for an argument of the wrong shape (naming it and the shape
+expected).
 """
 
 from ._kdl_space import (  # noqa: F401  (re-exported)

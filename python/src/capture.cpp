@@ -15,7 +15,7 @@ PyResult solve(const CaptureProblem& p) {
   CaptureResult r;
   {
     py::gil_scoped_release nogil;
-    r = solveCapture(p);  // InputError -> kdl_space.InputError
+    r = solveCapture(p);  // InputError or a side's ModelError, as kdl_space's
   }
   PyResult out{r, PySide{r.robot, p.robot.model->jointNames()}, std::nullopt};
   if (r.floating_target)
@@ -146,15 +146,17 @@ void bindCapture(py::module_& m) {
   });
 
   m.def("load_scenario", [](const std::string& path) { return PyScenario{loadScenario(path)}; }, py::arg("path"),
-        "Reads and checks a scenario file (YAML or JSON); InputError 'FILE[:LINE]: FIELD: what is wrong'.");
+        "Reads and checks a scenario file (YAML or JSON); InputError 'FILE[:LINE]: FIELD: what is wrong' (a URDF "
+        "that loads no model: the loader's ModelError, with the same 'FILE:LINE: robot.urdf: ' in front).");
   m.def("solve_capture", [](const PyScenario& s) {
     if (!s.scenario.impact) throw py::value_error("scenario: '" + s.scenario.file + "' has no target and no law (a plain motion)");
     return solve(s.scenario.capture);
-  }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError naming the part.");
+  }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
+     "the part.");
   m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
-    return Model{attachTarget(p, r.r), source};  // InputError naming the part
+    return Model{attachTarget(p, r.r), source};  // an Error naming the part
   };
   m.def("attach_target", [attach](const PyScenario& s, const PyResult& r) { return attach(s.scenario.capture, r, s.scenario.robot_urdf); },
         py::arg("scenario_or_problem"), py::arg("result"),

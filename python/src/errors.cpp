@@ -1,5 +1,5 @@
-// The library's errors as Python exceptions (kdl_space.Error and its subclasses ModelError,
-// InputError, ComputeError with `.code`), and the NumPy conversions that name the argument.
+// The library's errors as Python exceptions (kdl_space.Error, the binding of kdl_space::Error, and
+// its subclasses ModelError, InputError, ComputeError with `.code`), and the NumPy conversions that name the argument.
 #include <sstream>
 
 #include "conversions.hpp"
@@ -75,14 +75,15 @@ KDL::Frame frameFromPython(py::handle given, const char* name) {
 }
 
 void bindErrors(py::module_& m) {
-  struct Base {};
-  static py::exception<Base> error(m, "Error", PyExc_RuntimeError);
-  error.doc() = "Base of the errors kdl_space raises (the C++ library's message).";
+  // kdl_space.Error is the binding of the C++ base (errors.hpp): a C++ ModelError or InputError
+  // arrives as its subclass, any other kdl_space::Error as Error itself.
+  static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+  error.doc() = "Base of the errors kdl_space raises (the C++ library's kdl_space::Error and its message).";
   static py::exception<ModelError> model_error(m, "ModelError", error.ptr());
-  model_error.doc() = "A model or an input that a loader, constructor or set-up call cannot use; the "
+  model_error.doc() = "A model or an object that a loader, constructor or set-up call cannot build as asked; the "
                       "message names the file, the link or joint and what is wrong.";
   static py::exception<InputError> input_error(m, "InputError", error.ptr());
-  input_error.doc() = "A scenario or capture input that cannot be used; the message names the file, the "
+  input_error.doc() = "A scenario, study or capture input that cannot be used; the message names the file, the "
                       "field and what is wrong.";
   static py::exception<ComputeError> compute_error(m, "ComputeError", error.ptr());
   compute_error.doc() = "A compute call returned an error code: `.code` is the code (e.g. E_NOT_FINITE = "
@@ -98,6 +99,8 @@ void bindErrors(py::module_& m) {
       model_error(e.what());
     } catch (const InputError& e) {
       input_error(e.what());
+    } catch (const Error& e) {
+      error(e.what());
     }
   });
   py::module_ codes = m.def_submodule("codes", "The return codes of compute calls (ComputeError.code).");

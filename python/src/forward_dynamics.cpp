@@ -88,7 +88,7 @@ struct FD {
 
   void setGravity(py::handle g) {
     const Vector3d v = g.is_none() ? Vector3d::Zero() : vec3(g, "gravity");
-    check(withoutGil(mutex, [&] { return solver.setGravity(v); }), "gravity");
+    withoutGil(mutex, [&] { solver.setGravity(v); });  // ModelError naming the value
     gravity = v;
   }
   void setGrounded(bool g) {
@@ -97,7 +97,7 @@ struct FD {
   }
   void setLocked(py::handle obj) {
     const std::vector<bool> l = lockedJoints(*model.ptr, obj);
-    check(withoutGil(mutex, [&] { return solver.setLocked(l); }), "locked");
+    withoutGil(mutex, [&] { solver.setLocked(l); });
     locked = l;
   }
   py::tuple accelerations(const PyState& s, py::handle tau_obj, py::handle wrenches, const char* who) {

@@ -178,8 +178,8 @@ std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model
       w->sim->addWrench(x);
     }
     return w;
-  } catch (const ModelError& e) {
-    throw InputError(sc.file + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(sc.file + ": ");
   }
 }
 

@@ -116,6 +116,13 @@ py::dict summary(const PyStudy& s, py::handle given) {
   d["study"] = st.file, d["fingerprint"] = hex(st.fingerprint), d["samples"] = sum.samples, d["failed"] = sum.failed;
   d["seed"] = st.seed, d["outcomes"] = outcomes, d["probabilities"] = probabilities, d["objective"] = st.objective;
   d["best"] = digests(sum.best), d["worst"] = digests(sum.worst);
+  py::list failures;
+  for (const StudyFailure& f : sum.failures) {
+    py::dict x;
+    x["status"] = f.status, x["count"] = f.count, x["first_sample"] = f.first_sample, x["message"] = f.message;
+    failures.append(x);
+  }
+  d["failures"] = failures;
   return d;
 }
 
@@ -182,7 +189,9 @@ void bindStudy(py::module_& m) {
       .def("summary", &summary, py::arg("rows"),
            "The summary of a table (rows of this study, any order), as `kdl_space study --json` prints it: study, "
            "fingerprint (hex), samples, failed, seed, outcomes {name: {min, q05, q25, median, q75, q95, max, "
-           "mean}}, probabilities {exceeds.*: p}, objective, best and worst [{sample, objective, inputs}].")
+           "mean}}, probabilities {exceeds.*: p}, objective, best and worst [{sample, objective, inputs}], failures "
+           "[{status, count, first_sample, message}] (one per distinct status; the message from evaluating "
+           "first_sample again, GIL released).")
       .def("__repr__", [](const PyStudy& s) {
         std::ostringstream r;
         r << "<kdl_space.Study '" << s.study->file << "' " << s.study->samples << " samples, inputs [";

@@ -142,6 +142,12 @@ def test_model_and_input_errors(arm, computed, tmp_path):
     broken = SOURCE_DIR / "tests" / "data" / "broken_scenarios" / "approach_zero_gain.yaml"
     with pytest.raises(kdl_space.InputError, match="approach_zero_gain.yaml"):
         kdl_space.load_scenario(str(broken))
+    # a scenario whose URDF loads no model: the loader's ModelError, the scenario's file and field in front
+    broken_urdf = broken.parent / "broken_urdf.yaml"
+    with pytest.raises(kdl_space.ModelError, match=r"broken_urdf.yaml:3: robot.urdf: .*not_a_robot.urdf: ") as e:
+        kdl_space.load_scenario(str(broken_urdf))
+    assert isinstance(e.value, kdl_space.Error) and not isinstance(e.value, kdl_space.InputError)
+    assert issubclass(kdl_space.InputError, kdl_space.Error) and issubclass(kdl_space.ModelError, kdl_space.Error)
     other = kdl_space.load_urdf(str(ARM))
     with pytest.raises(ValueError, match="another model"):
         computed.G_star(other.contact("end_effector"))

@@ -116,8 +116,9 @@ def test_forward_dynamics_errors(arm):
         fd.accelerations(moving(arm), wrenches={"nowhere": np.zeros(6)})
     with pytest.raises(kdl_space.ModelError, match="no joint named 'jointX'"):
         kdl_space.DenseForwardDynamicsSolver(arm, locked=["jointX"])
-    with pytest.raises(kdl_space.ComputeError):
+    with pytest.raises(kdl_space.ModelError, match=r"setGravity: the gravity \(0, nan, 0\) m/s\^2 is not finite"):
         fd.gravity = [0, np.nan, 0]
+    assert np.array_equal(fd.gravity, [0, 0, 0])  # a set-up call: refused, nothing changed
     fd.gravity = [0, 0, -1.62]
     assert np.array_equal(fd.gravity, [0, 0, -1.62])
     assert "ForwardDynamicsSolver" in repr(fd) and "7 joints" in repr(fd)

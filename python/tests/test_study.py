@@ -231,6 +231,23 @@ def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
     assert repr(grasp) == f"<kdl_space.StudyResult '{GRASP_STUDY}' 403 samples (0 failed), table (403, {len(grasp.columns)})>"
 
 
+def test_a_failure_keeps_its_message(tmp_path):
+    # a target mass drawn <= 0 is refused: the status column says E_BAD_ARGUMENT, the summary why
+    path = tmp_path / "failing.yaml"
+    path.write_text(f"scenario: {CAPTURE_SCENARIO}\nsamples: 30\nseed: 5\n"
+                    "inputs: {target.mass: {normal: {mean: 10, std: 20}}}\n")
+    r = kdl_space.study(str(path), threads=2)
+    status = r["status"]
+    failed = np.flatnonzero(status != 0)
+    assert len(failed) > 0 and np.all(status[failed] == kdl_space.E_BAD_ARGUMENT)
+    assert np.all(r["target.mass"][failed] <= 0)
+    assert r.summary["failures"] == [{"status": kdl_space.E_BAD_ARGUMENT, "count": len(failed),
+                                      "first_sample": int(failed[0]),
+                                      "message": "target: mass must be a finite value > 0"}]
+    # rows in any order: the same first sample and message
+    assert r.study.summary(r.table[::-1])["failures"] == r.summary["failures"]
+
+
 def test_unreachable_scheduler(small, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     t0 = time.monotonic()

@@ -1,5 +1,7 @@
 #include "kdl_space/algorithm/dense_forward_dynamics.hpp"
 
+#include "algorithm/set_up.hpp"
+
 namespace kdl_space {
 namespace {
 
@@ -32,16 +34,14 @@ DenseForwardDynamicsSolver::DenseForwardDynamicsSolver(std::shared_ptr<const Flo
   M_llt_.compute(Eigen::MatrixXd::Identity(6 + n, 6 + n));  // sized
 }
 
-int DenseForwardDynamicsSolver::setGravity(const Vector3d& g) {
-  if (!g.allFinite()) return E_NOT_FINITE;
+void DenseForwardDynamicsSolver::setGravity(const Vector3d& g) {
+  detail::checkGravity(g, "DenseForwardDynamicsSolver");
   gravity_ = g;
-  return E_NOERROR;
 }
 
-int DenseForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
-  if (locked.size() != model().nj()) return E_SIZE_MISMATCH;
-  locked_ = locked;
-  return E_NOERROR;
+void DenseForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
+  detail::checkLocked(model(), locked, false, "DenseForwardDynamicsSolver");
+  locked_ = locked;  // the same size: no allocation (the Simulator changes the brakes in a run)
 }
 
 int DenseForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,

@@ -1,5 +1,6 @@
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 
+#include "algorithm/set_up.hpp"
 #include "detail/multiversion.hpp"
 #include "detail/symmetric6d.hpp"
 
@@ -60,11 +61,15 @@ ForwardDynamicsSolver::~ForwardDynamicsSolver() = default;
 ForwardDynamicsSolver::ForwardDynamicsSolver(const ForwardDynamicsSolver&) = default;
 ForwardDynamicsSolver& ForwardDynamicsSolver::operator=(const ForwardDynamicsSolver&) = default;
 
-int ForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
-  if (locked.size() != model_->nj()) return E_SIZE_MISMATCH;
-  locked_ = locked;
+void ForwardDynamicsSolver::setGravity(const Vector3d& g) {
+  detail::checkGravity(g, "ForwardDynamicsSolver");
+  gravity_ = g;
+}
+
+void ForwardDynamicsSolver::setLocked(const std::vector<bool>& locked) {
+  detail::checkLocked(*model_, locked, false, "ForwardDynamicsSolver");
+  locked_ = locked;  // the same size: no allocation (the Simulator changes the brakes in a run)
   for (BodyData& b : data_) b.moving = b.joint >= 0 && !locked_[b.joint];
-  return E_NOERROR;
 }
 
 int ForwardDynamicsSolver::CartToJnt(const State& state, const FloatingVelocity& velocity, const KDL::JntArray& tau,

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "algorithm/set_up.hpp"
+
 namespace kdl_space {
 FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
     : model_(std::move(model)) {
@@ -30,16 +32,15 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   H_locked_work_.setZero(n, n);
 }
 
-int FreeFloatingSolver::setLocked(const std::vector<bool>& locked) {
+void FreeFloatingSolver::setLocked(const std::vector<bool>& locked) {
+  detail::checkLocked(*model_, locked, true, "FreeFloatingSolver");
   const unsigned int n = model_->nj();
-  if (!locked.empty() && locked.size() != n) return E_SIZE_MISMATCH;
   locked_.assign(n, false);
   for (std::size_t j = 0; j < locked.size(); ++j) locked_[j] = locked[j];
   any_locked_ = false;
   for (unsigned int j = 0; j < n; ++j) any_locked_ = any_locked_ || locked_[j];
   computed_ = false;  // the factorisations depend on the locks
   H_ok_ = false;
-  return E_NOERROR;
 }
 
 void FreeFloatingSolver::dropLocked(Eigen::Ref<Matrix6Xd> J) const {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "algorithm/set_up.hpp"
 #include "multibody/joint_motion.hpp"
 #include "detail/multiversion.hpp"
 #include "detail/lane_symmetric6d.hpp"
@@ -39,15 +40,14 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   for (std::size_t i = 0; i < nb; ++i) moves_[i] = model_->bodies()[i].joint >= 0;
 }
 
-int RecursiveExIITSolver::setLocked(const std::vector<bool>& locked) {
+void RecursiveExIITSolver::setLocked(const std::vector<bool>& locked) {
+  detail::checkLocked(*model_, locked, true, "RecursiveExIITSolver");
   const unsigned int n = model_->nj();
-  if (!locked.empty() && locked.size() != n) return E_SIZE_MISMATCH;
   locked_.assign(n, false);
   for (std::size_t j = 0; j < locked.size(); ++j) locked_[j] = locked[j];
   const std::vector<Body>& bodies = model_->bodies();
   for (std::size_t i = 0; i < bodies.size(); ++i) moves_[i] = bodies[i].joint >= 0 && !locked_[bodies[i].joint];
   computed_ = false;  // the articulated inertias depend on the locks
-  return E_NOERROR;
 }
 
 RecursiveExIITSolver::~RecursiveExIITSolver() = default;

@@ -10,9 +10,9 @@
 namespace kdl_space {
 namespace {
 
-/// A free-floating side, or an InputError that names the part (`who`: "robot" or "target"). A
-/// state whose kinematics cannot be computed is reported as such, anything else the side
-/// refuses in its own words.
+/// A free-floating side; its refusal names the part (`who`: "robot" or "target"). A state whose
+/// kinematics cannot be computed is an InputError, anything else the side refuses (a ModelError)
+/// keeps its kind and its own words.
 std::unique_ptr<FloatingSide> floatingSide(const FloatingSystem& s, ExIITMethod method, const std::string& who) {
   if (!s.model) throw InputError(who + ": no model");
   Kinematics kin(*s.model);
@@ -22,8 +22,8 @@ std::unique_ptr<FloatingSide> floatingSide(const FloatingSystem& s, ExIITMethod 
   try {
     return std::make_unique<FloatingSide>(s.model, std::move(kin), s.contact, s.velocity, s.response, method,
                                           s.locked);
-  } catch (const ModelError& e) {
-    throw InputError(who + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(who + ": ");
   }
 }
 
@@ -145,11 +145,7 @@ const CaptureResult& CaptureSolver::solve(const CaptureProblem& problem) {
   std::optional<RigidBodySide> rigid_target;
   ImpactSide* target = nullptr;
   if (const RigidTarget* rigid = std::get_if<RigidTarget>(&problem.target)) {
-    try {
-      target = &rigid_target.emplace(rigid->toWorld(), result.contact_point);
-    } catch (const ModelError& e) {
-      throw InputError(e.what());  // "target: ..."
-    }
+    target = &rigid_target.emplace(rigid->toWorld(), result.contact_point);  // or ModelError "target: ..."
   } else {
     floating_target = floatingSide(std::get<FloatingSystem>(problem.target), problem.method, "target");
     const double gap = (contactPoint(*floating_target, "target") - result.contact_point).norm();
@@ -219,8 +215,8 @@ std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem,
     return std::make_shared<const FloatingModel>(model->withPayload(
         link_name,
         KDL::RigidBodyInertia(b.mass, com, KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)))));
-  } catch (const ModelError& e) {
-    throw InputError("target: cannot attach the captured target to link " + detail::quoted(link_name) + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext("target: cannot attach the captured target to link " + detail::quoted(link_name) + ": ");
   }
 }
 

@@ -96,8 +96,8 @@ void setModesAfter(const Scenario& sc, const CaptureProblem& problem, const Oper
         control.set_point *= joint.target_joint_sign[j];  // a reversed joint's coordinate is negated
         try {
           sim.setJointControl(static_cast<unsigned int>(joint.target_joints[j]), control);
-        } catch (const ModelError& e) {
-          throw InputError(sc.file + ": simulation.target_joints: " + e.what());
+        } catch (const Error& e) {
+          e.rethrowWithContext(sc.file + ": simulation.target_joints: ");
         }
       }
     }
@@ -150,8 +150,8 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     r.joined = inScenario(sc, [&] {
       try {
         return joinedAfterCapture(problem, *capture);
-      } catch (const ModelError& e) {
-        throw InputError(std::string("target: cannot join the captured target to the robot: ") + e.what());
+      } catch (const Error& e) {
+        e.rethrowWithContext("target: cannot join the captured target to the robot: ");
       }
     });
     r.model = r.joined ? r.joined->model : inScenario(sc, [&] { return attachTarget(problem, *capture); });

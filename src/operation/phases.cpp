@@ -11,8 +11,8 @@ std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_pt
                                         bool approach) {
   try {
     return makeSimulator(sc, model, approach);
-  } catch (const ModelError& e) {
-    throw InputError(sc.file + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(sc.file + ": ");
   }
 }
 
@@ -38,8 +38,8 @@ void approach(const Scenario& sc, double output_step, OperationResult& result, S
     try {
       return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach,
                                                   FreeRigidMotion(std::get<RigidTarget>(sc.capture.target)));
-    } catch (const ModelError& e) {
-      throw InputError(std::string("approach: ") + e.what());
+    } catch (const Error& e) {
+      e.rethrowWithContext("approach: ");
     }
   });
   s.state = robot.state;

@@ -26,15 +26,16 @@ std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CapturePro
 std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                         bool approach);
 
-/// `f()`, an InputError it throws with the scenario's file in front ("FILE: target: ...").
+/// `f()`; an error it throws comes back with the scenario's file in front ("FILE: target: ..."),
+/// of its own type (an OperationError, which names the file already, as it is).
 template <typename F>
 auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
   try {
     return f();
   } catch (const OperationError&) {
     throw;
-  } catch (const InputError& e) {
-    throw InputError(scenario.file + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(scenario.file + ": ");
   }
 }
 

@@ -20,14 +20,14 @@ class Dynamics {
       : route_(model->mimic().empty() ? Route(std::in_place_type<ForwardDynamicsSolver>, model)
                                       : Route(std::in_place_type<DenseForwardDynamicsSolver>, model)) {}
 
-  int setGravity(const Vector3d& g) {
-    return std::visit([&](auto& d) { return d.setGravity(g); }, route_);
+  void setGravity(const Vector3d& g) {
+    std::visit([&](auto& d) { d.setGravity(g); }, route_);
   }
   void setGrounded(bool grounded) {
     std::visit([&](auto& d) { d.setGrounded(grounded); }, route_);
   }
-  int setLocked(const std::vector<bool>& locked) {
-    return std::visit([&](auto& d) { return d.setLocked(locked); }, route_);
+  void setLocked(const std::vector<bool>& locked) {
+    std::visit([&](auto& d) { d.setLocked(locked); }, route_);
   }
   int CartToJnt(const Kinematics& kin, const FloatingVelocity& velocity, const KDL::JntArray& tau,
                 const std::vector<KDL::Wrench>& f_ext, FloatingAcceleration& acceleration) {

@@ -61,7 +61,8 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   // ModelError for an integrator that is no enumerator.
   stepper_ = detail::makeStepper(options_.integrator, *equations_, size,
                                  detail::ErrorControl{options_.rtol, options_.atol, layout.work});
-  if (dynamics_->setGravity(options_.gravity) != E_NOERROR) throw ModelError("simulation: gravity must be finite");
+  if (!options_.gravity.allFinite()) throw ModelError("simulation: gravity must be finite");
+  dynamics_->setGravity(options_.gravity);
   dynamics_->setGrounded(options_.grounded);
 }
 

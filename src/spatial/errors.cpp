@@ -17,4 +17,16 @@ const char* strError(int code) {
   }
 }
 
+// Out of line: one vtable and one type_info per exception, so that a catch in a program matches
+// what the shared library throws.
+Error::~Error() = default;
+ModelError::~ModelError() = default;
+InputError::~InputError() = default;
+
+void Error::rethrowWithContext(const std::string& context) const { std::rethrow_exception(renamed(context + what())); }
+
+std::exception_ptr Error::renamed(const std::string& what) const { return std::make_exception_ptr(Error(what)); }
+std::exception_ptr ModelError::renamed(const std::string& what) const { return std::make_exception_ptr(ModelError(what)); }
+std::exception_ptr InputError::renamed(const std::string& what) const { return std::make_exception_ptr(InputError(what)); }
+
 }  // namespace kdl_space

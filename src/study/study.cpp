@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "detail/text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
@@ -61,7 +62,7 @@ KDL::Frame handFrame(const Kinematics& kin, const Contact& h) {
 
 /// The motion after the capture (runMotionAfterCapture: the scenario's simulation section, its PD
 /// servos holding the capture configuration): each joint's largest |torque|, the base's largest
-/// |w| and the largest |qdot_j| / limit_j, at the output steps.
+/// |w| and the largest |qdot_j| / limit_j, at the output steps. A run that fails: its code.
 int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureResult& r, std::vector<double>& peak,
                 double& peak_base_rate, double& rate_ratio) {
   const FloatingModel& robot = *problem.robot.model;
@@ -84,10 +85,9 @@ int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureRes
   OperationResult motion;
   try {
     runMotionAfterCapture(st.scenario, problem, r, 0.0, o, motion);
-  } catch (const OperationError& e) {
-    return e.code() != E_NOERROR ? e.code() : E_BAD_ARGUMENT;
-  } catch (const std::exception&) {
-    return E_BAD_ARGUMENT;
+  } catch (const OperationError& e) {  // a run that failed: its code; a refused set-up throws on
+    if (e.code() == E_NOERROR) throw;   // (evaluate reports it as the sample's failure, in its words)
+    return e.code();
   }
   return E_NOERROR;
 }
@@ -120,6 +120,16 @@ StudyEvaluator::StudyEvaluator(std::shared_ptr<const Study> study)
 StudyEvaluator::~StudyEvaluator() = default;
 
 void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
+  failure_.clear();
+  try {
+    sample(i, row);
+  } catch (const std::exception& e) {  // a set-up the library refused (an Error): its status, its words
+    row[1] = E_BAD_ARGUMENT;
+    failure_ = e.what();
+  }
+}
+
+void StudyEvaluator::sample(std::uint64_t i, double* row) {
   const Study& st = *study_;
   const Scenario& sc = st.scenario;
   Work& w = *work_;
@@ -128,7 +138,11 @@ void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
   sampling::draw(st, i, w.drawn.data());
   std::copy(w.drawn.begin(), w.drawn.end(), row + 2);
   double* out = row + 2 + w.drawn.size();
-  const auto fail = [&](int code) { row[1] = code; };
+  // A compute call's code: the status, and what could not be computed for the summary.
+  const auto fail = [&](int code, const std::string& what) {
+    row[1] = code;
+    failure_ = what + ": " + strError(code);
+  };
 
   // The inputs, set in a copy of the scenario's problem: the robot's first, then the target's.
   FloatingSystem& robot = w.problem.robot;
@@ -157,30 +171,24 @@ void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
     v += sampling::valuesOf(in);
   }
   if (w.self_motion && self_motion != 0.0)
-    if (const int rc = w.self_motion->move(robot.state, self_motion)) return fail(rc);
+    if (const int rc = w.self_motion->move(robot.state, self_motion))
+      return fail(rc, "robot.self_motion: the arm cannot move " + detail::number(self_motion) + " rad along its self-motion");
   if (target0) {
     if (timing > 0.0) {  // later along the tumble: the attitude and twist then
-      try {
-        FreeRigidMotion motion(target);
-        if (const int rc = motion.at(timing, target)) return fail(rc);
-      } catch (const ModelError&) {
-        return fail(E_BAD_ARGUMENT);
-      }
+      FreeRigidMotion motion(target);  // or ModelError "FreeRigidMotion: ..." (a mass drawn <= 0)
+      if (const int rc = motion.at(timing, target))
+        return fail(rc, "timing: the target's tumble cannot be followed for " + detail::number(timing) + " s");
     }
     if (w.kin) {  // the target rides with the hand: the grasp point (moved by target.grasp) at the contact point
-      if (const int rc = forwardKinematics(*robot.model, robot.state, *w.kin)) return fail(rc);
+      if (const int rc = forwardKinematics(*robot.model, robot.state, *w.kin))
+        return fail(rc, "robot.q: the hand's pose cannot be computed at the sample's joint positions");
       const KDL::Frame hand = handFrame(*w.kin, robot.contact);
       target.pose.M = hand.M * w.hand_nominal.M.Inverse() * target.pose.M;
       target.pose.p = hand.p - target.pose.M * toKDL(w.grasp + grasp_shift);
     }
     w.problem.target = target;
   }
-  const CaptureResult* r = nullptr;
-  try {
-    r = &w.capture.solve(w.problem);
-  } catch (const InputError&) {
-    return fail(E_BAD_ARGUMENT);
-  }
+  const CaptureResult* r = &w.capture.solve(w.problem);  // or its Error ("robot: ...", "target: ...")
   const Vector6d F_h = r->impulse.F;
   for (int k = 0; k < 6; ++k) *out++ = F_h(k);
   *out++ = F_h.head<3>().norm();
@@ -205,7 +213,8 @@ void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
       rate_ratio = std::max(rate_ratio, std::abs(r->robot.after.qdot(j)) / (*st.limits.joint_rate)[j]);
   if (st.motion_duration > 0.0) {
     std::vector<double> peak(n, 0.0);
-    if (const int rc = motionPeaks(st, w.problem, *r, peak, peak_base_rate, rate_ratio)) return fail(rc);
+    if (const int rc = motionPeaks(st, w.problem, *r, peak, peak_base_rate, rate_ratio))
+      return fail(rc, "motion: the motion after the capture cannot be simulated for " + detail::number(st.motion_duration) + " s");
     for (unsigned int j = 0; j < n; ++j) {
       *out++ = peak[j];
       if (st.limits.joint_torque) torque_ratio = std::max(torque_ratio, peak[j] / (*st.limits.joint_torque)[j]);

@@ -180,8 +180,8 @@ Study loadStudy(const std::string& path) {
     scenario_path = (std::filesystem::path(path).parent_path() / scenario_path).lexically_normal().string();
   try {
     st.scenario = loadScenario(scenario_path);
-  } catch (const InputError& e) {
-    top.at("scenario").fail(e.what());
+  } catch (const Error& e) {  // its own InputError, or a URDF's ModelError: the kind kept
+    e.rethrowWithContext(top.at("scenario").where());
   }
   const Scenario& sc = st.scenario;
   if (!sc.impact) top.at("scenario").fail("is a plain motion: a study samples captures (give the scenario a target and a law)");
@@ -222,8 +222,8 @@ Study loadStudy(const std::string& path) {
       probe.contact_body_pose = KDL::Frame::Identity();
       if (sc.capture.law.kind == ImpactKind::TranslationalCapture || !std::holds_alternative<RigidTarget>(sc.capture.target))
         attachTarget(sc.capture, probe);  // refuses what no motion follows
-    } catch (const InputError& e) {
-      m.fail(std::string("no motion follows this scenario's capture: ") + e.what());
+    } catch (const Error& e) {
+      e.rethrowWithContext(m.where() + "no motion follows this scenario's capture: ");
     }
   }
   const FloatingModel& robot = *sc.capture.robot.model;

@@ -1,7 +1,8 @@
 // A study's table summarised: quantiles of each outcome, the probability of each limit exceeded,
-// the best and worst samples by the objective with their inputs.
+// the best and worst samples by the objective with their inputs, each distinct failure with why.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "kdl_space/study/study.hpp"
 #include "study/study_sampling.hpp"
@@ -17,6 +18,48 @@ double quantile(const std::vector<double>& sorted, double p) {
   return sorted[k] + (x - static_cast<double>(k)) * (sorted[k + 1] - sorted[k]);
 }
 
+/// A table's status as a code (a value no code can be, for a table whose status is no whole
+/// number: rows handed in by a caller, not written by a study).
+int statusOf(double v) {
+  const bool code = std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e9;
+  return code ? static_cast<int>(v) : std::numeric_limits<int>::min();
+}
+
+/// Each distinct status of the failed rows: how many, the first sample, and why (that sample
+/// evaluated again: its row may come from another thread, process, shard or run).
+std::vector<StudyFailure> failures(const Study& study, const std::vector<double>& rows, std::size_t m) {
+  std::vector<StudyFailure> list;
+  for (std::size_t r = 0; r < rows.size() / m; ++r) {
+    if (rows[r * m + 1] == 0.0) continue;
+    const int status = statusOf(rows[r * m + 1]);
+    const double i = rows[r * m];
+    const std::uint64_t sample = i >= 0.0 && i < 1e18 ? static_cast<std::uint64_t>(i) : ~std::uint64_t{0};
+    auto f = std::find_if(list.begin(), list.end(), [&](const StudyFailure& x) { return x.status == status; });
+    if (f == list.end()) f = list.insert(list.end(), StudyFailure{status, 0, sample, ""});
+    ++f->count;
+    f->first_sample = std::min(f->first_sample, sample);
+  }
+  std::sort(list.begin(), list.end(), [](const StudyFailure& a, const StudyFailure& b) { return a.first_sample < b.first_sample; });
+  if (list.empty()) return list;
+  StudyEvaluator evaluator(std::shared_ptr<const Study>(std::shared_ptr<const Study>(), &study));  // not owned
+  std::vector<double> row(m);
+  for (StudyFailure& f : list) {
+    const std::string stored = "status " + std::to_string(f.status) + " (" + strError(f.status) + ")";
+    if (f.first_sample >= study.samples) {
+      f.message = stored + "; sample " + std::to_string(f.first_sample) + " is no sample of this study";
+      continue;
+    }
+    evaluator.evaluate(f.first_sample, row.data());
+    if (statusOf(row[1]) == f.status) {
+      f.message = evaluator.failure();
+    } else {  // not reproduced: the table holds a row of another run
+      f.message = stored + "; evaluated again, sample " + std::to_string(f.first_sample) +
+                  (row[1] == 0.0 ? " computes" : " fails with status " + std::to_string(statusOf(row[1])) + ": " + evaluator.failure());
+    }
+  }
+  return list;
+}
+
 }  // namespace
 
 StudySummary summarizeStudy(const Study& study, const std::vector<double>& rows) {
@@ -28,6 +71,7 @@ StudySummary summarizeStudy(const Study& study, const std::vector<double>& rows)
   s.samples = count;
   std::vector<std::size_t> good;
   for (std::size_t r = 0; r < count; ++r) (rows[r * m + 1] == 0.0 ? good.push_back(r) : void(++s.failed));
+  s.failures = failures(study, rows, m);
   std::vector<double> values(good.size());
   for (std::size_t c = first_outcome; c < m; ++c) {
     for (std::size_t k = 0; k < good.size(); ++k) values[k] = rows[good[k] * m + c];

@@ -76,8 +76,8 @@ void compareAtRandomState(const ModelPtr& model, const Loads& loads, std::mt1993
   ForwardDynamicsSolver aba(model);
   CrbForwardDynamics crb(model);
   const Vector3d g = loads.gravity ? Vector3d(0.4, -1.1, -9.81) : Vector3d::Zero();
-  ASSERT_EQ(aba.setGravity(g), E_NOERROR);
-  ASSERT_EQ(crb.setGravity(g), E_NOERROR);
+  aba.setGravity(g);
+  crb.setGravity(g);
 
   const State state = randomState(*model, rng);
   FloatingVelocity v(*model);
@@ -94,8 +94,8 @@ void compareAtRandomState(const ModelPtr& model, const Loads& loads, std::mt1993
     for (unsigned int j = 0; j < n; ++j)
       if (locked[j] && !loads.locked_moving) v.qdot(j) = 0.0;  // a braked joint does not move...
   }  // ...unless the test asks what happens to one that still does (its velocity products stay)
-  ASSERT_EQ(aba.setLocked(locked), E_NOERROR);
-  ASSERT_EQ(crb.setLocked(locked), E_NOERROR);
+  aba.setLocked(locked);
+  crb.setLocked(locked);
   std::vector<KDL::Wrench> f;
   if (loads.wrenches) {  // on the base, every third body, and the last
     f.assign(model->bodies().size(), KDL::Wrench::Zero());

@@ -273,7 +273,7 @@ TEST_P(LockedDynamics, EqualsTheModelWithThoseJointsFixed) {
     int count = 0;
     for (int j = 0; j < n; ++j) count += (locked[j] = s == 9 || coin(rng)) ? 1 : 0;
     if (count == 0) locked[s % n] = true, count = 1;
-    ASSERT_EQ(solver.setLocked(locked), E_NOERROR);
+    solver.setLocked(locked);
 
     const State state = randomState(*model, rng);
     FloatingVelocity v = randomVelocity(*model, rng);

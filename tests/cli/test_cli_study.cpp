@@ -107,10 +107,11 @@ TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
   const json j = json::parse(r.out);
   EXPECT_EQ(j, json::parse(slurp(summary)));
   for (const char* key : {"study", "fingerprint", "table", "samples", "failed", "seed", "outcomes", "probabilities",
-                          "objective", "best", "worst"})
+                          "objective", "best", "worst", "failures"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["samples"], 31 * 13);  // its grid
   EXPECT_EQ(j["failed"], 0);
+  EXPECT_EQ(j["failures"], json::array());
   EXPECT_EQ(j["objective"], "base_rate");
   const json& q = j["outcomes"]["base_rate"];
   EXPECT_LE(q["min"].get<double>(), q["q05"].get<double>());
@@ -123,6 +124,48 @@ TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
   EXPECT_GT(fs::file_size(plot), 1000u);
   EXPECT_GT(fs::file_size(map), 1000u);
   EXPECT_NE(slurp(map).find("<svg"), std::string::npos);
+}
+
+TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {
+  // A target mass drawn <= 0 is refused (status E_BAD_ARGUMENT, -106): the summary keeps the
+  // library's message, the same from one run, from shards merged and in the text summary.
+  const std::string study = write("failing.yaml", "scenario: " + kScenarios + "tumbling_box_capture.yaml\n"
+                                  "samples: 30\nseed: 5\ninputs: {target.mass: {normal: {mean: 10, std: 20}}}\n");
+  const std::string table = scratch("failing.csv");
+  const ToolRun r = kdlSpace("study " + study + " -o " + table + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const json j = json::parse(r.out);
+  ASSERT_EQ(j["failures"].size(), 1u) << j.dump(2);
+  const json& f = j["failures"][0];
+  EXPECT_EQ(f["status"], -106);
+  EXPECT_EQ(f["count"], j["failed"]);
+  EXPECT_GT(f["count"].get<int>(), 0);
+  EXPECT_EQ(f["message"], "target: mass must be a finite value > 0");
+  // The first sample: the first row whose status is -106.
+  std::istringstream lines(slurp(table));
+  std::string line;
+  std::getline(lines, line);
+  std::getline(lines, line);
+  long first = -1;
+  for (long i = 0; first < 0 && std::getline(lines, line); ++i)
+    if (line.find(",-106,") != std::string::npos) first = i;
+  EXPECT_EQ(f["first_sample"], first);
+  // From two shards merged: the same failures.
+  std::string parts;
+  for (int i = 1; i <= 2; ++i) {
+    const std::string part = scratch("failing_part" + std::to_string(i) + ".csv");
+    ASSERT_EQ(kdlSpace("study " + study + " --shard " + std::to_string(i) + "/2 -o " + part).rc, 0);
+    parts += " " + part;
+  }
+  const ToolRun m = kdlSpace("study " + study + " --merge" + parts + " -o " + scratch("failing_merged.csv") + " --json");
+  ASSERT_EQ(m.rc, 0) << m.err;
+  EXPECT_EQ(json::parse(m.out)["failures"], j["failures"]);
+  // The text summary says it under its first line.
+  const ToolRun t = kdlSpace("study " + study + " -o " + table);
+  ASSERT_EQ(t.rc, 0) << t.err;
+  const std::string expected = "  status -106: " + std::to_string(f["count"].get<int>()) + " samples, the first " +
+                               std::to_string(first) + ": target: mass must be a finite value > 0\n";
+  EXPECT_NE(t.out.find(" could not be computed), seed 5; table " + table + "\n" + expected), std::string::npos) << t.out;
 }
 
 TEST(StudyCommand, TheNominalSamplesMotionIsSimulates) {

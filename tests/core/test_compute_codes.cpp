@@ -209,27 +209,6 @@ TEST(ForwardDynamicsCodes, CartToJntChecksEverySizeAndValue) {
   EXPECT_EQ(a.qddot.data, Eigen::VectorXd::Constant(n, kSentinel));
   EXPECT_NO_THROW(EXPECT_EQ(fd.CartToJnt(kin, v, tau, none, a), E_NOERROR));
 
-  EXPECT_EQ(fd.setLocked(std::vector<bool>(n + 1)), E_SIZE_MISMATCH);
-  // The impact solvers' brakes: size nj() or empty (none); a refusal keeps the locks.
-  RecursiveExIITSolver recursive(model);
-  FreeFloatingSolver dense(model);
-  std::vector<bool> one(n, false);
-  one[0] = true;
-  EXPECT_EQ(recursive.setLocked(one), E_NOERROR);
-  EXPECT_EQ(dense.setLocked(one), E_NOERROR);
-  for (const std::size_t size : {std::size_t{1}, std::size_t{n - 1}, std::size_t{n + 1}}) {
-    EXPECT_EQ(recursive.setLocked(std::vector<bool>(size, true)), E_SIZE_MISMATCH) << size;
-    EXPECT_EQ(dense.setLocked(std::vector<bool>(size, true)), E_SIZE_MISMATCH) << size;
-  }
-  EXPECT_EQ(recursive.locked(), one) << "unchanged after a refusal";
-  EXPECT_EQ(dense.locked(), one) << "unchanged after a refusal";
-  EXPECT_EQ(recursive.setLocked({}), E_NOERROR);
-  EXPECT_EQ(dense.setLocked({}), E_NOERROR);
-  EXPECT_EQ(recursive.locked(), std::vector<bool>(n, false)) << "empty: none";
-  EXPECT_EQ(dense.locked(), std::vector<bool>(n, false)) << "empty: none";
-  EXPECT_EQ(fd.setGravity(Vector3d(0, 0, kNaN)), E_NOT_FINITE);
-  EXPECT_EQ(fd.gravity(), Vector3d::Zero()) << "unchanged after a refusal";
-  EXPECT_EQ(fd.setGravity(Vector3d(0, 0, -9.81)), E_NOERROR);
 }
 
 // --- Simulator ---------------------------------------------------------------------------------
@@ -568,6 +547,47 @@ void expectModelError(Build build, const std::string& prefix, const std::string&
     EXPECT_EQ(what.rfind(prefix, 0), 0u) << what;
     EXPECT_NE(what.find(fragment), std::string::npos) << what;
   }
+}
+
+TEST(SolverSetUp, SetLockedAndSetGravityThrowModelErrorNamingTheProblem) {
+  // Set-up calls: a refusal is a ModelError naming the call and the model's joints (or the
+  // value), and the solver keeps what it had.
+  const ModelPtr model = arm7();
+  const unsigned int n = model->nj();
+  const std::string joints = "(joint1, joint2, joint3, joint4, joint5, joint6, joint7)";
+  ForwardDynamicsSolver fd(model);
+  DenseForwardDynamics crb(model);
+  expectModelError([&] { fd.setLocked(std::vector<bool>(n + 1)); }, "ForwardDynamicsSolver::setLocked: 8 braked-joint flags",
+                   "a model of 7 joints; give one per joint, in the model's order " + joints);
+  expectModelError([&] { crb.setLocked({}); }, "DenseForwardDynamics::setLocked: 0 braked-joint flags", joints);
+  EXPECT_EQ(fd.locked(), std::vector<bool>(n, false)) << "unchanged after a refusal";
+  // The impact solvers' brakes: size nj() or empty (none); a refusal keeps the locks.
+  RecursiveExIITSolver recursive(model);
+  FreeFloatingSolver dense(model);
+  std::vector<bool> one(n, false);
+  one[0] = true;
+  recursive.setLocked(one);
+  dense.setLocked(one);
+  for (const std::size_t size : {std::size_t{1}, std::size_t{n - 1}, std::size_t{n + 1}}) {
+    const std::string flags = std::to_string(size) + " braked-joint flags for a model of 7 joints";
+    expectModelError([&] { recursive.setLocked(std::vector<bool>(size, true)); }, "RecursiveExIITSolver::setLocked: " + flags,
+                     joints + ", or none");
+    expectModelError([&] { dense.setLocked(std::vector<bool>(size, true)); }, "FreeFloatingSolver::setLocked: " + flags,
+                     joints + ", or none");
+  }
+  EXPECT_EQ(recursive.locked(), one) << "unchanged after a refusal";
+  EXPECT_EQ(dense.locked(), one) << "unchanged after a refusal";
+  recursive.setLocked({});
+  dense.setLocked({});
+  EXPECT_EQ(recursive.locked(), std::vector<bool>(n, false)) << "empty: none";
+  EXPECT_EQ(dense.locked(), std::vector<bool>(n, false)) << "empty: none";
+  expectModelError([&] { fd.setGravity(Vector3d(0, 0, kNaN)); }, "ForwardDynamicsSolver::setGravity: the gravity (0, 0, nan)",
+                   "is not finite");
+  expectModelError([&] { crb.setGravity(Vector3d(kInf, 0, 0)); }, "DenseForwardDynamics::setGravity: the gravity (inf, 0, 0)",
+                   "is not finite");
+  EXPECT_EQ(fd.gravity(), Vector3d::Zero()) << "unchanged after a refusal";
+  fd.setGravity(Vector3d(0, 0, -9.81));
+  EXPECT_EQ(fd.gravity(), Vector3d(0, 0, -9.81));
 }
 
 TEST_F(SideCodes, SideConstructorsThrowModelErrorNamingTheProblem) {

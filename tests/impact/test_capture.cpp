@@ -240,11 +240,11 @@ TEST(SolveCaptureRobotToRobot, ConservesMomentumAndLeavesNoRelativeTwist) {
   }
 }
 
-/// The message of the InputError that solveCapture throws, or "" if it does not.
+/// The message of the Error that solveCapture throws, or "" if it does not.
 std::string refusal(const CaptureProblem& p) {
   try {
     solveCapture(p);
-  } catch (const InputError& e) {
+  } catch (const Error& e) {
     return e.what();
   }
   return "";
@@ -276,21 +276,26 @@ TEST(SolveCaptureRefusals, NameThePart) {
   p.robot.state.world_T_base.p = KDL::Vector(NAN, 0, 0);
   EXPECT_TRUE(starts(refusal(p), "robot: the free-floating quantities cannot be computed at this state (robot.base, "
                                  "robot.q): " + std::string(strError(E_NOT_FINITE))));
+  EXPECT_THROW(solveCapture(p), InputError) << "the problem's state: an input";
   p = good;
   p.robot.velocity.qdot = KDL::JntArray(p.robot.model->nj() + 1);
   EXPECT_TRUE(starts(refusal(p), "robot: FloatingSide: "));
+  EXPECT_THROW(solveCapture(p), ModelError) << "the side's refusal keeps its kind, the part in front";
   p = good;
   p.robot.model = nullptr;
   EXPECT_TRUE(starts(refusal(p), "robot: "));
+  EXPECT_THROW(solveCapture(p), InputError);
   p = good;
   std::get<RigidTarget>(p.target).mass = -1.0;
-  EXPECT_TRUE(starts(refusal(p), "target: "));
+  EXPECT_EQ(refusal(p), "target: mass must be a finite value > 0");
+  EXPECT_THROW(solveCapture(p), ModelError) << "RigidBodySide's own";
   p = good;
   std::get<RigidTarget>(p.target).inertia(0, 0) = -5.0;
   EXPECT_TRUE(starts(refusal(p), "target: "));
   p = good;
   p.law.restitution = 2.0;
   EXPECT_TRUE(starts(refusal(p), "law: the impact cannot be solved: " + std::string(strError(E_BAD_ARGUMENT))));
+  EXPECT_THROW(solveCapture(p), InputError);
   p = good;
   FloatingSystem other = randomSystem(impactRobots()[0], rng);
   other.state.q(0) = INFINITY;

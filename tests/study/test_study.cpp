@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 
 #include "kdl_space/study/study.hpp"
 #include "test_util.hpp"
@@ -173,6 +175,77 @@ TEST(Study, SummaryQuantilesProbabilitiesAndRanks) {
   EXPECT_EQ(s.worst[0].sample, 0u);  // base_rate 10
   EXPECT_EQ(s.best[0].inputs.size(), 6u);
   EXPECT_EQ(s.best[0].inputs[0].first, "robot.q.joint2");
+}
+
+/// A study of the tumbling box whose samples fail for known reasons: a target mass drawn <= 0
+/// (RigidBodySide refuses it: E_BAD_ARGUMENT) and, for the others, a motion after the capture
+/// whose step budget (3 steps) is spent (E_MAX_STEPS).
+std::string failingStudy() {
+  std::ifstream in(kScenarios + "tumbling_box_capture.yaml");
+  std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  scenario.replace(scenario.find("../urdf/"), 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  scenario.replace(scenario.find("  atol:"), 0, "  max_steps: 3\n");
+  const std::string path = studyFile("failing_scenario.yaml", scenario);
+  return studyFile("failing.yaml", "scenario: " + path + "\nsamples: 40\nseed: 5\n"
+                   "inputs: {target.mass: {normal: {mean: 10, std: 20}}}\nmotion: {duration: 0.5}\n");
+}
+
+TEST(Study, TheSummaryKeepsTheMessageOfTheFirstSampleOfEachFailure) {
+  const auto st = std::make_shared<const Study>(loadStudy(failingStudy()));
+  const std::size_t m = studyColumns(*st).size();
+  // Evaluated here: each failed sample says why.
+  StudyEvaluator evaluator(st);
+  std::vector<double> row(m);
+  std::map<int, std::uint64_t> count, first;
+  for (std::uint64_t i = 0; i < st->samples; ++i) {
+    evaluator.evaluate(i, row.data());
+    const int status = static_cast<int>(row[1]);
+    ASSERT_TRUE(status == E_BAD_ARGUMENT || status == E_MAX_STEPS) << i << ": " << status;
+    if (count[status]++ == 0) first[status] = i;
+    const double mass = row[2];
+    EXPECT_EQ(status == E_BAD_ARGUMENT, mass <= 0.0) << i;
+    EXPECT_EQ(evaluator.failure(), status == E_BAD_ARGUMENT ? "target: mass must be a finite value > 0"
+                                                            : "motion: the motion after the capture cannot be simulated "
+                                                              "for 0.5 s: " + std::string(strError(E_MAX_STEPS)));
+  }
+  ASSERT_GT(count[E_BAD_ARGUMENT], 0u);
+  ASSERT_GT(count[E_MAX_STEPS], 0u);
+  // The table from two threads in chunks of 7 (in the order they complete), its rows reversed:
+  // the summary evaluates each failure's first sample again, so its message does not depend on
+  // where or in which order the rows were computed.
+  std::vector<double> done;
+  runStudy(st, studyChunks(0, st->samples, 7), 2,
+           [&](const StudyChunk&, const std::vector<double>& part) { done.insert(done.end(), part.begin(), part.end()); });
+  ASSERT_EQ(done.size(), static_cast<std::size_t>(st->samples) * m);
+  std::vector<double> rows;
+  for (std::size_t r = st->samples; r-- > 0;) {
+    const auto at = done.begin() + static_cast<std::ptrdiff_t>(r * m);
+    rows.insert(rows.end(), at, at + static_cast<std::ptrdiff_t>(m));
+  }
+  const StudySummary s = summarizeStudy(*st, rows);
+  EXPECT_EQ(s.failed, st->samples);
+  ASSERT_EQ(s.failures.size(), 2u);
+  EXPECT_LT(s.failures[0].first_sample, s.failures[1].first_sample) << "in the order of their first sample";
+  for (const StudyFailure& f : s.failures) {
+    SCOPED_TRACE(f.status);
+    EXPECT_EQ(f.count, count[f.status]);
+    EXPECT_EQ(f.first_sample, first[f.status]);
+  }
+  const StudyFailure& bad = s.failures[s.failures[0].status == E_BAD_ARGUMENT ? 0 : 1];
+  EXPECT_EQ(bad.message, "target: mass must be a finite value > 0");
+  const StudyFailure& steps = s.failures[s.failures[0].status == E_MAX_STEPS ? 0 : 1];
+  EXPECT_EQ(steps.message, "motion: the motion after the capture cannot be simulated for 0.5 s: " +
+                               std::string(strError(E_MAX_STEPS)));
+  // A row that does not fail when evaluated again (another run's, or a caller's): said so.
+  std::vector<double> good(m);
+  StudyEvaluator(std::make_shared<const Study>(loadStudy(mixedStudy()))).evaluate(3, good.data());
+  ASSERT_EQ(good[1], 0.0);
+  good[1] = E_MAX_STEPS;
+  const StudySummary other = summarizeStudy(loadStudy(mixedStudy()), good);
+  ASSERT_EQ(other.failures.size(), 1u);
+  EXPECT_EQ(other.failures[0].first_sample, 3u);
+  EXPECT_EQ(other.failures[0].message, "status -105 (" + std::string(strError(E_MAX_STEPS)) +
+                                           "); evaluated again, sample 3 computes");
 }
 
 /// The message of loadStudy for a study file, or "" if it loads.

@@ -27,8 +27,9 @@ class KDL_SPACE_EXPORT DenseForwardDynamicsSolver {
   explicit DenseForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model);
 
   const FloatingModel& model() const { return solver_.model(); }
-  int setGravity(const Vector3d& g);
-  int setLocked(const std::vector<bool>& locked);
+  /// As ForwardDynamicsSolver::setGravity and setLocked: set-up calls, \throws ModelError.
+  void setGravity(const Vector3d& g);
+  void setLocked(const std::vector<bool>& locked);
   /// A grounded base: the base rows and columns replaced by the identity, its acceleration zero
   /// (as ForwardDynamicsSolver::setGrounded).
   void setGrounded(bool grounded) { grounded_ = grounded; }

@@ -48,16 +48,14 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   ForwardDynamicsSolver& operator=(const ForwardDynamicsSolver&);
 
   const FloatingModel& model() const { return *model_; }
-  /// Gravity acceleration (world frame); zero by default (orbit). For ground test beds.
-  /// \return 0, or E_NOT_FINITE (and the gravity unchanged) for a NaN or infinite g.
-  int setGravity(const Vector3d& g) {
-    if (!g.allFinite()) return E_NOT_FINITE;
-    gravity_ = g;
-    return E_NOERROR;
-  }
+  /// Gravity acceleration (world frame); zero by default (orbit). For ground test beds. A set-up
+  /// call: \throws ModelError (naming the value; the gravity unchanged) for a NaN or infinite g.
+  void setGravity(const Vector3d& g);
   const Vector3d& gravity() const { return gravity_; }
-  /// Joints whose brakes are on (model order, size nj()). \return E_SIZE_MISMATCH or 0.
-  int setLocked(const std::vector<bool>& locked);
+  /// Joints whose brakes are on (model order, size nj()). A set-up call: \throws ModelError
+  /// (naming the model's joints; the locks unchanged) for another size. Allocation-free, so the
+  /// Simulator changes the brakes with it during a run (always of the right size there).
+  void setLocked(const std::vector<bool>& locked);
   const std::vector<bool>& locked() const { return locked_; }
   /// \brief A grounded base (held still, as on a test bed or a fixed-base arm): its acceleration
   /// is zero and the joints follow the fixed-base dynamics H qddot = tau - c (eq. 22's H). The

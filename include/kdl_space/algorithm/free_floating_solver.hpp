@@ -50,9 +50,9 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   /// G = J_f H_ff^-1 J_f^T with f the free joints; their rate jumps are exactly 0 (a mimic
   /// joint follows its leader's coordinate: braked with it). The accessors (H, H*, A_m, J, J*)
   /// and momentum, energy, handTwist stay those of the whole model. A set-up call (it may
-  /// allocate); takes effect at the next compute(). \return 0, or E_SIZE_MISMATCH (another size
-  /// than nj() or 0; the locks are unchanged).
-  int setLocked(const std::vector<bool>& locked);
+  /// allocate); takes effect at the next compute(). \throws ModelError (naming the model's
+  /// joints; the locks unchanged) for another size than nj() or 0.
+  void setLocked(const std::vector<bool>& locked);
   /// The braked joints (model order, size nj(); all false unless setLocked says otherwise).
   const std::vector<bool>& locked() const { return locked_; }
 

@@ -48,9 +48,9 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   /// \brief Joints braked at the impact (model order, size nj(); empty: none): each is treated as
   /// a fixed joint at its current position by compute, G and velocityJump (for FreeFloating and
   /// Grounded), so G is that of the partly locked system and their rate jumps are exactly 0. A
-  /// set-up call (it may allocate); takes effect at the next compute().
-  /// \return 0, or E_SIZE_MISMATCH (another size than nj() or 0; the locks are unchanged).
-  int setLocked(const std::vector<bool>& locked);
+  /// set-up call (it may allocate); takes effect at the next compute(). \throws ModelError
+  /// (naming the model's joints; the locks unchanged) for another size than nj() or 0.
+  void setLocked(const std::vector<bool>& locked);
   /// The braked joints (model order, size nj(); all false unless setLocked says otherwise).
   const std::vector<bool>& locked() const { return locked_; }
 

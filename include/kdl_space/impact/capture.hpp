@@ -82,8 +82,10 @@ struct CaptureResult {
 
 /// \brief Solves the capture problem: both sides at their states (FloatingSide, RigidBodySide),
 /// the impulse from the law (collide), everything after. O(n) per free-floating side with
-/// ExIITMethod::Recursive. A set-up call: \throws InputError with a message that starts with the
-/// part concerned ("robot: ...", "target: ...", "target.contact: ...", "law: ...").
+/// ExIITMethod::Recursive. A set-up call: \throws InputError for the problem's own fields, or the
+/// ModelError of a side that refuses its state (FloatingSide, RigidBodySide), with a message
+/// that starts with the part concerned ("robot: ...", "target: ...", "target.contact: ...",
+/// "law: ...").
 KDL_SPACE_EXPORT CaptureResult solveCapture(const CaptureProblem& problem);
 
 /// \brief solveCapture for many problems of one robot (a study, a sweep): the robot's side, its
@@ -97,7 +99,7 @@ class KDL_SPACE_EXPORT CaptureSolver {
   CaptureSolver(const CaptureSolver&) = delete;
   CaptureSolver& operator=(const CaptureSolver&) = delete;
   /// \brief Solves `problem` (see solveCapture); the result stays valid until the next call.
-  /// \throws InputError as solveCapture.
+  /// \throws InputError or ModelError as solveCapture.
   const CaptureResult& solve(const CaptureProblem& problem);
 
  private:
@@ -113,7 +115,8 @@ class KDL_SPACE_EXPORT CaptureSolver {
 /// link (the target's inertia in that link's frame at the impact, result.contact_body_pose);
 /// after a point impact (frictional or not), the robot's own model, the same pointer (the target
 /// separates). A set-up call: \throws InputError ("law.type: ..." for a translational capture,
-/// "target.urdf: ..." for a free-floating target, "target: ..." if the merged model is refused).
+/// "target.urdf: ..." for a free-floating target), or the ModelError of the merged model
+/// ("target: cannot attach ...").
 KDL_SPACE_EXPORT std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
 
 }  // namespace kdl_space

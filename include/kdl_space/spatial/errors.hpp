@@ -1,23 +1,33 @@
 // Error codes of the compute calls (KDL::SolverI style; our own codes are <= -101) and the
-// exception thrown by constructors, loaders and set-up calls.
+// exceptions thrown by constructors, loaders and set-up calls.
 //
 // The rule, for every class and free function of the library:
 //  - Compute calls (everything called per state, per contact, per impulse or per step:
 //    FreeFloatingSolver's queries, RecursiveExIITSolver, ForwardDynamicsSolver::CartToJnt,
 //    Simulator::run / engageBrakes / energyAndMomentum, solveImpact, ImpactSide::applyImpulse,
-//    collide) never throw. They check the sizes of their inputs and outputs, the finiteness of
-//    their inputs and the range of their parameters, and return 0 (E_NOERROR) or one of the
-//    codes below. On an error their outputs are left untouched (Simulator::run documents its
-//    state argument). A result that overflows (finite inputs of absurd magnitude) is reported as
-//    E_NOT_FINITE, never returned.
-//  - Constructors, loaders and set-up calls (FloatingModel, loadUrdfFile/String, jointsByName,
-//    FloatingSide, RigidBodySide, Simulator and Simulator::setJointControl) throw ModelError with a
-//    message that names the file, the link or joint, and what is wrong: they run once, before
-//    any loop, and an object they cannot build must not exist.
+//    FloatingSide::reset, collide) never throw. They check the sizes of their inputs and outputs,
+//    the finiteness of their inputs and the range of their parameters, and return 0 (E_NOERROR) or
+//    one of the codes below. On an error their outputs are left untouched (Simulator::run
+//    documents its state argument). A result that overflows (finite inputs of absurd magnitude) is
+//    reported as E_NOT_FINITE, never returned.
+//  - Set-up calls throw and return nothing to check: constructors, loaders and the calls that
+//    configure an object before its compute calls (FloatingModel, loadUrdfFile/String,
+//    jointsByName, the solvers' setLocked and setGravity, FloatingSide, RigidBodySide, Simulator
+//    and its setJointControl / setLimitMode / setBaseControl / addWrench, loadScenario,
+//    solveCapture, loadStudy). They throw ModelError for a model or an object that cannot be
+//    built as asked (a URDF, a joint, a size, a value), and InputError for an input file or a
+//    field of a problem (a scenario's line and field, a capture problem's part); the message
+//    names the file, field, link or joint, and what is wrong. They run once, before any loop,
+//    and an object they cannot build must not exist.
+//  - Both derive from Error. An error keeps its kind on the way up: a caller that knows more (the
+//    scenario's file and field) puts it in front of the message with rethrowWithContext, which
+//    throws the same type again; nothing converts a ModelError into an InputError or back. A
+//    caller that reports both alike catches Error.
 // Callbacks that the caller hands to a compute call (Simulator's torque callback and observer)
 // are the caller's code: an exception they throw propagates unchanged.
 #pragma once
 
+#include <exception>
 #include <kdl/solveri.hpp>
 #include <stdexcept>
 #include <string>
@@ -28,7 +38,7 @@ namespace kdl_space {
 
 /// Return codes of compute calls. 0 and KDL's codes (e.g. KDL::SolverI::E_SIZE_MISMATCH = -4)
 /// keep their KDL meaning; ours start at -101.
-enum Error : int {
+enum ErrorCode : int {
   E_NOERROR = KDL::SolverI::E_NOERROR,
   E_SIZE_MISMATCH = KDL::SolverI::E_SIZE_MISMATCH,
   E_NOT_COMPUTED = -101,          ///< compute(state) has not succeeded yet
@@ -43,19 +53,44 @@ enum Error : int {
 /// Human-readable text of a return code.
 KDL_SPACE_EXPORT const char* strError(int code);
 
-/// Thrown by constructors, loaders and set-up calls when a model or an input cannot be used. The
-/// message names the file, the link or joint, and what is wrong.
-class KDL_SPACE_EXPORT ModelError : public std::runtime_error {
+/// \brief The base of the library's exceptions (ModelError, InputError): what a set-up call
+/// throws. Catch it to report both kinds alike; Python's kdl_space.Error is its binding.
+class KDL_SPACE_EXPORT Error : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  ~Error() override;
+  /// \brief Throws an error of this one's own type (ModelError stays ModelError) whose message is
+  /// `context` + what(): how a caller adds the file or field it knows, e.g.
+  /// `catch (const Error& e) { e.rethrowWithContext(path + ": "); }`.
+  [[noreturn]] void rethrowWithContext(const std::string& context) const;
+
+ protected:
+  /// An error of this one's own type with message `what` (each subclass says its type).
+  virtual std::exception_ptr renamed(const std::string& what) const;
 };
 
-/// Thrown by the scenario loader and the capture set-up when an input (a file, a field, a
-/// value) cannot be used: the message names the file, the field (e.g. "target.mass") and what
-/// is wrong.
-class KDL_SPACE_EXPORT InputError : public std::runtime_error {
+/// Thrown by constructors, loaders and set-up calls when a model or an object cannot be built as
+/// asked (a URDF, a joint, a size, a value). The message names the file, the link or joint, and
+/// what is wrong.
+class KDL_SPACE_EXPORT ModelError : public Error {
  public:
-  using std::runtime_error::runtime_error;
+  using Error::Error;
+  ~ModelError() override;
+
+ protected:
+  std::exception_ptr renamed(const std::string& what) const override;
+};
+
+/// Thrown by the scenario and study loaders and the capture set-up when an input (a file, a
+/// field, a value) cannot be used: the message names the file, the field (e.g. "target.mass")
+/// and what is wrong.
+class KDL_SPACE_EXPORT InputError : public Error {
+ public:
+  using Error::Error;
+  ~InputError() override;
+
+ protected:
+  std::exception_ptr renamed(const std::string& what) const override;
 };
 
 }  // namespace kdl_space

@@ -99,16 +99,21 @@ class KDL_SPACE_EXPORT StudyEvaluator {
   StudyEvaluator(const StudyEvaluator&) = delete;
   StudyEvaluator& operator=(const StudyEvaluator&) = delete;
   /// \brief Sample i's row into `row` (studyColumns().size() values). Never throws: a sample
-  /// that cannot be computed has its status (an Error code, or E_BAD_ARGUMENT for a set-up the
-  /// library refused) and NaN outcomes; its inputs are always filled.
+  /// that cannot be computed has its status (an error code, or E_BAD_ARGUMENT for a set-up the
+  /// library refused) and NaN outcomes, and failure() says why; its inputs are always filled.
   void evaluate(std::uint64_t i, double* row);
+  /// Why the last sample evaluated failed: the refusal's message (an Error's), or what could not
+  /// be computed and strError(status); empty if it computed.
+  const std::string& failure() const { return failure_; }
   std::size_t columns() const { return columns_; }
 
  private:
   struct Work;
+  void sample(std::uint64_t i, double* row);  ///< evaluate, but a set-up's refusal throws
   std::shared_ptr<const Study> study_;
   std::size_t columns_;
   std::unique_ptr<Work> work_;
+  std::string failure_;
 };
 
 /// A run of rows [begin, end) in chunks.
@@ -144,9 +149,20 @@ struct SampleDigest {
   double objective = 0.0;
   std::vector<std::pair<std::string, double>> inputs;
 };
+/// The samples of a table that failed with one status.
+struct StudyFailure {
+  int status = 0;                 ///< the table's status (an error code)
+  std::uint64_t count = 0;        ///< samples with this status
+  std::uint64_t first_sample = 0; ///< the smallest such sample index
+  /// Why first_sample failed: StudyEvaluator::failure() of that sample evaluated again (sample i
+  /// depends only on the seed and i, so the table's rows may come from any engine, shard or run).
+  std::string message;
+};
+
 /// What a whole table says.
 struct StudySummary {
   std::uint64_t samples = 0, failed = 0;
+  std::vector<StudyFailure> failures;  ///< one per distinct status, in the order of first_sample
   std::vector<OutcomeSummary> outcomes;
   /// Per limit column ("exceeds.base_rate", ..., "exceeds.any"): the fraction of computed
   /// samples that exceed it.
@@ -155,7 +171,9 @@ struct StudySummary {
 };
 
 /// \brief The summary of a table (rows x studyColumns(study), row-major, any order of samples).
-/// Quantiles interpolate linearly between order statistics.
+/// Quantiles interpolate linearly between order statistics. The message of each distinct failure
+/// comes from evaluating its first sample again in this process (one capture, and the motion
+/// after it, per distinct status; nothing when every sample computed).
 KDL_SPACE_EXPORT StudySummary summarizeStudy(const Study& study, const std::vector<double>& rows);
 
 }  // namespace kdl_space

@@ -90,10 +90,8 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
   try {
     checkInputFile(urdf_path, "URDF file");
     s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
-  } catch (const InputError& e) {
-    urdf.fail(e.what());
-  } catch (const ModelError& e) {
-    urdf.fail(e.what());
+  } catch (const Error& e) {  // the file unreadable (InputError) or its model broken (ModelError)
+    e.rethrowWithContext(urdf.where());
   }
   if (f.has("armature")) {  // rotor inertias, reflected: a number, or n^2 I_rotor
     std::vector<double> armature = s.model->armature();
@@ -186,8 +184,8 @@ RigidTarget rigidUrdfTarget(const Field& f, const FloatingSystem& t) {
   }
   try {
     return rigidSubtree(*t.model, t.state, body, t.velocity.base_twist);
-  } catch (const InputError& e) {
-    f.fail(e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(f.where());
   }
 }
 

@@ -44,11 +44,13 @@ std::string kindOf(const YAML::Node& node) {
 Field::Field(YAML::Node node, std::string path, const std::string* file)
     : node_(std::move(node)), path_(std::move(path)), file_(file) {}
 
-void Field::fail(const std::string& what) const {
+std::string Field::where() const {
   std::string where = *file_;
   if (node_.IsDefined() && node_.Mark().line >= 0) where += ":" + std::to_string(node_.Mark().line + 1);
-  throw InputError(where + ": " + (path_.empty() ? "" : path_ + ": ") + what);
+  return where + ": " + (path_.empty() ? "" : path_ + ": ");
 }
+
+void Field::fail(const std::string& what) const { throw InputError(where() + what); }
 
 bool Field::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
 

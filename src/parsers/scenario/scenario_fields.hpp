@@ -33,6 +33,9 @@ class Field {
 
   /// Throws InputError "FILE[:LINE]: PATH: what".
   [[noreturn]] void fail(const std::string& what) const;
+  /// "FILE[:LINE]: PATH: ", what fail() puts in front: the context a caller adds to an Error of
+  /// another part (a URDF's ModelError) that this field brought in (Error::rethrowWithContext).
+  std::string where() const;
   /// The key is present (with a value or without: at() reports "has no value").
   bool has(const std::string& key) const;
   /// The value of a required key ("missing (a required field)", "has no value").

@@ -190,8 +190,8 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
   try {
     return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics), std::move(mimic))
         .withJointProperties(properties(*model));
-  } catch (const ModelError& e) {
-    throw ModelError(source + ": " + e.what());
+  } catch (const Error& e) {
+    e.rethrowWithContext(source + ": ");
   }
 }
 

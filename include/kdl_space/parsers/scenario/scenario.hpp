@@ -59,7 +59,9 @@ struct Scenario {
 /// The joints a system's `locked:` list brakes at the impact are in its FloatingSystem::locked
 /// (`capture.robot.locked`: what a simulation keeps braked after the impact too).
 /// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
-/// be > 0 kg, got -3") for every problem, the file's own (missing, empty, not YAML) included.
+/// be > 0 kg, got -3") for every problem of the file, its own (missing, empty, not YAML)
+/// included; a URDF it names that loads no model is the loader's ModelError with the same
+/// "FILE:LINE: robot.urdf: " in front (catch Error for both).
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
 
 /// \brief The simulator as the scenario says, for `model` (the robot's, or the robot with a
