@@ -264,7 +264,7 @@ void bindSimulation(py::module_& m) {
       .def_static("from_scenario", &fromScenario, py::arg("scenario"), py::arg("model") = py::none(),
                   "The simulator as `kdl_space simulate` builds it from a scenario's simulation section (options, "
                   "joint controls, limits, base control, wrenches, the robot's brakes) for `model` (None: the robot's; "
-                  "after a capture: attach_target(scenario, result)). InputError naming the file.")
+                  "after a capture: attach_target(scenario, result)). kdl_space.Error (ModelError or InputError) naming the file.")
       .def_property_readonly("model", [](const PySimulator& w) { return w.model; }, "The Model it integrates.")
       .def_property_readonly("joint_names", [](const PySimulator& w) { return w.model.ptr->jointNames(); })
       .def_property_readonly("options", [](const PySimulator& w) {

@@ -556,10 +556,10 @@ TEST(SolverSetUp, SetLockedAndSetGravityThrowModelErrorNamingTheProblem) {
   const unsigned int n = model->nj();
   const std::string joints = "(joint1, joint2, joint3, joint4, joint5, joint6, joint7)";
   ForwardDynamicsSolver fd(model);
-  DenseForwardDynamics crb(model);
+  DenseForwardDynamicsSolver crb(model);
   expectModelError([&] { fd.setLocked(std::vector<bool>(n + 1)); }, "ForwardDynamicsSolver::setLocked: 8 braked-joint flags",
                    "a model of 7 joints; give one per joint, in the model's order " + joints);
-  expectModelError([&] { crb.setLocked({}); }, "DenseForwardDynamics::setLocked: 0 braked-joint flags", joints);
+  expectModelError([&] { crb.setLocked({}); }, "DenseForwardDynamicsSolver::setLocked: 0 braked-joint flags", joints);
   EXPECT_EQ(fd.locked(), std::vector<bool>(n, false)) << "unchanged after a refusal";
   // The impact solvers' brakes: size nj() or empty (none); a refusal keeps the locks.
   RecursiveExIITSolver recursive(model);
@@ -583,7 +583,7 @@ TEST(SolverSetUp, SetLockedAndSetGravityThrowModelErrorNamingTheProblem) {
   EXPECT_EQ(dense.locked(), std::vector<bool>(n, false)) << "empty: none";
   expectModelError([&] { fd.setGravity(Vector3d(0, 0, kNaN)); }, "ForwardDynamicsSolver::setGravity: the gravity (0, 0, nan)",
                    "is not finite");
-  expectModelError([&] { crb.setGravity(Vector3d(kInf, 0, 0)); }, "DenseForwardDynamics::setGravity: the gravity (inf, 0, 0)",
+  expectModelError([&] { crb.setGravity(Vector3d(kInf, 0, 0)); }, "DenseForwardDynamicsSolver::setGravity: the gravity (inf, 0, 0)",
                    "is not finite");
   EXPECT_EQ(fd.gravity(), Vector3d::Zero()) << "unchanged after a refusal";
   fd.setGravity(Vector3d(0, 0, -9.81));
