@@ -162,19 +162,22 @@ SceneSnapshot impactSnapshot(const Scenario& sc) {
   return s;
 }
 
+std::vector<InputFile> scenarioInputs(const Scenario& sc) {
+  return {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf}, {"the target's URDF", sc.target_urdf}};
+}
+
 void runCapture(const CaptureOptions& o, std::ostream& out) {
   // An output that cannot be written is refused before any work.
   if (!o.scene.empty()) {
     namespace fs = std::filesystem;
     sceneTerminal(o.scene);
     checkOutputFile(o.scene, "--scene");
-    std::error_code ec;
-    if (fs::equivalent(o.scene, o.scenario, ec))
-      throw UsageError("--scene " + o.scene + ": is the scenario file; it would be overwritten");
+    refuseOverwritingInputs("--scene", o.scene, {{"the scenario file", o.scenario}});
     if (std::system("command -v gnuplot >/dev/null 2>&1") != 0)
       throw InputError("--scene " + o.scene + ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
   }
   const Scenario sc = loadScenario(o.scenario);
+  refuseOverwritingInputs("--scene", o.scene, scenarioInputs(sc));
   if (!sc.impact)
     throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
   if (sc.approach)

@@ -31,6 +31,9 @@ auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
   }
 }
 
+/// The files a scenario makes a run read: the scenario, the robot's URDF, the target's URDF.
+std::vector<InputFile> scenarioInputs(const Scenario& scenario);
+
 /// The capture JSON object (the keys are a contract: see the README).
 Json captureJson(const Scenario& scenario, const CaptureResult& result);
 /// The readable summary.

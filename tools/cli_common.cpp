@@ -213,6 +213,20 @@ void checkOutputFile(const std::string& path, const std::string& option) {
   unlink(probe.c_str());
 }
 
+void refuseOverwritingInputs(const std::string& option, const std::string& path, const std::vector<InputFile>& inputs) {
+  if (path.empty()) return;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(path, ec);
+  for (const InputFile& in : inputs) {
+    if (in.path.empty()) continue;
+    std::error_code e1, e2;
+    const bool same_name = !ec && fs::weakly_canonical(in.path, e1) == out && !e1;
+    if (same_name || fs::equivalent(path, in.path, e2))
+      throw UsageError(option + " " + path + ": is " + in.what + (in.path == path ? "" : " " + in.path) +
+                       "; it would be overwritten: give the output another name");
+  }
+}
+
 AtomicFile::AtomicFile(std::string path, std::string option)
     : path_(std::move(path)), option_(std::move(option)) {
   // Same folder (the rename is atomic there), a name that says what it is.

@@ -91,6 +91,17 @@ CLI::Validator positiveNumber(); ///< a finite number > 0
 /// option (e.g. "--csv run.csv: the folder 'out' does not exist").
 void checkOutputFile(const std::string& path, const std::string& option);
 
+/// A file a run reads, with what it is for messages ("the scenario file", "the robot's URDF").
+struct InputFile {
+  std::string what, path;
+};
+
+/// \brief No output replaces an input: throws UsageError (exit 2, before any work) when the output
+/// `path` of `option` is one of `inputs`, by canonical path or as the same file (device and inode:
+/// a hard or symbolic link to it), naming both ("--csv a.urdf: is the robot's URDF
+/// robots/a.urdf; it would be overwritten").
+void refuseOverwritingInputs(const std::string& option, const std::string& path, const std::vector<InputFile>& inputs);
+
 /// \brief A file written under a temporary name in the same folder and renamed into place by
 /// commit(), so that a failed run never leaves a partial file that looks complete; the temporary
 /// is removed if the object is destroyed without a commit.

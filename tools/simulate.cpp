@@ -29,8 +29,7 @@ void checkOutputs(const SimulateOptions& o) {
   for (const auto& [option, path] : outputs) {
     if (path.empty()) continue;
     checkOutputFile(path, option);
-    if (fs::equivalent(path, o.scenario, ec))
-      throw UsageError(std::string(option) + " " + path + ": is the scenario file; it would be overwritten");
+    refuseOverwritingInputs(option, path, {{"the scenario file", o.scenario}});
     for (const auto& [other, other_path] : outputs)
       if (other != option && !other_path.empty() && (path == other_path || fs::equivalent(path, other_path, ec)))
         throw UsageError(std::string(option) + " and " + other + " name the same file " + path);
@@ -113,6 +112,8 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
 void runSimulate(const SimulateOptions& o, std::ostream& out) {
   checkOutputs(o);
   const Scenario sc = loadScenario(o.scenario);
+  for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}})
+    refuseOverwritingInputs(option, path, scenarioInputs(sc));  // the URDFs it names too
   OperationOptions options;
   options.duration = o.duration;
   options.keep_samples = !o.plot.empty();  // the plot draws them all; the CSV is written as they come

@@ -6,6 +6,7 @@
 #include <map>
 #include <thread>
 
+#include "capture.hpp"
 #include "plot_writer.hpp"
 #include "study_plot.hpp"
 #include "study_table.hpp"
@@ -154,12 +155,13 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   const std::pair<const char*, std::string> outputs[] = {
       {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}};
   std::error_code ec;
+  std::vector<InputFile> inputs = scenarioInputs(st.scenario);  // no output replaces what the run reads
+  inputs.push_back({"the study file", o.study});
+  for (const std::string& part : o.merge) inputs.push_back({"one of the parts merged", part});
   for (const auto& [option, path] : outputs) {
     if (path.empty()) continue;
     checkOutputFile(path, option);
-    if (fs::equivalent(path, o.study, ec)) throw UsageError(std::string(option) + " " + path + ": is the study file");
-    for (const std::string& part : o.merge)
-      if (fs::equivalent(path, part, ec)) throw UsageError(std::string(option) + " " + path + ": is one of the parts merged");
+    refuseOverwritingInputs(option, path, inputs);
   }
   if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");

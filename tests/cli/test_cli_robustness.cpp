@@ -412,7 +412,7 @@ TEST(CommandLines, UsageErrorsExitWith2) {
       {"simulate " + kValid + " --csv ''", 2, "kdl_space: --csv: the file name is empty\n" + kHint},
       {"simulate " + kValid + " --plot run.gif", 2, "kdl_space: --plot run.gif: the file name must end in .svg or .png\n"},
       {"simulate " + kValid + " --csv " + kValid, 2,
-       "kdl_space: --csv " + kValid + ": is the scenario file; it would be overwritten\n"},
+       "kdl_space: --csv " + kValid + ": is the scenario file; it would be overwritten: give the output another name\n"},
       {"inspect --urdf " + kTwolink, 2, "kdl_space: --tip is required\n" + kHint},
       {"inspect --tip hand", 2, "kdl_space: --urdf is required\n" + kHint},
       {"inspect --urdf " + kTwolink + " --tip hand --offset a b c", 2, "kdl_space: --offset: 'a' is not a number\n" + kHint},
@@ -447,6 +447,12 @@ TEST(CommandLines, UnusableInputsExitWith3) {
 
 class OutputFiles : public HostileFiles {
  protected:
+  static std::string file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+  }
   /// Files in the scratch folder whose name is not in `expected` (temporaries left behind).
   std::vector<std::string> strays(const std::set<std::string>& expected) const {
     std::vector<std::string> found;
@@ -483,6 +489,39 @@ TEST_F(OutputFiles, FoldersThatCannotTakeTheFileAreRefusedBeforeAnyWork) {
   });
   EXPECT_EQ(strays({"file.txt", "sub"}), std::vector<std::string>{});
   EXPECT_TRUE(fs::is_empty(sub));
+}
+
+TEST_F(OutputFiles, NoOutputReplacesAFileTheRunReads) {
+  // A copy of a scenario, its robot, a study of it, and links to them: the guard must hold (if it
+  // failed, only these copies would be lost).
+  const std::string urdf = write("robot.urdf", file(urdfDir() + "/spacedyn_twolink.urdf"));
+  std::string text = file(kValid);
+  text.replace(text.find("../reference/models/spacedyn_twolink.urdf"), std::string("../reference/models/spacedyn_twolink.urdf").size(),
+               "robot.urdf");
+  const std::string scenario = write("run.yaml", text);
+  const std::string study = write("study.yaml", "scenario: run.yaml\nsamples: 4\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n");
+  fs::create_symlink(urdf, dir / "link.urdf");
+  fs::create_hard_link(urdf, dir / "hard.urdf");
+  fs::create_hard_link(urdf, dir / "robot.svg");  // a picture's name, the robot's bytes
+  fs::create_directories(dir / "sub");
+  const std::string dotted = (dir / "sub" / ".." / "robot.urdf").string();
+  const std::string d = dir.string();
+  const std::string tail = "; it would be overwritten: give the output another name\n";
+  expectAll({
+      {"simulate " + scenario + " --csv " + urdf, 2, "kdl_space: --csv " + urdf + ": is the robot's URDF" + tail},
+      {"simulate " + scenario + " --csv " + d + "/link.urdf", 2,
+       "kdl_space: --csv " + d + "/link.urdf: is the robot's URDF " + urdf + tail},
+      {"simulate " + scenario + " --csv " + d + "/hard.urdf", 2,
+       "kdl_space: --csv " + d + "/hard.urdf: is the robot's URDF " + urdf + tail},
+      {"simulate " + scenario + " --csv " + dotted, 2, "kdl_space: --csv " + dotted + ": is the robot's URDF " + urdf + tail},
+      {"capture " + scenario + " --scene " + d + "/robot.svg", 2,
+       "kdl_space: --scene " + d + "/robot.svg: is the robot's URDF " + urdf + tail},
+      {"study " + study + " -o " + scenario, 2, "kdl_space: --table " + scenario + ": is the scenario file" + tail},
+      {"study " + study + " -o " + urdf, 2, "kdl_space: --table " + urdf + ": is the robot's URDF" + tail},
+      {"study " + study + " --summary " + study, 2, "kdl_space: --summary " + study + ": is the study file" + tail},
+  });
+  EXPECT_EQ(file(urdf), file(urdfDir() + "/spacedyn_twolink.urdf")) << "the robot is as it was";
+  EXPECT_EQ(file(scenario), text);
 }
 
 TEST_F(OutputFiles, ARunThatFailsMidwayLeavesNoFileAndKeepsAnOldOne) {
