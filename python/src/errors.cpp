@@ -1,5 +1,6 @@
 // The library's errors as Python exceptions (kdl_space.Error, the binding of kdl_space::Error, and
 // its subclasses ModelError, InputError, ComputeError with `.code`), and the NumPy conversions that name the argument.
+#include <cmath>
 #include <sstream>
 
 #include "conversions.hpp"
@@ -21,6 +22,12 @@ Eigen::MatrixXd fromNumpy(py::handle given, const char* name, long rows, long co
   const std::vector<long> expected = cols < 0 ? std::vector<long>{rows} : std::vector<long>{rows, cols};
   using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
   const py::object obj = fromPyKDL(given);
+  if (!obj.is_none()) {  // forcecast would drop an imaginary part without a word
+    const py::array as_given = py::array::ensure(obj);
+    if (as_given && as_given.dtype().kind() == 'c')
+      throw py::value_error(std::string(name) + ": expected real numbers, got a complex array");
+    PyErr_Clear();
+  }
   Array a;
   if (!obj.is_none()) a = Array::ensure(obj);
   if (obj.is_none() || !a) {  // a default array_t is an empty array, not a null one
@@ -66,6 +73,26 @@ KDL::Frame frameFromPython(py::handle given, const char* name) {
     }
   }
   const Eigen::MatrixXd T = fromNumpy(obj, name, 4, 4);
+  // A pose is a rotation and a position: anything else would give wrong results without a word.
+  // (Non-finite entries pass here: the compute calls answer them with E_NOT_FINITE.)
+  if (T.allFinite()) {
+    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const double orthonormal = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    const double det = R.determinant();
+    if (orthonormal > 1e-9 || std::abs(det - 1.0) > 1e-9) {
+      std::ostringstream why;
+      why << name << ": the upper-left 3x3 is no rotation: max |R^T R - I| = " << orthonormal << ", det R = " << det
+          << " (a rotation has R^T R = I and det R = +1, to 1e-9; a mirror or a scale is no pose)";
+      throw py::value_error(why.str());
+    }
+    const Eigen::RowVector4d last = T.row(3);
+    if ((last - Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)).cwiseAbs().maxCoeff() > 1e-9) {
+      std::ostringstream why;
+      why << name << ": the last row of a 4x4 pose is (0, 0, 0, 1), got (" << last(0) << ", " << last(1) << ", "
+          << last(2) << ", " << last(3) << ")";
+      throw py::value_error(why.str());
+    }
+  }
   KDL::Frame f;
   for (int i = 0; i < 3; ++i) {
     f.p(i) = T(i, 3);

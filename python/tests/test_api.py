@@ -95,6 +95,24 @@ def test_wrong_shapes_name_the_argument(arm, computed):
         kdl_space.State(arm, base_twist=np.zeros((2, 3)))
     with pytest.raises(ValueError, match=r"base_pose: expected shape \(4, 4\)"):
         kdl_space.State(arm, base_pose=np.eye(3))
+    # A pose is a rotation and a position: a matrix of ones, a scale or a mirror is refused, saying
+    # how far it is from a rotation; the last row is (0, 0, 0, 1); no complex numbers.
+    for T, far in ((np.ones((4, 4)), "3, det R = 0"), (np.diag([2.0, 2, 2, 1]), "3, det R = 8"),
+                   (np.diag([1.0, 1, -1, 1]), "0, det R = -1")):
+        with pytest.raises(ValueError, match=r"base_pose: the upper-left 3x3 is no rotation: max \|R\^T R - I\| = " + far):
+            kdl_space.State(arm, base_pose=T)
+    tilted = np.eye(4)
+    tilted[3, 0] = 0.5
+    with pytest.raises(ValueError, match=r"base_pose: the last row of a 4x4 pose is \(0, 0, 0, 1\), got \(0.5, 0, 0, 1\)"):
+        kdl_space.State(arm, base_pose=tilted)
+    with pytest.raises(ValueError, match="base_pose: expected real numbers, got a complex array"):
+        kdl_space.State(arm, base_pose=np.eye(4) + 0j)
+    with pytest.raises(ValueError, match="base_twist: expected real numbers, got a complex array"):
+        kdl_space.State(arm, base_twist=np.zeros(6, dtype=complex))
+    # A rotation to round-off is a rotation.
+    c, s_ = math.cos(0.3), math.sin(0.3)
+    R = np.array([[c, -s_, 0, 1], [s_, c, 0, 2], [0, 0, 1, 3], [0, 0, 0, 1]])
+    assert np.allclose(kdl_space.State(arm, base_pose=R).base_pose, R, atol=1e-15)
     with pytest.raises(ValueError, match=r"qdot: expected an array of numbers of shape \(7,\)"):
         kdl_space.State(arm, qdot="fast")
     with pytest.raises(ValueError, match=r"offset: expected shape \(3,\)"):
