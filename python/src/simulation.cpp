@@ -117,6 +117,8 @@ PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, 
     Vector6d h = Vector6d::Constant(std::nan(""));
     if (const int rc = w.sim->energyAndMomentum(x, T, h)) sample_rc = sample_rc ? sample_rc : rc;
     samples.add(x, T, h);
+    py::gil_scoped_acquire gil;  // Ctrl-C ends the run at the next output sample (a KeyboardInterrupt)
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   };
   int rc;
   {

@@ -392,3 +392,26 @@ def test_no_reference_leaks(arm):
     loop(3000)
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak < 8 * 1024
     assert (sys.getrefcount(arm), sys.getrefcount(controller), sys.getrefcount(state)) == refs
+
+
+def test_ctrl_c_ends_a_run_at_the_next_output_sample(arm):
+    """SIGINT during a long run without a controller (and during run_operation) raises
+    KeyboardInterrupt at the next output sample, not at the end of the run."""
+    import os
+    import signal
+    import threading
+    import time
+
+    sim = kdl_space.Simulator(arm, integrator="rk4", step=1e-3, max_steps=10**9)
+    state = kdl_space.State(arm, qdot=np.full(arm.nj, 0.1))
+    scenario = kdl_space.load_scenario(str(CAPTURE_SCENARIO))
+    for run in (lambda: sim.run(state, t_end=1e4, output_dt=0.01),  # some 40 s of CPU if not interrupted
+                lambda: kdl_space.run_operation(scenario, duration=4e4)):  # within its step budget
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        start = time.monotonic()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            run()
+        timer.join()
+        assert time.monotonic() - start < 10.0  # (a KeyboardInterrupt after the run would come too late)
+    assert len(sim.run(state, t_end=0.02, output_dt=0.01)) == 3  # usable after it
