@@ -32,7 +32,7 @@ ControlGrid controlGrid(double output_dt, double period) {
 
 int runSampled(Simulator& sim, SimulationState& s, double t_end, double output_dt, const SampledController& controller,
                double control_rate, const std::function<void(const SimulationState&)>& observer) {
-  const bool hold = control_rate != 0.0;
+  const bool hold = controller && control_rate != 0.0;  // a rate without a controller: nothing to hold
   const ControlGrid grid = controlGrid(output_dt, hold ? 1.0 / control_rate : 0.0);
   const double t0 = s.t;
   const Eigen::Index n = sim.model().nj();

@@ -95,6 +95,16 @@ TEST_F(SampledControl, FastHoldApproachesTheContinuousController) {
   EXPECT_LT(previous, 2e-3);
 }
 
+TEST_F(SampledControl, WithoutAControllerTheRateIsNotUsedAndTheRunIsPlain) {
+  Simulator sim(model);
+  SimulationState sampled = start, plain = start;
+  int seen = 0;
+  ASSERT_EQ(runSampled(sim, sampled, 0.5, 0.05, nullptr, 20.0, [&](const SimulationState&) { ++seen; }), 0);
+  ASSERT_EQ(sim.run(plain, 0.5, 0.05, nullptr), 0);
+  EXPECT_EQ(seen, 11);
+  EXPECT_EQ(sampled.state.q.data, plain.state.q.data);
+}
+
 TEST_F(SampledControl, ControllerOfTheWrongSizeEndsTheRun) {
   Simulator sim(model);
   SimulationState s = start;

@@ -29,7 +29,8 @@ struct ControlGrid {
 KDL_SPACE_EXPORT ControlGrid controlGrid(double output_dt, double period);
 
 /// \brief Runs `sim` from s to t_end with `controller` (may be empty: the joint modes alone) called
-/// at `control_rate` [Hz] with a zero-order hold, or at every evaluation when control_rate is 0.
+/// at `control_rate` [Hz] with a zero-order hold, or at every evaluation when control_rate is 0
+/// (without a controller the rate is not used).
 /// Its torques add to those of the joint modes. `observer` sees s.t, every multiple of output_dt
 /// after it and t_end, as Simulator::run's; at a control instant it sees the new command
 /// (Simulator::actuation). The simulator's torque callback is set for the run and cleared after it,
