@@ -162,6 +162,8 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   r.record.model = r.model;
   r.record.output_step = r.output_step;
   r.record.t_start = r.record.t_reached = t_capture;
+  if (o.observer)
+    for (const MotionSample& x : r.approach_samples) o.observer(r, x);
   if (!o.motion) return;
 
   std::unique_ptr<Simulator> simulator = operation::simulatorFor(sc, r.model, false);
@@ -173,8 +175,6 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   setModesAfter(sc, problem, r, o.hold_servos, sim);
   checkStart(sc, sim, s);
   const SimulationState start = s;
-  if (o.observer)
-    for (const MotionSample& x : r.approach_samples) o.observer(r, x);
   int observer_rc = E_NOERROR;
   const Phase phase = sc.impact ? Phase::Post : Phase::Motion;
   const bool spherical = r.joined && r.joined->grasp == GraspJoint::Spherical;
