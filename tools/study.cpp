@@ -1,5 +1,6 @@
 #include "study.hpp"
 
+#include <charconv>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -37,9 +38,19 @@ namespace {
 /// "i/N" -> rows [floor((i-1) S / N), floor(i S / N)).
 std::pair<std::uint64_t, std::uint64_t> shardRange(const std::string& text, std::uint64_t samples, std::uint64_t& i,
                                                    std::uint64_t& n) {
-  unsigned long long a = 0, b = 0;
-  char tail = 0;
-  if (std::sscanf(text.c_str(), "%llu/%llu%c", &a, &b, &tail) != 2 || text[0] == '-' || b == 0 || a < 1 || a > b)
+  // Whole numbers in full (from_chars: no sign, no saturation of one too large to hold).
+  const std::size_t slash = text.find('/');
+  std::uint64_t a = 0, b = 0;
+  const auto whole = [&](const char* from, const char* to, std::uint64_t& v) {
+    const auto [end, ec] = std::from_chars(from, to, v);
+    if (ec == std::errc::result_out_of_range)
+      throw UsageError("--shard " + text + ": " + std::string(from, to) + " is too large: at most " +
+                       std::to_string(samples) + " shards (the study's samples)");
+    return from != to && ec == std::errc() && end == to;
+  };
+  const char* begin = text.data();
+  if (slash == std::string::npos || !whole(begin, begin + slash, a) || !whole(begin + slash + 1, begin + text.size(), b) ||
+      b == 0 || a < 1 || a > b)
     throw UsageError("--shard " + text + ": expected i/N with 1 <= i <= N (e.g. 2/8)");
   if (b > samples)
     throw UsageError("--shard " + text + ": " + std::to_string(b) + " shards of " + std::to_string(samples) +

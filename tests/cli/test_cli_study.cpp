@@ -229,6 +229,11 @@ TEST(StudyCommand, BadInputsNameTheFieldAndWriteNothing) {
       {write("seed.yaml", head + "samples: 5\nseed: 0.5\ninputs: {timing: {uniform: [0, 1]}}\n"), "seed: must be a whole number", 3},
       {kGrasp + " --shard 0/3", "--shard 0/3: expected i/N with 1 <= i <= N", 2},
       {kGrasp + " --shard 4/3", "--shard 4/3: expected i/N", 2},
+      {kGrasp + " --shard 1/-3", "--shard 1/-3: expected i/N", 2},
+      {kGrasp + " --shard 1/3x", "--shard 1/3x: expected i/N", 2},
+      // One past what 64 bits hold: not read as 18446744073709551615 shards.
+      {kGrasp + " --shard 1/18446744073709551617",
+       "--shard 1/18446744073709551617: 18446744073709551617 is too large: at most 400 shards (the study's samples)", 2},
       {kGrasp + " --shard 1/3 --merge x.csv", "--shard and --merge", 2},
       {kGrasp + " --heat-map map.txt", "--heat-map map.txt: the file name must end in .svg or .png", 2},
   };
