@@ -21,6 +21,13 @@ inline std::string echo(const std::string& text) {
   return "'" + shown + (text.size() > 40 ? "...'" : "'");
 }
 
+/// A path as a message shows it: whole up to 80 characters, else its first 40 and last 36 around
+/// "..." (a field of megabytes named as a file must not become a message of megabytes).
+inline std::string shownPath(const std::string& path) {
+  if (path.size() <= 80) return path;
+  return path.substr(0, 40) + "..." + path.substr(path.size() - 36);
+}
+
 /// A number as a message shows it: 6 significant digits, the stream's default ("0.2", "1e+06").
 inline std::string number(double x) {
   std::ostringstream s;

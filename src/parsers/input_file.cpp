@@ -10,19 +10,22 @@
 #include <locale>
 #include <sstream>
 
+#include "detail/text.hpp"
+
 namespace kdl_space {
 
 void checkInputFile(const std::string& path, const std::string& kind) {
   namespace fs = std::filesystem;
+  const std::string shown = detail::shownPath(path);  // a path of megabytes is not a message of megabytes
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (ec || !fs::exists(status)) throw InputError(path + ": no such file");
-  if (fs::is_directory(status)) throw InputError(path + ": is a folder, not a " + kind);
+  if (ec || !fs::exists(status)) throw InputError(shown + ": no such file");
+  if (fs::is_directory(status)) throw InputError(shown + ": is a folder, not a " + kind);
   // A device, FIFO or socket could block or never end (/dev/zero): only regular files are read.
-  if (!fs::is_regular_file(status)) throw InputError(path + ": is not a regular file; expected a " + kind);
+  if (!fs::is_regular_file(status)) throw InputError(shown + ": is not a regular file; expected a " + kind);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file: " + std::strerror(errno));
-  if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(path + ": the file is empty; expected a " + kind);
+  if (!in) throw InputError(shown + ": cannot open the file: " + std::strerror(errno));
+  if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(shown + ": the file is empty; expected a " + kind);
 }
 
 NumberText readNumber(const std::string& text, double& value, bool space_before) {

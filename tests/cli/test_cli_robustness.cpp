@@ -356,6 +356,23 @@ TEST_F(HostileFiles, UrdfFilesThatAreNoUrdf) {
 
 // TinyXML descends once per nesting level and overflowed the stack at 200,000 levels: every
 // command that reads a URDF must refuse such a file with the loader's message.
+TEST_F(HostileFiles, AFieldOfMegabytesIsNotEchoedWhole) {
+  // A URDF path of a million characters: the message shows its start and its end, not all of it.
+  std::ifstream valid(kValid);
+  std::stringstream text;
+  text << valid.rdbuf();
+  std::string yaml = text.str();
+  const std::string huge(1000000, 'y');
+  yaml.replace(yaml.find("../reference/models/spacedyn_twolink.urdf"), std::string("../reference/models/spacedyn_twolink.urdf").size(), huge);
+  const std::string scenario = write("huge_field.yaml", yaml);
+  const ToolRun r = kdlSpace("capture " + scenario);
+  EXPECT_EQ(r.rc, 3) << r.err.substr(0, 300);
+  EXPECT_LT(r.err.size(), 400u) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find("robot.urdf: "), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find("yyyy...yyyy"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find(": no such file"), std::string::npos) << r.err.substr(0, 300);
+}
+
 TEST_F(HostileFiles, DeeplyNestedUrdfIsRefusedByEveryCommand) {
   std::string xml = "<robot name=\"deep\">";
   for (int i = 0; i < 200000; ++i) xml += "<a>";
