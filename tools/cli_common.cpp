@@ -1,5 +1,7 @@
 #include "cli_common.hpp"
 
+#include <csignal>
+
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
 #include <unistd.h>
@@ -226,6 +228,23 @@ void refuseOverwritingInputs(const std::string& option, const std::string& path,
                        "; it would be overwritten: give the output another name");
   }
 }
+
+namespace {
+std::atomic<bool> interrupt_flag{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the flag is set from a signal handler");
+
+extern "C" void onInterrupt(int signal) {
+  interrupt_flag.store(true);
+  std::signal(signal, SIG_DFL);  // a second Ctrl-C ends the process at once
+}
+}  // namespace
+
+void installInterruptHandler() {
+  std::signal(SIGINT, onInterrupt);
+  std::signal(SIGTERM, onInterrupt);
+}
+
+const std::atomic<bool>& interruptFlag() { return interrupt_flag; }
 
 AtomicFile::AtomicFile(std::string path, std::string option)
     : path_(std::move(path)), option_(std::move(option)) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <stdexcept>
@@ -19,8 +20,20 @@ class Validator;
 
 namespace kdl_space::cli {
 
-/// Exit codes of every subcommand.
-enum Exit : int { kOk = 0, kUsage = 2, kUnusable = 3 };
+/// Exit codes of every subcommand (kInterrupted: 128 + SIGINT, as a shell reports Ctrl-C).
+enum Exit : int { kOk = 0, kUsage = 2, kUnusable = 3, kInterrupted = 130 };
+
+/// \brief Ctrl-C (SIGINT) and SIGTERM set interruptFlag(), which the long runs poll (a study
+/// between samples, a simulation between steps) to stop within a fraction of a second and leave
+/// what they promised; a second signal ends the process at once (the default action). Installed
+/// once by main().
+void installInterruptHandler();
+/// True once SIGINT or SIGTERM has arrived (lock-free: safe to set from a signal handler).
+const std::atomic<bool>& interruptFlag();
+/// A run stopped by interruptFlag(): main() prints its message and exits kInterrupted.
+struct Interrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// A command-line mistake (exit 2).
 struct UsageError : std::runtime_error {

@@ -1,5 +1,5 @@
 // kdl_space: command-line tool. Parses, calls the library, prints. Exit codes: 0 success,
-// 2 usage error, 3 the model or an input cannot be used.
+// 2 usage error, 3 the model or an input cannot be used, 130 interrupted (Ctrl-C, SIGTERM).
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
     std::cerr << "kdl_space: " << what << "\n(run 'kdl_space --help' or 'kdl_space <command> --help')\n";
     return kUsage;
   }
+  installInterruptHandler();
   try {
     if (inspect->parsed()) runInspect(*inspect, inspect_options, std::cout);
     if (capture->parsed()) runCapture(capture_options, std::cout);
@@ -53,6 +54,9 @@ int main(int argc, char** argv) {
       return kUnusable;
     }
     return rc;
+  } catch (const Interrupted& e) {
+    std::cerr << "kdl_space: interrupted: " << e.what() << "\n";
+    return kInterrupted;
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";
     return kUsage;
