@@ -68,8 +68,69 @@ def _count(value, name, low):
     return int(value)
 
 
+def _probe(scheduler, timeout):
+    """What answers at `scheduler` (a tcp:// or tls:// address), found within `timeout` seconds
+    without creating a Client (a Client that fails to start hangs the interpreter's exit for
+    seconds): None if a Dask scheduler, else why not, as a sentence."""
+    import asyncio
+    import socket
+    import time
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    try:
+        scheme, location = parse_address(scheduler, strict=True)
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError) as e:
+        return f"is no scheduler address ({e}): expected tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786"
+    if scheme not in ("tcp", "tls"):
+        return None  # inproc://, ucx://...: the Client tells
+    start = time.monotonic()
+    try:
+        socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except socket.gaierror as e:
+        return f"cannot resolve the host {host!r} ({e.strerror}): check the name"
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except ConnectionRefusedError:
+        return (f"the connection was refused: nothing listens at {host}:{port} (start the scheduler, "
+                "`dask scheduler`, or check the port: 8786 by default)")
+    except socket.timeout:
+        return f"no answer within {timeout:g} s (a firewall, or the wrong host?)"
+    except OSError as e:
+        return f"cannot connect ({e.strerror or e})"
+    left = max(timeout - (time.monotonic() - start), 0.1)
+
+    async def handshake():
+        comm = await connect(scheduler, timeout=left)
+        try:
+            await comm.write({"op": "identity"})
+            return await asyncio.wait_for(comm.read(), left)
+        finally:
+            comm.abort()
+
+    t0 = time.monotonic()
+    try:
+        reply = asyncio.run(handshake())
+    except (OSError, asyncio.TimeoutError, EOFError, ValueError, TypeError) as e:
+        took = time.monotonic() - t0
+        if took < 0.9 * left:  # it answered, and not as Dask does
+            return (f"something answers at {host}:{port}, but not a Dask scheduler (the handshake failed "
+                    f"after {took:.1f} s: {type(e).__name__}): check the address and port")
+        return f"the connection opened, but no Dask handshake within {timeout:g} s (a busy or hung scheduler?)"
+    except Exception as e:  # a reply that does not even decode: garbage
+        return (f"something answers at {host}:{port}, but not a Dask scheduler ({type(e).__name__}: {e}): "
+                "check the address and port")
+    if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
+        what = reply.get("type") if isinstance(reply, dict) else type(reply).__name__
+        return f"a Dask {what}, not a scheduler, answers there: give the scheduler's address"
+    return None
+
+
 def _connect(scheduler, timeout):
     from dask.distributed import Client
+    why = _probe(scheduler, timeout)
+    if why is not None:
+        raise InputError(f"scheduler {scheduler}: {why}")
     try:
         return Client(scheduler, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError) as e:  # asyncio/ distributed timeouts are OSError or TimeoutError
@@ -117,7 +178,9 @@ def study(study, *, engine="threads", threads=0, client=None, scheduler=None, ch
     engine: ``"threads"``: the C++ engine on this process's threads (``threads``; 0: all cores).
       ``"dask"``: chunks of samples as tasks on a ``dask.distributed`` cluster, gathered in order:
       ``client`` (a ``dask.distributed.Client``, left open), or ``scheduler`` (its address, e.g.
-      ``"tcp://10.0.0.5:8786"``: connected within ``timeout`` seconds, else InputError naming it),
+      ``"tcp://10.0.0.5:8786"``: connected within ``timeout`` seconds, else InputError naming it and
+      what happened: refused, a host with no address, something that is no Dask scheduler, no
+      handshake in time, a malformed address),
       or neither: a ``LocalCluster`` of ``threads`` (0: all cores) single-threaded workers in this
       process, started and closed by the call. The workers load the study from its absolute path:
       they need the same files at the same path (a shared file system).
