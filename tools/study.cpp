@@ -3,6 +3,8 @@
 #include <charconv>
 #include <chrono>
 #include <filesystem>
+#include <functional>
+#include <iostream>
 #include <iomanip>
 #include <map>
 #include <thread>
@@ -106,17 +108,32 @@ void printSummary(std::ostream& out, const Study& st, const StudySummary& s, con
   list("worst (largest)", s.worst);
 }
 
-/// The whole table from parts that must cover [0, samples) once.
-std::vector<double> mergeParts(const std::vector<std::string>& paths, const Study& st, const std::vector<std::string>& columns) {
-  std::map<std::uint64_t, std::pair<StudyPart, std::string>> by_begin;
+/// Called with each row of the table as it is written (sample order).
+using RowSink = std::function<void(const std::vector<double>& row)>;
+
+/// Copies a part's rows (each checked) into the table and the sink; Ctrl-C stops it (the table's
+/// temporary is removed, what is on disk stays).
+void appendPart(StudyPartReader& part, StudyTableWriter& table, const RowSink& sink, const std::string& stopped) {
+  std::uint64_t n = 0;
+  while (part.next()) {
+    table.addLine(part.line());
+    sink(part.row());
+    if ((++n & 1023u) == 0 && interruptFlag()) throw Interrupted(stopped);
+  }
+  if (interruptFlag()) throw Interrupted(stopped);
+}
+
+/// `--merge`: the table from parts that must cover [0, samples) once, read in the order of their
+/// rows (their head lines first, to check that they cover it), each row checked as it is copied.
+std::string mergeParts(const std::vector<std::string>& paths, const std::string& table, const Study& st,
+                       const std::vector<std::string>& columns, const RowSink& sink) {
+  std::map<std::uint64_t, std::pair<std::uint64_t, std::string>> by_begin;  // begin -> end, path
   for (const std::string& p : paths) {
-    StudyPart part = readStudyPart(p, st, columns);
-    const std::uint64_t b = part.begin;
-    if (!by_begin.emplace(b, std::make_pair(std::move(part), p)).second)
+    const StudyPartReader part(p, st, columns);
+    const std::uint64_t b = part.begin();
+    if (!by_begin.emplace(b, std::make_pair(part.end(), p)).second)
       throw InputError("--merge: " + p + " and " + by_begin[b].second + " both hold the rows from " + std::to_string(b));
   }
-  std::vector<double> rows;
-  rows.reserve(static_cast<std::size_t>(st.samples) * columns.size());
   std::uint64_t next = 0;
   for (const auto& [b, entry] : by_begin) {
     if (b != next)
@@ -124,12 +141,91 @@ std::vector<double> mergeParts(const std::vector<std::string>& paths, const Stud
                                                                 ") are also in another part"
                                                           : "rows " + std::to_string(next) + "-" + std::to_string(b) +
                                                                 " are in no part (a shard is missing)"));
-    rows.insert(rows.end(), entry.first.rows.begin(), entry.first.rows.end());
-    next = entry.first.end;
+    next = entry.first;
   }
   if (next != st.samples)
     throw InputError("--merge: rows " + std::to_string(next) + "-" + std::to_string(st.samples) + " are in no part (a shard is missing)");
-  return rows;
+  StudyTableWriter out(table, "--table", st, columns, 0, st.samples);
+  for (const auto& [b, entry] : by_begin) {
+    StudyPartReader part(entry.second, st, columns);
+    appendPart(part, out, sink, "interrupted while merging into " + table + ": nothing written; run the same command again");
+  }
+  out.commit();
+  return std::to_string(paths.size()) + " parts merged";
+}
+
+/// Whether `path` is a complete part of rows [begin, end) of this study (every row and the
+/// checksum read and checked).
+bool wholePart(const std::string& path, const Study& st, const std::vector<std::string>& columns, std::uint64_t begin,
+               std::uint64_t end) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  try {
+    StudyPartReader part(path, st, columns);
+    if (part.begin() != begin || part.end() != end) return false;
+    while (part.next()) {
+    }
+    return true;
+  } catch (const InputError&) {  // cut short, changed, or of another version of the study
+    return false;
+  }
+}
+
+/// Rows [begin, end) computed in chunks kept in TABLE.parts/ (those already there, of an
+/// interrupted run, are used), then the table: the chunks concatenated in order, each checked.
+std::string computeTable(const std::shared_ptr<const Study>& study, const StudyOptions& o, const std::string& table,
+                         std::uint64_t begin, std::uint64_t end, const std::vector<std::string>& columns,
+                         const RowSink& sink) {
+  const Study& st = *study;
+  const fs::path parts = table + ".parts";
+  std::error_code ec;
+  if (fs::is_directory(parts, ec) && wholePart(table, st, columns, begin, end)) {
+    // A run killed while it removed its chunks: the table was already whole.
+    StudyPartReader whole(table, st, columns);
+    while (whole.next()) sink(whole.row());
+    fs::remove_all(parts, ec);
+    return "the table was whole; the chunks a stopped run left in " + parts.string() + " removed";
+  }
+  const std::uint64_t chunk = o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
+  const std::vector<StudyChunk> chunks = studyChunks(begin, end, chunk);
+  const auto chunkFile = [&](const StudyChunk& c) {
+    return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
+  };
+  std::vector<StudyChunk> todo;
+  for (const StudyChunk& c : chunks)
+    if (!wholePart(chunkFile(c), st, columns, c.begin, c.end)) todo.push_back(c);
+  fs::create_directories(parts, ec);
+  if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
+  const auto t0 = std::chrono::steady_clock::now();
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::uint64_t kept = chunks.size() - todo.size(), computed = 0;
+  kdl_space::runStudy(
+      study, todo, threads,
+      [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
+        writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
+        ++kept;
+        computed += c.end - c.begin;
+      },
+      &interruptFlag());
+  const std::string resume = std::to_string(kept) + " of " + std::to_string(chunks.size()) + " chunks kept in " +
+                             parts.string() + "; run the same command again to resume";
+  if (interruptFlag()) throw Interrupted(resume);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  StudyTableWriter out(table, "--table", st, columns, begin, end);
+  for (const StudyChunk& c : chunks) {
+    StudyPartReader part(chunkFile(c), st, columns);
+    if (part.begin() != c.begin || part.end() != c.end)
+      throw InputError(chunkFile(c) + ": holds rows " + std::to_string(part.begin()) + "-" + std::to_string(part.end()) +
+                       ", not those its name says; remove it and run the same command again");
+    appendPart(part, out, sink, "interrupted while writing " + table + ": " + resume);
+  }
+  out.commit();
+  fs::remove_all(parts, ec);
+  std::ostringstream h;
+  h << computed << " computed on " << threads << " thread" << (threads > 1 ? "s" : "") << " in " << std::setprecision(3)
+    << seconds << " s";
+  if (computed < end - begin) h << ", " << (end - begin - computed) << " resumed from " << parts.string();
+  return h.str();
 }
 
 }  // namespace
@@ -177,52 +273,16 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 
+  // Until the summary streams: the rows, gathered as the table is written.
   std::vector<double> rows;
+  const RowSink sink = [&](const std::vector<double>& row) { rows.insert(rows.end(), row.begin(), row.end()); };
   std::string how;
-  if (!o.merge.empty()) {
-    rows = mergeParts(o.merge, st, columns);
-    how = std::to_string(o.merge.size()) + " parts merged";
-  } else {
-    // Chunks already on disk (an interrupted run of this study) are kept; the rest computed.
-    const fs::path parts = table + ".parts";
-    const std::uint64_t chunk = o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
-    const std::vector<StudyChunk> chunks = studyChunks(begin, end, chunk);
-    const std::size_t m = columns.size();
-    rows.assign(static_cast<std::size_t>(end - begin) * m, 0.0);
-    const auto chunkFile = [&](const StudyChunk& c) {
-      return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
-    };
-    std::vector<StudyChunk> todo;
-    for (const StudyChunk& c : chunks) {
-      if (fs::exists(chunkFile(c), ec)) {
-        try {
-          const StudyPart p = readStudyPart(chunkFile(c), st, columns);
-          std::copy(p.rows.begin(), p.rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
-          continue;
-        } catch (const InputError&) {  // cut short, or of another version of the study: computed again
-        }
-      }
-      todo.push_back(c);
-    }
-    fs::create_directories(parts, ec);
-    if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
-    const auto t0 = std::chrono::steady_clock::now();
-    const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-    kdl_space::runStudy(study, todo, threads, [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
-      writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
-      std::copy(chunk_rows.begin(), chunk_rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
-    });
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::uint64_t computed = 0;
-    for (const StudyChunk& c : todo) computed += c.end - c.begin;
-    std::ostringstream h;
-    h << computed << " computed on " << threads << " thread" << (threads > 1 ? "s" : "") << " in " << std::setprecision(3)
-      << seconds << " s";
-    if (computed < end - begin) h << ", " << (end - begin - computed) << " resumed from " << parts.string();
-    how = h.str();
+  {
+    const TableLock lock(table, std::cerr);  // no second run on this table until this one ends
+    removeStaleTemporaries(table, table + ".parts");
+    how = o.merge.empty() ? computeTable(study, o, table, begin, end, columns, sink)
+                          : mergeParts(o.merge, table, st, columns, sink);
   }
-  writeStudyPart(table, "--table", st, columns, begin, end, rows.data());
-  if (o.merge.empty()) fs::remove_all(table + ".parts", ec);
 
   if (shard_n) {  // a part: its rows only; the summary is the merged table's
     out << st.file << ": shard " << shard_i << "/" << shard_n << ", samples " << begin << "-" << end << " (" << how

@@ -11,6 +11,7 @@ import struct
 import subprocess
 import threading
 import time
+import zlib
 
 import numpy as np
 import pytest
@@ -43,7 +44,7 @@ def read_table(path):
     """A table the tool wrote: (first line, columns, rows as float64)."""
     with open(path) as f:
         head, header = f.readline().rstrip("\n"), f.readline().rstrip("\n").split(",")
-        rows = [[float(x) for x in line.rstrip("\n").split(",")] for line in f]
+        rows = [[float(x) for x in line.rstrip("\n").split(",")] for line in f if not line.startswith("# end;")]
     return head, header, np.array(rows, dtype=np.float64).reshape(len(rows), len(header))
 
 
@@ -160,6 +161,26 @@ def test_to_csv_is_the_tool_table(small, small_tool, grasp_tool, tmp_path):
         r.to_csv(tmp_path / "mine.csv")
         assert (tmp_path / "mine.csv").read_bytes() == table.read_bytes()
     assert sorted(os.listdir(tmp_path)) == ["mine.csv"]
+
+
+def test_to_csv_ends_with_the_crc32_the_tool_checks(cli, small, small_tool, tmp_path):
+    # The last line: the rows again and the CRC-32 of the row lines' bytes; a table from to_csv
+    # merges as a part (the tool reads and checks it), and one with a digit changed is refused.
+    r = kdl_space.study(str(small), threads=2)
+    r.to_csv(tmp_path / "mine.csv")
+    data = (tmp_path / "mine.csv").read_bytes()
+    lines = data.split(b"\n")
+    assert lines[-1] == b"" and lines[-2] == b"# end; rows 0-60; crc32 %08x" % zlib.crc32(b"".join(l + b"\n" for l in lines[2:-2]))
+    run_cli(cli, small, "--merge", tmp_path / "mine.csv", "-o", tmp_path / "merged.csv", cwd=tmp_path)
+    assert (tmp_path / "merged.csv").read_bytes() == small_tool[0].read_bytes()
+    at = data.index(b",", data.index(b"\n3,") + 4) + 3  # a digit of sample 3's first input
+    changed = data[:at] + (b"1" if data[at:at + 1] != b"1" else b"2") + data[at + 1:]
+    (tmp_path / "changed.csv").write_bytes(changed)
+    with pytest.raises(subprocess.CalledProcessError) as e:
+        run_cli(cli, small, "--merge", tmp_path / "changed.csv", "-o", tmp_path / "never.csv", cwd=tmp_path)
+    assert e.value.returncode == 3
+    assert f"{tmp_path / 'changed.csv'}:63: the rows' checksum is " in e.value.stderr
+    assert not (tmp_path / "never.csv").exists()
 
 
 def test_to_csv_formats_doubles_as_c_does():
