@@ -301,12 +301,12 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   }
   if (!o.plot.empty()) {
     AtomicFile f(o.plot, "--plot");
-    writeStudyHistograms(f, st, columns, rows);
+    writeStudyHistograms(f, st, columns, table, summary);
     f.commit();
   }
   if (!o.heat_map.empty()) {
     AtomicFile f(o.heat_map, "--heat-map");
-    writeStudyHeatMap(f, st, columns, rows);
+    writeStudyHeatMap(f, st, columns, table);
     f.commit();
   }
   if (o.json) {

@@ -141,18 +141,20 @@ StudyPartReader::StudyPartReader(const std::string& path, const Study& study, co
   unsigned long long b = 0, e = 0;
   if (!readLine() ||
       std::sscanf(line_.c_str(), "# kdl_space study; fingerprint %*16[0-9a-f]; samples %*u; rows %llu-%llu", &b, &e) != 2)
-    fail("is no table written by kdl_space study (its first line is not '# kdl_space study; ...')");
+    failFile("is no table written by kdl_space study (its first line is not '# kdl_space study; ...')");
   begin_ = b, end_ = e, expected_ = b;
   if (line_ != headLine(study, begin_, end_) || end_ > study.samples || begin_ > end_)
-    fail("holds rows of another study, or of another version of its files (" + line_.substr(2) +
+    failFile("holds rows of another study, or of another version of its files (" + line_.substr(2) +
          "; this study: " + headLine(study, 0, study.samples).substr(2) + ")");
-  if (!readLine() || line_ != joined(columns)) fail("its columns are not this study's");
+  if (!readLine() || line_ != joined(columns)) failFile("its columns are not this study's");
   row_.resize(columns_);
 }
 
 void StudyPartReader::fail(const std::string& why) const {
   throw InputError(path_ + (line_no_ > 0 ? ":" + std::to_string(line_no_) : std::string()) + ": " + why);
 }
+
+void StudyPartReader::failFile(const std::string& why) const { throw InputError(path_ + ": " + why); }
 
 bool StudyPartReader::readLine() {
   if (!std::getline(in_, line_)) return false;
@@ -164,12 +166,11 @@ bool StudyPartReader::readLine() {
 bool StudyPartReader::next() {
   if (done_) return false;
   if (!readLine()) {
-    line_no_ = 0;
     if (expected_ == end_)
-      fail("has no last line with the checksum of its rows ('# end; rows " + std::to_string(begin_) + "-" +
+      failFile("has no last line with the checksum of its rows ('# end; rows " + std::to_string(begin_) + "-" +
            std::to_string(end_) + "; crc32 ...'): it was cut short, or written by an older kdl_space, which wrote "
            "none; compute it again (or merge it with that older version)");
-    fail("is incomplete: rows " + std::to_string(begin_) + "-" + std::to_string(end_) + " announced, " +
+    failFile("is incomplete: rows " + std::to_string(begin_) + "-" + std::to_string(end_) + " announced, " +
          std::to_string(expected_ - begin_) + " found (cut short: compute it again)");
   }
   if (line_.rfind("# end;", 0) == 0) {

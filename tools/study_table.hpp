@@ -77,7 +77,8 @@ class StudyPartReader {
   const std::string& path() const { return path_; }
 
  private:
-  [[noreturn]] void fail(const std::string& why) const;
+  [[noreturn]] void fail(const std::string& why) const;      ///< "PATH:LINE: why"
+  [[noreturn]] void failFile(const std::string& why) const;  ///< "PATH: why"
   bool readLine();
   void checkRow();
   void checkEnd();
