@@ -42,7 +42,7 @@ class ExactSum {
 /// level h moves the rank of any value by at most 2^h, so rankError(), their sum, bounds the
 /// error of any rank: it is at most n/kFirst + n/kLevel per level above 0, i.e. a fraction
 /// 1/65536 + floor(log2(n/16384))/16384 of n (under 0.1 % for 1e9 values). Memory: kFirst +
-/// kLevel per level values, 2.6 MB at 1e9 values. Which values are kept depends only on the
+/// kLevel per level values, 2.2 MB at 1e9 values. Which values are kept depends only on the
 /// values and the order of add() and merge(), never on how the values were cut into blocks.
 class QuantileSketch {
  public:

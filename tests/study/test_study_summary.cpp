@@ -258,11 +258,11 @@ TEST(StudyRun, AGridOfChunksSkipsWhatItIsToldAndEqualsTheListOfChunks) {
 }
 
 TEST(StudyRun, ACancelStopsAChunkWithinASample) {
-  // One chunk of 65,536 samples, the largest of the default grid (about 17 s on one thread):
-  // cancelled after 100 ms.
+  // One chunk of 2,000 samples, each a capture and half a second of motion after it (about 13 s
+  // on one thread): cancelled after 100 ms.
   const auto st = std::make_shared<const Study>(loadStudy(studyFile("long.yaml",
       "scenario: " + kScenarios + "tumbling_box_capture.yaml\nsamples: 1000000\nseed: 1\n"
-      "inputs: {timing: {uniform: [0, 3]}, robot.q.joint2: {uniform: [0.5, 0.9]}}\n")));
+      "inputs: {timing: {uniform: [0, 3]}, robot.q.joint2: {uniform: [0.5, 0.9]}}\nmotion: {duration: 0.5}\n")));
   using Clock = std::chrono::steady_clock;
   std::atomic<bool> cancel{false};
   Clock::time_point cancelled;
@@ -272,7 +272,7 @@ TEST(StudyRun, ACancelStopsAChunkWithinASample) {
     cancel = true;
   });
   int reports = 0;
-  runStudy(st, StudyGrid{0, 65536, 65536}, 1, [&](const StudyChunk&, const std::vector<double>&) { ++reports; },
+  runStudy(st, StudyGrid{0, 2000, 2000}, 1, [&](const StudyChunk&, const std::vector<double>&) { ++reports; },
            &cancel);
   const double latency = std::chrono::duration<double>(Clock::now() - cancelled).count();
   canceller.join();

@@ -193,7 +193,7 @@ struct StudySummary {
 };
 
 /// \brief A study's summary from its rows fed a block at a time, in memory that does not grow
-/// with the number of rows (about 2.6 MB per outcome at 1e9 rows: a quantile sketch each, see
+/// with the number of rows (about 2.2 MB per outcome at 1e9 rows: a quantile sketch each, see
 /// quantile_rank_error): min, max, mean, probabilities, failures, best and worst are exact. The
 /// result does not depend on how the rows were cut into blocks, nor on their order except for
 /// inexact quantiles (fed in the same order, the same summary, bit for bit). Summarizers of
