@@ -94,6 +94,9 @@ void printSummary(std::ostream& out, const Study& st, const StudySummary& s, con
     for (const double v : {o.min, o.q05, o.q25, o.median, o.q75, o.q95, o.max}) out << std::setw(12) << v;
     out << "\n";
   }
+  if (s.quantile_rank_error > 0.0)
+    out << "(quantiles from a streaming sketch: each within a rank of +-" << s.quantile_rank_error
+        << " of the computed samples of the exact one)\n";
   if (!s.probabilities.empty()) out << "\n";
   for (const auto& [name, p] : s.probabilities) out << "P(" << name << ") = " << p << "\n";
   const auto list = [&](const char* title, const std::vector<SampleDigest>& ds) {
@@ -171,6 +174,18 @@ bool wholePart(const std::string& path, const Study& st, const std::vector<std::
   }
 }
 
+/// The most chunk files a run keeps in TABLE.parts/ (a folder of more is slow to list and to remove).
+constexpr std::uint64_t kMaxChunks = 1000000;
+
+std::uint64_t chunkSize(const StudyOptions& o, const Study& st) {
+  return o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
+}
+
+/// The chunks of the grid that meet [begin, end).
+std::uint64_t chunkCount(const StudyGrid& g) {
+  return g.end == g.begin ? 0 : (g.end + g.chunk_size - 1) / g.chunk_size - g.begin / g.chunk_size;
+}
+
 /// Rows [begin, end) computed in chunks kept in TABLE.parts/ (those already there, of an
 /// interrupted run, are used), then the table: the chunks concatenated in order, each checked.
 std::string computeTable(const std::shared_ptr<const Study>& study, const StudyOptions& o, const std::string& table,
@@ -186,33 +201,41 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
     fs::remove_all(parts, ec);
     return "the table was whole; the chunks a stopped run left in " + parts.string() + " removed";
   }
-  const std::uint64_t chunk = o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
-  const std::vector<StudyChunk> chunks = studyChunks(begin, end, chunk);
+  // The grid of chunks, generated as they are needed (nothing here grows with their number):
+  // chunk k holds rows [k c, (k + 1) c) cut to [begin, end).
+  const StudyGrid grid{begin, end, chunkSize(o, st)};
+  const std::uint64_t first = begin / grid.chunk_size, count = chunkCount(grid);
+  const auto chunkAt = [&](std::uint64_t k) {
+    return StudyChunk{std::max(begin, (first + k) * grid.chunk_size), std::min(end, (first + k + 1) * grid.chunk_size)};
+  };
   const auto chunkFile = [&](const StudyChunk& c) {
     return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
   };
-  std::vector<StudyChunk> todo;
-  for (const StudyChunk& c : chunks)
-    if (!wholePart(chunkFile(c), st, columns, c.begin, c.end)) todo.push_back(c);
   fs::create_directories(parts, ec);
   if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
   const auto t0 = std::chrono::steady_clock::now();
   const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  std::uint64_t kept = chunks.size() - todo.size(), computed = 0;
+  std::uint64_t kept = 0, computed = 0;
   kdl_space::runStudy(
-      study, todo, threads,
+      study, grid, threads,
       [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
         writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
         ++kept;
         computed += c.end - c.begin;
       },
-      &interruptFlag());
-  const std::string resume = std::to_string(kept) + " of " + std::to_string(chunks.size()) + " chunks kept in " +
+      &interruptFlag(),
+      [&](const StudyChunk& c) {  // a chunk already on disk, whole (of an interrupted run)
+        const bool whole = wholePart(chunkFile(c), st, columns, c.begin, c.end);
+        kept += whole;
+        return whole;
+      });
+  const std::string resume = std::to_string(kept) + " of " + std::to_string(count) + " chunks kept in " +
                              parts.string() + "; run the same command again to resume";
   if (interruptFlag()) throw Interrupted(resume);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   StudyTableWriter out(table, "--table", st, columns, begin, end);
-  for (const StudyChunk& c : chunks) {
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const StudyChunk c = chunkAt(k);
     StudyPartReader part(chunkFile(c), st, columns);
     if (part.begin() != c.begin || part.end() != c.end)
       throw InputError(chunkFile(c) + ": holds rows " + std::to_string(part.begin()) + "-" + std::to_string(part.end()) +
@@ -239,7 +262,8 @@ Json studySummaryJson(const Study& st, const StudySummary& s, const std::string&
   return Json{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
               {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
               {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
-              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures}};
+              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures},
+              {"quantile_rank_error", s.quantile_rank_error}};
 }
 
 void runStudyCommand(const StudyOptions& o, std::ostream& out) {
@@ -261,6 +285,11 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
             (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
   const std::pair<const char*, std::string> outputs[] = {
       {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}};
+  if (o.merge.empty() && chunkCount(StudyGrid{begin, end, chunkSize(o, st)}) > kMaxChunks)
+    throw UsageError("--chunk-size " + std::to_string(chunkSize(o, st)) + ": " +
+                     std::to_string(chunkCount(StudyGrid{begin, end, chunkSize(o, st)})) + " chunk files for samples " +
+                     std::to_string(begin) + "-" + std::to_string(end) + ", more than " + std::to_string(kMaxChunks) +
+                     "; use --chunk-size " + std::to_string((end - begin + kMaxChunks - 2) / (kMaxChunks - 1)) + " or more");
   std::error_code ec;
   std::vector<InputFile> inputs = scenarioInputs(st.scenario);  // no output replaces what the run reads
   inputs.push_back({"the study file", o.study});
@@ -273,9 +302,15 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 
-  // Until the summary streams: the rows, gathered as the table is written.
-  std::vector<double> rows;
-  const RowSink sink = [&](const std::vector<double>& row) { rows.insert(rows.end(), row.begin(), row.end()); };
+  // The summary from the rows as the table is written, a block at a time: never the whole table.
+  StudySummarizer summarizer(study);
+  std::vector<double> block;
+  constexpr std::size_t kBlockRows = 4096;
+  block.reserve(kBlockRows * columns.size());
+  const RowSink sink = [&](const std::vector<double>& row) {
+    block.insert(block.end(), row.begin(), row.end());
+    if (block.size() == kBlockRows * columns.size()) summarizer.add(block.data(), kBlockRows), block.clear();
+  };
   std::string how;
   {
     const TableLock lock(table, std::cerr);  // no second run on this table until this one ends
@@ -283,13 +318,15 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     how = o.merge.empty() ? computeTable(study, o, table, begin, end, columns, sink)
                           : mergeParts(o.merge, table, st, columns, sink);
   }
+  summarizer.add(block.data(), block.size() / columns.size());
+  std::vector<double>().swap(block);
 
   if (shard_n) {  // a part: its rows only; the summary is the merged table's
     out << st.file << ": shard " << shard_i << "/" << shard_n << ", samples " << begin << "-" << end << " (" << how
         << ") written to " << table << "; join the shards with: kdl_space study " << st.file << " --merge PART...\n";
     return;
   }
-  const StudySummary summary = summarizeStudy(st, rows);
+  const StudySummary summary = summarizer.finish();
   const Json json = studySummaryJson(st, summary, table);
   if (!o.summary.empty()) {
     AtomicFile f(o.summary, "--summary");
