@@ -11,8 +11,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -424,6 +426,124 @@ TEST(StudyParts, KilledAtRandomMomentsAndRunAgainTheTableIsAnUninterruptedRunsBy
   EXPECT_FALSE(fs::exists(table + ".parts"));
   for (const auto& entry : fs::directory_iterator(fs::path(table).parent_path()))
     EXPECT_EQ(entry.path().filename().string().rfind(".killed.csv.", 0), std::string::npos) << entry.path();
+}
+
+/// A two-link arm's capture: the fewest outcome columns (22), the cheapest samples.
+const std::string kTwoLink = write("twolink.yaml", "robot:\n  urdf: " + std::string(KDL_SPACE_SOURCE_DIR) +
+                                   "/urdf/spacedyn_twolink.urdf\n  contact: {link: link2}\n  q: {joint1: 0.5, joint2: -1.0}\n"
+                                   "  mode: free\ntarget:\n  mass: 5\n  inertia: [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]\n"
+                                   "  pose: {position: [1.5, 0.3, 0], rpy: [0, 0, 0]}\n  twist: [0.01, 0, 0, 0, 0, 0.02]\n"
+                                   "law: {type: capture}\n");
+
+std::string twoLinkStudy(const std::string& name, std::uint64_t samples) {
+  return write(name, "scenario: " + kTwoLink + "\nsamples: " + std::to_string(samples) +
+                     "\nseed: 1\ninputs: {timing: {uniform: [0, 0.5]}}\n");
+}
+
+/// The tool run under `ulimit -v kb` (virtual memory, KiB); its exit code.
+int runUnder(long kb, const std::string& args, const std::string& out, const std::string& err) {
+  const std::string cmd = "ulimit -v " + std::to_string(kb) + "; exec " + std::string(KDL_SPACE_CLI) + " " + args + " >" + out +
+                          " 2>" + err;
+  const int status = std::system(("/bin/sh -c '" + cmd + "'").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// The smallest of a few limits [KiB] under which the tool runs a small study: its baseline (the
+/// libraries mapped, the threads' stacks); 0 if none (a sanitizer's shadow memory).
+long baselineKb(const std::string& out, const std::string& err) {
+  const std::string tiny = twoLinkStudy("tiny.yaml", 200);
+  for (const long kb : {40000L, 50000L, 60000L, 70000L, 80000L, 100000L, 130000L, 170000L, 220000L})
+    if (runUnder(kb, "study " + tiny + " --threads 2 -o " + scratch("tiny.csv"), out, err) == 0) return kb;
+  return 0;
+}
+
+TEST(StudyMemory, AMergedTableLargerThanTheMemoryLimitIsJoinedAndSummarised) {
+  // 1e6 rows of 22 columns: 176 MB as doubles (the tool before the table streamed held it twice,
+  // and failed under 300 MB), some 130 MB as text; merged and summarised under the tool's
+  // baseline + 48 MB. The rows are made up (the merge checks them, it does not compute them).
+  const std::string out = scratch("mem.out"), err = scratch("mem.err");
+  const long base = baselineKb(out, err);
+  if (base == 0) GTEST_SKIP() << "the tool does not run under ulimit -v here (a sanitizer build?)";
+  const std::uint64_t n = 1000000;
+  const std::string study = twoLinkStudy("million.yaml", n), first = scratch("million_first.csv");
+  ASSERT_EQ(kdlSpace("study " + study + " --shard 1/1000000 -o " + first).rc, 0);  // its head line and header
+  const std::vector<std::string> own = lines(slurp(first));
+  const std::string head = own[0].substr(0, own[0].rfind("rows ")) + "rows 0-" + std::to_string(n);
+  const std::size_t columns = static_cast<std::size_t>(std::count(own[1].begin(), own[1].end(), ',')) + 1;
+  ASSERT_EQ(columns, 22u) << own[1];
+  const std::string table = scratch("million.csv"), merged = scratch("million_merged.csv");
+  {
+    std::ofstream f(table, std::ios::binary);
+    f << head << "\n" << own[1] << "\n";
+    std::string rows;
+    std::uint32_t crc = 0xFFFFFFFFu;  // CRC-32 run on as the rows are written (as crc32Bitwise)
+    char cell[32];
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const double x = static_cast<double>((i * 7919) % 1000003) / 1000003.0;
+      rows = std::to_string(i) + ",0";
+      std::snprintf(cell, sizeof cell, ",%.6g", 0.5 * x);
+      rows += cell;
+      for (std::size_t c = 3; c < columns; ++c) {
+        std::snprintf(cell, sizeof cell, ",%.5g", x + static_cast<double>(c));
+        rows += cell;
+      }
+      rows += "\n";
+      for (const unsigned char b : rows) {
+        crc ^= b;
+        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+      }
+      f << rows;
+    }
+    char end[64];
+    std::snprintf(end, sizeof end, "# end; rows 0-%llu; crc32 %08x\n", static_cast<unsigned long long>(n), ~crc);
+    f << end;
+  }
+  const long limit = base + 48 * 1024;
+  std::printf("baseline %ld KiB, limit %ld KiB; the table: %ju bytes of text, %ju bytes as doubles\n", base, limit,
+              static_cast<std::uintmax_t>(fs::file_size(table)), static_cast<std::uintmax_t>(n * columns * 8));
+  ASSERT_LT(limit * 1024, static_cast<long>(n * columns * 8));
+  const int rc = runUnder(limit, "study " + study + " --merge " + table + " -o " + merged + " --json", out, err);
+  ASSERT_EQ(rc, 0) << slurp(err);
+  EXPECT_EQ(slurp(merged), slurp(table));
+  const std::string json = slurp(out);
+  EXPECT_NE(json.find("\"samples\": 1000000"), std::string::npos) << json.substr(0, 400);
+  const std::size_t key = json.find("\"quantile_rank_error\": ");
+  ASSERT_NE(key, std::string::npos) << json;
+  const double rank_error = std::stod(json.substr(key + 23));
+  EXPECT_GT(rank_error, 0.0) << "past 65,536 samples: a sketch";
+  EXPECT_LT(rank_error, 0.001);
+}
+
+TEST(StudyMemory, AStudyOfABillionSamplesRunsInBoundedMemoryUntilCtrlC) {
+  // 1e9 samples in chunks of 2000 (500,000 chunk files at most): no table and no list of chunks
+  // in memory; stopped by Ctrl-C after a second, its chunks kept. Before the table streamed, the
+  // tool allocated the whole table (176 GB) at its start: std::bad_alloc.
+  const std::string out = scratch("billion.out"), err = scratch("billion.err");
+  const long base = baselineKb(out, err);
+  if (base == 0) GTEST_SKIP() << "the tool does not run under ulimit -v here (a sanitizer build?)";
+  const std::string study = twoLinkStudy("billion.yaml", 1000000000), table = scratch("billion.csv");
+  fs::remove_all(table + ".parts");
+  const std::string cmd = "ulimit -v " + std::to_string(base + 48 * 1024) + "; exec " + std::string(KDL_SPACE_CLI) + " study " +
+                          study + " --threads 2 --chunk-size 2000 -o " + table + " >" + out + " 2>" + err;
+  const char* argv[] = {"/bin/sh", "-c", cmd.c_str(), nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, "/bin/sh", nullptr, nullptr, const_cast<char**>(argv), environ), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130) << slurp(err);
+  EXPECT_NE(slurp(err).find(" of 500000 chunks kept in " + table + ".parts"), std::string::npos) << slurp(err);
+  EXPECT_FALSE(fs::exists(table));
+  fs::remove_all(table + ".parts");
+  // Too many chunk files: refused up front, with the chunk size to use.
+  const ToolRun r = kdlSpace("study " + study + " --chunk-size 999 -o " + table);
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_NE(r.err.find("--chunk-size 999: 1001002 chunk files for samples 0-1000000000, more than 1000000; use --chunk-size "
+                       "1001 or more"),
+            std::string::npos)
+      << r.err;
 }
 
 }  // namespace
