@@ -342,7 +342,7 @@ TEST(StudyParts, CtrlCStopsTheRunKeepsItsChunksAndTheRerunResumes) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
   ASSERT_TRUE(WIFEXITED(status)) << "ended by the signal, not by the tool";
   EXPECT_EQ(WEXITSTATUS(status), 130) << slurp(err);
-  EXPECT_LT(seconds, 2.0) << "a chunk of 8 samples at most after the signal";
+  EXPECT_LT(seconds, 0.5) << "the run stops within a sample (on each thread) of the signal";
   EXPECT_NE(slurp(err).find(" chunks kept in " + table + ".parts; run the same command again to resume"), std::string::npos)
       << slurp(err);
   EXPECT_FALSE(fs::exists(table));
@@ -512,6 +512,8 @@ TEST(StudyMemory, AMergedTableLargerThanTheMemoryLimitIsJoinedAndSummarised) {
   const double rank_error = std::stod(json.substr(key + 23));
   EXPECT_GT(rank_error, 0.0) << "past 65,536 samples: a sketch";
   EXPECT_LT(rank_error, 0.001);
+  fs::remove(table);  // 150 MB each
+  fs::remove(merged);
 }
 
 TEST(StudyMemory, AStudyOfABillionSamplesRunsInBoundedMemoryUntilCtrlC) {
