@@ -1,5 +1,6 @@
 #include "study.hpp"
 
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <filesystem>
@@ -215,7 +216,8 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
   if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
   const auto t0 = std::chrono::steady_clock::now();
   const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  std::uint64_t kept = 0, computed = 0;
+  std::atomic<std::uint64_t> kept{0};  // from done and skip, which may run at once on two threads
+  std::uint64_t computed = 0;
   kdl_space::runStudy(
       study, grid, threads,
       [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
@@ -229,7 +231,7 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
         kept += whole;
         return whole;
       });
-  const std::string resume = std::to_string(kept) + " of " + std::to_string(count) + " chunks kept in " +
+  const std::string resume = std::to_string(kept.load()) + " of " + std::to_string(count) + " chunks kept in " +
                              parts.string() + "; run the same command again to resume";
   if (interruptFlag()) throw Interrupted(resume);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
