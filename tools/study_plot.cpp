@@ -70,7 +70,7 @@ void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::
   g << "set terminal " << plotTerminal(out.path(), rows_of_panels) << "\nset output " << gnuplotQuoted(out.tmp()) << "\n"
     << "set multiplot layout " << rows_of_panels << ",2 title "
     << gnuplotLabel(study.file + ": " + std::to_string(study.samples) + " captures, seed " + std::to_string(study.seed))
-    << "\nset style fill solid 0.6\nset grid\nset ylabel 'samples'\nunset key\n";
+    << "\nset style fill solid 0.6\nset grid\nset ylabel 'samples'\nunset key\nset offsets 0, 0, graph 0.05, 0\n";
   for (std::size_t k = 0; k < panels; ++k)
     g << "set xlabel " << gnuplotLabel(shown[k].first + " [" + shown[k].second + "]") << "\n"
       << "set boxwidth " << bins[k].width << " absolute\n"
