@@ -257,11 +257,28 @@ AtomicFile::~AtomicFile() {
   if (!committed_) std::remove(tmp_.c_str());
 }
 
+namespace {
+/// Flushes a file or a folder to the disk (best effort where the file system cannot: EINVAL).
+bool syncPath(const std::string& path, int flags) {
+  const int fd = open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool ok = fsync(fd) == 0 || errno == EINVAL || errno == EROFS;
+  close(fd);
+  return ok;
+}
+}  // namespace
+
 void AtomicFile::commit() {
+  // The data on the disk before the name: a crash (power, kernel) after the rename never leaves a
+  // file that has its name but not its bytes. Then the folder, so that the rename itself lasts.
+  if (!syncPath(tmp_, O_RDONLY))
+    throw InputError(option_ + " " + path_ + ": cannot write (fsync): " + std::strerror(errno));
   std::error_code ec;
   fs::rename(tmp_, path_, ec);
   if (ec) throw InputError(option_ + " " + path_ + ": cannot write: " + ec.message());
   committed_ = true;
+  const fs::path folder = fs::path(path_).parent_path();
+  syncPath(folder.empty() ? "." : folder.string(), O_RDONLY | O_DIRECTORY);
 }
 
 void AtomicFile::retract() {

@@ -1,8 +1,11 @@
 #include "study.hpp"
 
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <filesystem>
+#include <functional>
+#include <iostream>
 #include <iomanip>
 #include <map>
 #include <thread>
@@ -92,6 +95,9 @@ void printSummary(std::ostream& out, const Study& st, const StudySummary& s, con
     for (const double v : {o.min, o.q05, o.q25, o.median, o.q75, o.q95, o.max}) out << std::setw(12) << v;
     out << "\n";
   }
+  if (s.quantile_rank_error > 0.0)
+    out << "(quantiles from a streaming sketch: each within a rank of +-" << s.quantile_rank_error
+        << " of the computed samples of the exact one)\n";
   if (!s.probabilities.empty()) out << "\n";
   for (const auto& [name, p] : s.probabilities) out << "P(" << name << ") = " << p << "\n";
   const auto list = [&](const char* title, const std::vector<SampleDigest>& ds) {
@@ -106,17 +112,32 @@ void printSummary(std::ostream& out, const Study& st, const StudySummary& s, con
   list("worst (largest)", s.worst);
 }
 
-/// The whole table from parts that must cover [0, samples) once.
-std::vector<double> mergeParts(const std::vector<std::string>& paths, const Study& st, const std::vector<std::string>& columns) {
-  std::map<std::uint64_t, std::pair<StudyPart, std::string>> by_begin;
+/// Called with each row of the table as it is written (sample order).
+using RowSink = std::function<void(const std::vector<double>& row)>;
+
+/// Copies a part's rows (each checked) into the table and the sink; Ctrl-C stops it (the table's
+/// temporary is removed, what is on disk stays).
+void appendPart(StudyPartReader& part, StudyTableWriter& table, const RowSink& sink, const std::string& stopped) {
+  std::uint64_t n = 0;
+  while (part.next()) {
+    table.addLine(part.line());
+    sink(part.row());
+    if ((++n & 1023u) == 0 && interruptFlag()) throw Interrupted(stopped);
+  }
+  if (interruptFlag()) throw Interrupted(stopped);
+}
+
+/// `--merge`: the table from parts that must cover [0, samples) once, read in the order of their
+/// rows (their head lines first, to check that they cover it), each row checked as it is copied.
+std::string mergeParts(const std::vector<std::string>& paths, const std::string& table, const Study& st,
+                       const std::vector<std::string>& columns, const RowSink& sink) {
+  std::map<std::uint64_t, std::pair<std::uint64_t, std::string>> by_begin;  // begin -> end, path
   for (const std::string& p : paths) {
-    StudyPart part = readStudyPart(p, st, columns);
-    const std::uint64_t b = part.begin;
-    if (!by_begin.emplace(b, std::make_pair(std::move(part), p)).second)
+    const StudyPartReader part(p, st, columns);
+    const std::uint64_t b = part.begin();
+    if (!by_begin.emplace(b, std::make_pair(part.end(), p)).second)
       throw InputError("--merge: " + p + " and " + by_begin[b].second + " both hold the rows from " + std::to_string(b));
   }
-  std::vector<double> rows;
-  rows.reserve(static_cast<std::size_t>(st.samples) * columns.size());
   std::uint64_t next = 0;
   for (const auto& [b, entry] : by_begin) {
     if (b != next)
@@ -124,12 +145,112 @@ std::vector<double> mergeParts(const std::vector<std::string>& paths, const Stud
                                                                 ") are also in another part"
                                                           : "rows " + std::to_string(next) + "-" + std::to_string(b) +
                                                                 " are in no part (a shard is missing)"));
-    rows.insert(rows.end(), entry.first.rows.begin(), entry.first.rows.end());
-    next = entry.first.end;
+    next = entry.first;
   }
   if (next != st.samples)
     throw InputError("--merge: rows " + std::to_string(next) + "-" + std::to_string(st.samples) + " are in no part (a shard is missing)");
-  return rows;
+  StudyTableWriter out(table, "--table", st, columns, 0, st.samples);
+  for (const auto& [b, entry] : by_begin) {
+    StudyPartReader part(entry.second, st, columns);
+    appendPart(part, out, sink, "interrupted while merging into " + table + ": nothing written; run the same command again");
+  }
+  out.commit();
+  return std::to_string(paths.size()) + " parts merged";
+}
+
+/// Whether `path` is a complete part of rows [begin, end) of this study (every row and the
+/// checksum read and checked).
+bool wholePart(const std::string& path, const Study& st, const std::vector<std::string>& columns, std::uint64_t begin,
+               std::uint64_t end) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  try {
+    StudyPartReader part(path, st, columns);
+    if (part.begin() != begin || part.end() != end) return false;
+    while (part.next()) {
+    }
+    return true;
+  } catch (const InputError&) {  // cut short, changed, or of another version of the study
+    return false;
+  }
+}
+
+/// The most chunk files a run keeps in TABLE.parts/ (a folder of more is slow to list and to remove).
+constexpr std::uint64_t kMaxChunks = 1000000;
+
+std::uint64_t chunkSize(const StudyOptions& o, const Study& st) {
+  return o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
+}
+
+/// The chunks of the grid that meet [begin, end).
+std::uint64_t chunkCount(const StudyGrid& g) {
+  return g.end == g.begin ? 0 : (g.end + g.chunk_size - 1) / g.chunk_size - g.begin / g.chunk_size;
+}
+
+/// Rows [begin, end) computed in chunks kept in TABLE.parts/ (those already there, of an
+/// interrupted run, are used), then the table: the chunks concatenated in order, each checked.
+std::string computeTable(const std::shared_ptr<const Study>& study, const StudyOptions& o, const std::string& table,
+                         std::uint64_t begin, std::uint64_t end, const std::vector<std::string>& columns,
+                         const RowSink& sink) {
+  const Study& st = *study;
+  const fs::path parts = table + ".parts";
+  std::error_code ec;
+  if (fs::is_directory(parts, ec) && wholePart(table, st, columns, begin, end)) {
+    // A run killed while it removed its chunks: the table was already whole.
+    StudyPartReader whole(table, st, columns);
+    while (whole.next()) sink(whole.row());
+    fs::remove_all(parts, ec);
+    return "the table was whole; the chunks a stopped run left in " + parts.string() + " removed";
+  }
+  // The grid of chunks, generated as they are needed (nothing here grows with their number):
+  // chunk k holds rows [k c, (k + 1) c) cut to [begin, end).
+  const StudyGrid grid{begin, end, chunkSize(o, st)};
+  const std::uint64_t first = begin / grid.chunk_size, count = chunkCount(grid);
+  const auto chunkAt = [&](std::uint64_t k) {
+    return StudyChunk{std::max(begin, (first + k) * grid.chunk_size), std::min(end, (first + k + 1) * grid.chunk_size)};
+  };
+  const auto chunkFile = [&](const StudyChunk& c) {
+    return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
+  };
+  fs::create_directories(parts, ec);
+  if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
+  const auto t0 = std::chrono::steady_clock::now();
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::atomic<std::uint64_t> kept{0};  // from done and skip, which may run at once on two threads
+  std::uint64_t computed = 0;
+  kdl_space::runStudy(
+      study, grid, threads,
+      [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
+        writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
+        ++kept;
+        computed += c.end - c.begin;
+      },
+      &interruptFlag(),
+      [&](const StudyChunk& c) {  // a chunk already on disk, whole (of an interrupted run)
+        const bool whole = wholePart(chunkFile(c), st, columns, c.begin, c.end);
+        kept += whole;
+        return whole;
+      });
+  const std::string resume = std::to_string(kept.load()) + " of " + std::to_string(count) + " chunks kept in " +
+                             parts.string() + "; run the same command again to resume";
+  if (interruptFlag()) throw Interrupted(resume);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  StudyTableWriter out(table, "--table", st, columns, begin, end);
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const StudyChunk c = chunkAt(k);
+    StudyPartReader part(chunkFile(c), st, columns);
+    if (part.begin() != c.begin || part.end() != c.end)
+      throw InputError(chunkFile(c) + ": holds rows " + std::to_string(part.begin()) + "-" + std::to_string(part.end()) +
+                       ", not those its name says; remove it and run the same command again");
+    appendPart(part, out, sink, "interrupted while writing " + table + ": " + resume);
+  }
+  out.commit();
+  fs::remove_all(parts, ec);
+  std::ostringstream h;
+  h << computed << " computed on " << threads << " thread" << (threads > 1 ? "s" : "") << " in " << std::setprecision(3)
+    << seconds << " s";
+  if (computed < end - begin) h << ", " << (end - begin - computed) << " resumed from " << parts.string();
+  return h.str();
 }
 
 }  // namespace
@@ -143,7 +264,8 @@ Json studySummaryJson(const Study& st, const StudySummary& s, const std::string&
   return Json{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
               {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
               {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
-              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures}};
+              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures},
+              {"quantile_rank_error", s.quantile_rank_error}};
 }
 
 void runStudyCommand(const StudyOptions& o, std::ostream& out) {
@@ -165,6 +287,11 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
             (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
   const std::pair<const char*, std::string> outputs[] = {
       {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}};
+  if (o.merge.empty() && chunkCount(StudyGrid{begin, end, chunkSize(o, st)}) > kMaxChunks)
+    throw UsageError("--chunk-size " + std::to_string(chunkSize(o, st)) + ": " +
+                     std::to_string(chunkCount(StudyGrid{begin, end, chunkSize(o, st)})) + " chunk files for samples " +
+                     std::to_string(begin) + "-" + std::to_string(end) + ", more than " + std::to_string(kMaxChunks) +
+                     "; use --chunk-size " + std::to_string((end - begin + kMaxChunks - 2) / (kMaxChunks - 1)) + " or more");
   std::error_code ec;
   std::vector<InputFile> inputs = scenarioInputs(st.scenario);  // no output replaces what the run reads
   inputs.push_back({"the study file", o.study});
@@ -177,59 +304,31 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 
-  std::vector<double> rows;
+  // The summary from the rows as the table is written, a block at a time: never the whole table.
+  StudySummarizer summarizer(study);
+  std::vector<double> block;
+  constexpr std::size_t kBlockRows = 4096;
+  block.reserve(kBlockRows * columns.size());
+  const RowSink sink = [&](const std::vector<double>& row) {
+    block.insert(block.end(), row.begin(), row.end());
+    if (block.size() == kBlockRows * columns.size()) summarizer.add(block.data(), kBlockRows), block.clear();
+  };
   std::string how;
-  if (!o.merge.empty()) {
-    rows = mergeParts(o.merge, st, columns);
-    how = std::to_string(o.merge.size()) + " parts merged";
-  } else {
-    // Chunks already on disk (an interrupted run of this study) are kept; the rest computed.
-    const fs::path parts = table + ".parts";
-    const std::uint64_t chunk = o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
-    const std::vector<StudyChunk> chunks = studyChunks(begin, end, chunk);
-    const std::size_t m = columns.size();
-    rows.assign(static_cast<std::size_t>(end - begin) * m, 0.0);
-    const auto chunkFile = [&](const StudyChunk& c) {
-      return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
-    };
-    std::vector<StudyChunk> todo;
-    for (const StudyChunk& c : chunks) {
-      if (fs::exists(chunkFile(c), ec)) {
-        try {
-          const StudyPart p = readStudyPart(chunkFile(c), st, columns);
-          std::copy(p.rows.begin(), p.rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
-          continue;
-        } catch (const InputError&) {  // cut short, or of another version of the study: computed again
-        }
-      }
-      todo.push_back(c);
-    }
-    fs::create_directories(parts, ec);
-    if (ec) throw InputError("--table " + table + ": cannot create the folder " + parts.string() + " for the chunks");
-    const auto t0 = std::chrono::steady_clock::now();
-    const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-    kdl_space::runStudy(study, todo, threads, [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
-      writeStudyPart(chunkFile(c), "--table", st, columns, c.begin, c.end, chunk_rows.data());
-      std::copy(chunk_rows.begin(), chunk_rows.end(), rows.begin() + static_cast<std::ptrdiff_t>((c.begin - begin) * m));
-    });
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::uint64_t computed = 0;
-    for (const StudyChunk& c : todo) computed += c.end - c.begin;
-    std::ostringstream h;
-    h << computed << " computed on " << threads << " thread" << (threads > 1 ? "s" : "") << " in " << std::setprecision(3)
-      << seconds << " s";
-    if (computed < end - begin) h << ", " << (end - begin - computed) << " resumed from " << parts.string();
-    how = h.str();
+  {
+    const TableLock lock(table, std::cerr);  // no second run on this table until this one ends
+    removeStaleTemporaries(table, table + ".parts");
+    how = o.merge.empty() ? computeTable(study, o, table, begin, end, columns, sink)
+                          : mergeParts(o.merge, table, st, columns, sink);
   }
-  writeStudyPart(table, "--table", st, columns, begin, end, rows.data());
-  if (o.merge.empty()) fs::remove_all(table + ".parts", ec);
+  summarizer.add(block.data(), block.size() / columns.size());
+  std::vector<double>().swap(block);
 
   if (shard_n) {  // a part: its rows only; the summary is the merged table's
     out << st.file << ": shard " << shard_i << "/" << shard_n << ", samples " << begin << "-" << end << " (" << how
         << ") written to " << table << "; join the shards with: kdl_space study " << st.file << " --merge PART...\n";
     return;
   }
-  const StudySummary summary = summarizeStudy(st, rows);
+  const StudySummary summary = summarizer.finish();
   const Json json = studySummaryJson(st, summary, table);
   if (!o.summary.empty()) {
     AtomicFile f(o.summary, "--summary");
@@ -241,12 +340,12 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   }
   if (!o.plot.empty()) {
     AtomicFile f(o.plot, "--plot");
-    writeStudyHistograms(f, st, columns, rows);
+    writeStudyHistograms(f, st, columns, table, summary);
     f.commit();
   }
   if (!o.heat_map.empty()) {
     AtomicFile f(o.heat_map, "--heat-map");
-    writeStudyHeatMap(f, st, columns, rows);
+    writeStudyHeatMap(f, st, columns, table);
     f.commit();
   }
   if (o.json) {

@@ -7,58 +7,74 @@
 
 #include "gnuplot_text.hpp"
 #include "plot_writer.hpp"
+#include "study_table.hpp"
 
 namespace kdl_space::cli {
 namespace {
+
+constexpr int kBins = 40;
 
 /// The index of a column (the loader checked the names).
 std::size_t columnOf(const std::vector<std::string>& columns, const std::string& name) {
   return static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
 }
 
-/// The computed samples' values of some columns, one line each, into a scratch data file.
-void writeData(const std::string& path, const std::vector<std::size_t>& cols, std::size_t m, const std::vector<double>& rows,
-               const std::string& where) {
-  std::ofstream d(path);
-  d << std::setprecision(12);
-  for (std::size_t r = 0; r < rows.size() / m; ++r) {
-    if (rows[r * m + 1] != 0.0) continue;  // status
-    for (std::size_t k = 0; k < cols.size(); ++k) d << (k ? " " : "") << rows[r * m + cols[k]];
-    d << '\n';
+/// A histogram's bins: kBins over [min, max] (one value: one bin of width 1e-9).
+struct Bins {
+  double min = 0.0, width = 1e-9;
+  std::vector<std::uint64_t> count = std::vector<std::uint64_t>(kBins, 0);
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    const double k = std::floor((v - min) / width);
+    count[static_cast<std::size_t>(std::clamp(k, 0.0, double{kBins - 1}))] += 1;  // max in the last bin
   }
-  d.close();
-  if (!d) throw InputError(where + "cannot write the plot's data next to it");
-}
+};
 
 }  // namespace
 
 void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
-                          const std::vector<double>& rows) {
+                          const std::string& table, const StudySummary& summary) {
   const std::string where = "--plot " + out.path() + ": ";
   std::vector<std::pair<std::string, std::string>> shown{  // outcome, unit
       {"impulse.force", "N s"}, {"impulse.moment", "N m s"}, {"base_rate", "rad/s"}, {"max_dqdot", "rad/s"},
       {"energy_lost", "J"}};
   if (study.motion_duration > 0.0) shown.emplace_back("peak_base_rate", "rad/s");
   std::vector<std::size_t> cols;
-  for (const auto& [name, unit] : shown) cols.push_back(columnOf(columns, name));
-  const std::size_t m = columns.size();
+  std::vector<Bins> bins(shown.size());
+  for (std::size_t k = 0; k < shown.size(); ++k) {
+    cols.push_back(columnOf(columns, shown[k].first));
+    for (const OutcomeSummary& o : summary.outcomes)
+      if (o.name == shown[k].first) {
+        bins[k].min = o.min;
+        if (o.max > o.min) bins[k].width = (o.max - o.min) / kBins;
+      }
+  }
+  StudyPartReader rows(table, study, columns);
+  while (rows.next())
+    if (rows.row()[1] == 0.0)  // status: computed
+      for (std::size_t k = 0; k < cols.size(); ++k) bins[k].add(rows.row()[cols[k]]);
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
-  writeData(data.path(), cols, m, rows, where);
+  {
+    std::ofstream d(data.path());
+    d << std::setprecision(12);
+    for (std::size_t k = 0; k < bins.size(); ++k) {  // one block per outcome (gnuplot's `index k`)
+      for (int b = 0; b < kBins; ++b) d << bins[k].min + (b + 0.5) * bins[k].width << " " << bins[k].count[b] << "\n";
+      d << "\n\n";
+    }
+    d.close();
+    if (!d) throw InputError(where + "cannot write the plot's data next to it");
+  }
   std::ofstream g(script.path());
   g << std::setprecision(12);
   const std::size_t panels = shown.size(), rows_of_panels = (panels + 1) / 2;
   g << "set terminal " << plotTerminal(out.path(), rows_of_panels) << "\nset output " << gnuplotQuoted(out.tmp()) << "\n"
     << "set multiplot layout " << rows_of_panels << ",2 title "
     << gnuplotLabel(study.file + ": " + std::to_string(study.samples) + " captures, seed " + std::to_string(study.seed))
-    << "\nset style fill solid 0.6\nset grid\nset ylabel 'samples'\nunset key\n";
-  for (std::size_t k = 0; k < panels; ++k) {
-    // Bins: 40 over the column's range (stats finds it; one value gets one bin of width 1e-9).
-    g << "stats " << gnuplotQuoted(data.path()) << " using " << k + 1 << " nooutput\n"
-      << "w = (STATS_max > STATS_min) ? (STATS_max - STATS_min) / 40.0 : 1e-9\n"
-      << "set xlabel " << gnuplotLabel(shown[k].first + " [" + shown[k].second + "]") << "\n"
-      << "plot " << gnuplotQuoted(data.path()) << " using (w * floor(($" << k + 1
-      << " - STATS_min) / w) + STATS_min + w / 2):(1.0) smooth frequency with boxes\n";
-  }
+    << "\nset style fill solid 0.6\nset grid\nset ylabel 'samples'\nunset key\nset offsets 0, 0, graph 0.05, 0\n";
+  for (std::size_t k = 0; k < panels; ++k)
+    g << "set xlabel " << gnuplotLabel(shown[k].first + " [" + shown[k].second + "]") << "\n"
+      << "set boxwidth " << bins[k].width << " absolute\n"
+      << "plot " << gnuplotQuoted(data.path()) << " index " << k << " using 1:2 with boxes\n";
   g << "unset multiplot\n";
   g.close();
   if (!g) throw InputError(where + "cannot write the plot's script next to it");
@@ -66,12 +82,20 @@ void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::
 }
 
 void writeStudyHeatMap(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
-                       const std::vector<double>& rows) {
+                       const std::string& table) {
   const std::string where = "--heat-map " + out.path() + ": ";
   const StudyHeatMap& h = *study.heat_map;
-  const std::size_t m = columns.size();
+  const std::size_t x = columnOf(columns, h.x), y = columnOf(columns, h.y), v = columnOf(columns, h.outcome);
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
-  writeData(data.path(), {columnOf(columns, h.x), columnOf(columns, h.y), columnOf(columns, h.outcome)}, m, rows, where);
+  {
+    std::ofstream d(data.path());
+    d << std::setprecision(12);
+    StudyPartReader rows(table, study, columns);
+    while (rows.next())
+      if (rows.row()[1] == 0.0) d << rows.row()[x] << " " << rows.row()[y] << " " << rows.row()[v] << "\n";
+    d.close();
+    if (!d) throw InputError(where + "cannot write the plot's data next to it");
+  }
   std::ofstream g(script.path());
   g << "set terminal " << plotTerminal(out.path(), 2) << "\nset output " << gnuplotQuoted(out.tmp()) << "\n"
     << "set title " << gnuplotLabel(study.file + ": " + h.outcome + " over " + h.x + " and " + h.y) << "\n"

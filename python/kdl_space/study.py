@@ -15,6 +15,7 @@ cluster's shared file system, or the same checkout on every machine); a worker w
 import math
 import os
 import threading
+import zlib
 
 import numpy as np
 
@@ -250,20 +251,26 @@ class StudyResult:
 
     def to_csv(self, path):
         """Writes the table as ``kdl_space study -o`` does, byte for byte: so the command-line tool
-        can merge it (``--merge``), resume from it, plot it."""
+        can merge it (``--merge``), resume from it, plot it. Its last line is the CRC-32 of the row
+        lines (``zlib.crc32``, as the tool checks it)."""
         s, n = self.study, self.table.shape[0]
-        lines = [f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{n}",
-                 ",".join(self.columns)]
+        head = (f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{n}\n"
+                + ",".join(self.columns) + "\n")
         row_format = "%.0f,%.0f" + ",%.17g" * (len(self.columns) - 2)
         negative_nan = np.isnan(self.table) & np.signbit(self.table)
+        lines = []
         for r, row in enumerate(self.table.tolist()):
             if negative_nan[r].any():
                 lines.append("%.0f,%.0f" % (row[0], row[1]) + "".join("," + _c_double(x) for x in row[2:]))
             else:
                 lines.append(row_format % tuple(row))
+        body = ("\n".join(lines) + "\n").encode("ascii") if lines else b""
+        end = f"# end; rows 0-{n}; crc32 {zlib.crc32(body):08x}\n"
         tmp = f"{path}.tmp{os.getpid()}"
-        with open(tmp, "w", encoding="ascii", newline="\n") as f:
-            f.write("\n".join(lines) + "\n")
+        with open(tmp, "wb") as f:
+            f.write(head.encode("ascii") + body + end.encode("ascii"))
+            f.flush()
+            os.fsync(f.fileno())  # the bytes on the disk before the name, as the tool does
         os.replace(tmp, path)
 
     def to_npz(self, path):

@@ -2,6 +2,10 @@
 // this process's threads (runStudy, GIL released) and its summary as the dict `kdl_space study
 // --json` prints. The engines in Python (kdl_space.study: threads, Dask) are python/kdl_space/study.py.
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -21,10 +25,6 @@ struct PyStudy {
   std::shared_ptr<const Study> study;
   std::vector<std::string> columns;
 };
-
-/// Thrown out of runStudy's callback when the caller's thread saw a signal (Ctrl-C): the Python
-/// error is already set.
-struct Interrupted {};
 
 std::string hex(std::uint64_t fingerprint) {
   char fp[17];
@@ -52,24 +52,45 @@ py::array_t<double> rows(const PyStudy& s, long long begin_arg, long long end_ar
   const std::size_t m = s.columns.size();
   py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(end - begin), static_cast<py::ssize_t>(m)});
   double* data = out.mutable_data();
-  const std::vector<StudyChunk> chunks = studyChunks(begin, end, defaultChunkSize(st.samples));
-  const std::thread::id caller = std::this_thread::get_id();
+  // The run on threads of its own, GIL released; this thread waits in slices of 50 ms and checks
+  // for signals between them, so Ctrl-C is answered within a slice and a sample (runStudy sees the
+  // cancel between samples), not after a chunk of up to 65,536 samples.
   std::atomic<bool> cancel{false};
-  try {
+  std::mutex mutex;
+  std::condition_variable finished_cv;
+  bool finished = false, interrupted = false;
+  std::exception_ptr error;
+  {
     py::gil_scoped_release nogil;
-    runStudy(s.study, chunks, threads, [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
-      std::memcpy(data + (c.begin - begin) * m, chunk_rows.data(), chunk_rows.size() * sizeof(double));
-      if (std::this_thread::get_id() == caller) {  // Ctrl-C stops the run after the chunks under way
-        py::gil_scoped_acquire gil;
-        if (PyErr_CheckSignals() != 0) {
-          cancel = true;
-          throw Interrupted{};
-        }
+    std::thread runner([&] {
+      try {
+        runStudy(s.study, StudyGrid{begin, end, defaultChunkSize(st.samples)}, threads,
+                 [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
+                   std::memcpy(data + (c.begin - begin) * m, chunk_rows.data(), chunk_rows.size() * sizeof(double));
+                 }, &cancel);
+      } catch (...) {
+        error = std::current_exception();
       }
-    }, &cancel);
-  } catch (const Interrupted&) {
-    throw py::error_already_set();
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished = true;
+      finished_cv.notify_all();
+    });
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        if (finished_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; })) break;
+      }
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {  // the error (KeyboardInterrupt) is set: raised below
+        interrupted = true;
+        cancel = true;
+        break;
+      }
+    }
+    runner.join();
   }
+  if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
   return out;
 }
 
@@ -104,11 +125,12 @@ py::dict summary(const PyStudy& s, py::handle given) {
   if (a.ndim() != 2 || a.shape(1) != m)
     throw py::value_error("rows: expected shape (n, " + std::to_string(m) + ") (the study's columns), got " +
                           std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(a.shape(), a.shape() + a.ndim()))))));
-  std::vector<double> table(a.data(), a.data() + a.size());
   StudySummary sum;
   {
     py::gil_scoped_release nogil;
-    sum = summarizeStudy(st, table);
+    StudySummarizer summarizer(s.study);
+    summarizer.add(a.data(), static_cast<std::size_t>(a.shape(0)));
+    sum = summarizer.finish();
   }
   py::dict outcomes, probabilities, d;
   for (const OutcomeSummary& o : sum.outcomes) outcomes[py::str(o.name)] = quantiles(o);
@@ -116,6 +138,7 @@ py::dict summary(const PyStudy& s, py::handle given) {
   d["study"] = st.file, d["fingerprint"] = hex(st.fingerprint), d["samples"] = sum.samples, d["failed"] = sum.failed;
   d["seed"] = st.seed, d["outcomes"] = outcomes, d["probabilities"] = probabilities, d["objective"] = st.objective;
   d["best"] = digests(sum.best), d["worst"] = digests(sum.worst);
+  d["quantile_rank_error"] = sum.quantile_rank_error;
   py::list failures;
   for (const StudyFailure& f : sum.failures) {
     py::dict x;
@@ -183,13 +206,14 @@ void bindStudy(py::module_& m) {
            "samples (0: default_chunk_size), as the command-line tool cuts them.")
       .def("rows", &rows, py::arg("begin"), py::arg("end"), py::arg("threads") = 1,
            "Rows [begin, end) of the table, (end - begin, len(columns)) float64, computed on `threads` threads "
-           "(0: all cores) in chunks, GIL released; Ctrl-C stops after the chunks under way. A sample that cannot "
+           "(0: all cores) in chunks, GIL released; Ctrl-C stops the run within a sample and raises KeyboardInterrupt. A sample that cannot "
            "be computed has its status (an error code) and NaN outcomes. ValueError unless 0 <= begin <= end <= "
            "samples.")
       .def("summary", &summary, py::arg("rows"),
            "The summary of a table (rows of this study, any order), as `kdl_space study --json` prints it: study, "
            "fingerprint (hex), samples, failed, seed, outcomes {name: {min, q05, q25, median, q75, q95, max, "
-           "mean}}, probabilities {exceeds.*: p}, objective, best and worst [{sample, objective, inputs}], failures "
+           "mean}}, quantile_rank_error (0: exact quantiles; else the bound on their ranks' error as a "
+           "fraction of the samples computed), probabilities {exceeds.*: p}, objective, best and worst [{sample, objective, inputs}], failures "
            "[{status, count, first_sample, message}] (one per distinct status; the message from evaluating "
            "first_sample again, GIL released).")
       .def("__repr__", [](const PyStudy& s) {

@@ -7,10 +7,12 @@ import ctypes
 import json
 import math
 import os
+import signal
 import struct
 import subprocess
 import threading
 import time
+import zlib
 
 import numpy as np
 import pytest
@@ -43,7 +45,7 @@ def read_table(path):
     """A table the tool wrote: (first line, columns, rows as float64)."""
     with open(path) as f:
         head, header = f.readline().rstrip("\n"), f.readline().rstrip("\n").split(",")
-        rows = [[float(x) for x in line.rstrip("\n").split(",")] for line in f]
+        rows = [[float(x) for x in line.rstrip("\n").split(",")] for line in f if not line.startswith("# end;")]
     return head, header, np.array(rows, dtype=np.float64).reshape(len(rows), len(header))
 
 
@@ -162,6 +164,26 @@ def test_to_csv_is_the_tool_table(small, small_tool, grasp_tool, tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["mine.csv"]
 
 
+def test_to_csv_ends_with_the_crc32_the_tool_checks(cli, small, small_tool, tmp_path):
+    # The last line: the rows again and the CRC-32 of the row lines' bytes; a table from to_csv
+    # merges as a part (the tool reads and checks it), and one with a digit changed is refused.
+    r = kdl_space.study(str(small), threads=2)
+    r.to_csv(tmp_path / "mine.csv")
+    data = (tmp_path / "mine.csv").read_bytes()
+    lines = data.split(b"\n")
+    assert lines[-1] == b"" and lines[-2] == b"# end; rows 0-60; crc32 %08x" % zlib.crc32(b"".join(l + b"\n" for l in lines[2:-2]))
+    run_cli(cli, small, "--merge", tmp_path / "mine.csv", "-o", tmp_path / "merged.csv", cwd=tmp_path)
+    assert (tmp_path / "merged.csv").read_bytes() == small_tool[0].read_bytes()
+    at = data.index(b",", data.index(b"\n3,") + 4) + 3  # a digit of sample 3's first input
+    changed = data[:at] + (b"1" if data[at:at + 1] != b"1" else b"2") + data[at + 1:]
+    (tmp_path / "changed.csv").write_bytes(changed)
+    with pytest.raises(subprocess.CalledProcessError) as e:
+        run_cli(cli, small, "--merge", tmp_path / "changed.csv", "-o", tmp_path / "never.csv", cwd=tmp_path)
+    assert e.value.returncode == 3
+    assert f"{tmp_path / 'changed.csv'}:63: the rows' checksum is " in e.value.stderr
+    assert not (tmp_path / "never.csv").exists()
+
+
 def test_to_csv_formats_doubles_as_c_does():
     libc = ctypes.CDLL(None)
     buf = ctypes.create_string_buffer(64)
@@ -216,6 +238,7 @@ def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
         r = kdl_space.study(str(study_file), threads=2)
         expected = dict(expected)
         del expected["table"]  # the tool's file; a result in memory has none
+        expected.setdefault("quantile_rank_error", 0.0)  # until the tool's --json writes it: exact here
         same(r.summary, expected, "summary")
         assert r.summary["samples"] == r.study.samples and r.summary["failed"] == r.failed == 0
         assert r.summary["fingerprint"] == f"{r.study.fingerprint:016x}"
@@ -287,3 +310,59 @@ def test_bad_inputs(small, tmp_path):
     with pytest.raises(KeyError, match="no column"):
         r["impulse"]
     assert len(r) == 3 and bit_identical(r["sample"], np.arange(3.0))
+
+
+def test_rows_answer_ctrl_c_within_half_a_second(tmp_path):
+    # Each sample a capture and half a second of motion (about 6 ms); 512,000 samples: chunks of
+    # 2,000 (about 13 s each on one thread); rows 0..4,000 would take about half a minute. SIGINT
+    # to this process after 0.3 s: KeyboardInterrupt within 0.5 s.
+    path = tmp_path / "long_study.yaml"
+    path.write_text(SMALL_STUDY.replace("samples: 60", "samples: 512000") + "motion: {duration: 0.5}\n")
+    s = kdl_space.load_study(str(path))
+    assert s.default_chunk_size == 2000
+    sent = []
+
+    def interrupt():
+        sent.append(time.monotonic())
+        signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+
+    timer = threading.Timer(0.3, interrupt)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            s.rows(0, 4000, threads=1)
+        answered = time.monotonic()
+    finally:
+        timer.cancel()
+        timer.join()
+    assert sent and sent[0] - start >= 0.29, "the signal came while rows() ran"
+    latency = answered - sent[0]
+    print(f"rows() answered SIGINT in {latency * 1e3:.0f} ms")
+    assert latency < 0.5
+    # the study runs again afterwards (no thread or state left behind)
+    assert s.rows(0, 3).shape == (3, len(s.columns))
+
+
+def test_summary_states_its_quantile_rank_error(small):
+    s = kdl_space.load_study(str(small))
+    rows = s.rows(0, 60, threads=2)
+    assert s.summary(rows)["quantile_rank_error"] == 0.0  # 60 samples: exact
+    # 70,000 rows made up from these (the summary takes any rows of the study): past the sketch's
+    # first buffer of 65,536, the error of the quantiles' ranks is bounded and stated.
+    big = np.tile(rows, (1167, 1))[:70000].copy()
+    big[:, 0] = np.arange(70000)
+    rng = np.random.default_rng(3)
+    rate = s.columns.index("base_rate")
+    big[:, rate] = rng.exponential(1.0, 70000)
+    summary = s.summary(big)
+    e = summary["quantile_rank_error"]
+    assert 0.0 < e <= 1 / 65536 + math.floor(math.log2(70000 / 16384)) / 16384
+    ordered = np.sort(big[:, rate])
+    n = len(ordered)
+    for key, p in (("q05", 0.05), ("median", 0.5), ("q95", 0.95)):
+        r, slack = math.floor(p * (n - 1)), math.ceil(e * n)
+        assert ordered[r - slack] <= summary["outcomes"]["base_rate"][key] <= ordered[min(n - 1, r + 1 + slack)], key
+    assert summary["outcomes"]["base_rate"]["min"] == ordered[0] and summary["outcomes"]["base_rate"]["max"] == ordered[-1]
+    # the mean: the exact sum rounded once (math.fsum is correctly rounded too), over n
+    assert summary["outcomes"]["base_rate"]["mean"] == math.fsum(ordered) / n

@@ -1,4 +1,5 @@
-// The embedded engine: a study's chunks on this machine's threads, one evaluator each.
+// The embedded engine: a study's chunks on this machine's threads, one evaluator each, handed out
+// from a counter (a grid of chunks is never listed), a cancel seen between samples.
 #include <algorithm>
 #include <exception>
 #include <mutex>
@@ -23,24 +24,37 @@ std::uint64_t defaultChunkSize(std::uint64_t samples) {
   return std::clamp<std::uint64_t>(samples / 256, 16, 65536);
 }
 
-void runStudy(const std::shared_ptr<const Study>& study, const std::vector<StudyChunk>& chunks, unsigned threads,
-              const std::function<void(const StudyChunk&, const std::vector<double>& rows)>& done,
-              const std::atomic<bool>* cancel) {
+namespace {
+
+/// The engine: chunks 0..count-1 (chunk(k)) handed to the threads from a counter.
+void runChunks(const std::shared_ptr<const Study>& study, std::uint64_t count,
+               const std::function<StudyChunk(std::uint64_t)>& chunk, unsigned threads, const StudyChunkDone& done,
+               const std::atomic<bool>* cancel, const std::function<bool(const StudyChunk&)>& skip) {
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(chunks.size(), 1)));
-  std::atomic<std::size_t> next{0};
+  threads = static_cast<unsigned>(std::min<std::uint64_t>(threads, std::max<std::uint64_t>(count, 1)));
+  std::atomic<std::uint64_t> next{0};
   std::atomic<bool> failed{false};
-  std::mutex report;
+  std::mutex report, skipping;
   std::exception_ptr error;
+  // Seen between samples, not only between chunks: a chunk is up to 65,536 samples (seconds).
+  const auto stop = [&] {
+    return failed.load(std::memory_order_relaxed) || (cancel && cancel->load(std::memory_order_relaxed));
+  };
   const auto work = [&] {
     try {
       StudyEvaluator evaluator(study);
+      const std::size_t m = evaluator.columns();
       std::vector<double> rows;
-      for (std::size_t k; !failed && !(cancel && *cancel) && (k = next++) < chunks.size();) {
-        const StudyChunk& c = chunks[k];
-        rows.resize(static_cast<std::size_t>(c.end - c.begin) * evaluator.columns());
-        for (std::uint64_t i = c.begin; i < c.end; ++i)
-          evaluator.evaluate(i, rows.data() + static_cast<std::size_t>(i - c.begin) * evaluator.columns());
+      for (std::uint64_t k; !stop() && (k = next++) < count;) {
+        const StudyChunk c = chunk(k);
+        if (skip) {
+          const std::lock_guard<std::mutex> lock(skipping);
+          if (skip(c)) continue;
+        }
+        rows.resize(static_cast<std::size_t>(c.end - c.begin) * m);
+        std::uint64_t i = c.begin;
+        for (; i < c.end && !stop(); ++i) evaluator.evaluate(i, rows.data() + static_cast<std::size_t>(i - c.begin) * m);
+        if (i < c.end) break;  // cut short: not reported
         const std::lock_guard<std::mutex> lock(report);
         if (!failed) done(c, rows);
       }
@@ -55,6 +69,27 @@ void runStudy(const std::shared_ptr<const Study>& study, const std::vector<Study
   work();
   for (std::thread& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+void runStudy(const std::shared_ptr<const Study>& study, const StudyGrid& grid, unsigned threads,
+              const StudyChunkDone& done, const std::atomic<bool>* cancel,
+              const std::function<bool(const StudyChunk&)>& skip) {
+  const std::uint64_t size = std::max<std::uint64_t>(grid.chunk_size, 1);
+  if (grid.end <= grid.begin) return;
+  const std::uint64_t first = grid.begin / size, count = (grid.end - 1) / size - first + 1;
+  const auto chunk = [&](std::uint64_t k) {
+    const std::uint64_t from = (first + k) * size;  // <= end - 1: no overflow
+    return StudyChunk{std::max(grid.begin, from), grid.end - from > size ? from + size : grid.end};
+  };
+  runChunks(study, count, chunk, threads, done, cancel, skip);
+}
+
+void runStudy(const std::shared_ptr<const Study>& study, const std::vector<StudyChunk>& chunks, unsigned threads,
+              const StudyChunkDone& done, const std::atomic<bool>* cancel) {
+  runChunks(study, chunks.size(), [&](std::uint64_t k) { return chunks[static_cast<std::size_t>(k)]; }, threads, done,
+            cancel, {});
 }
 
 }  // namespace kdl_space

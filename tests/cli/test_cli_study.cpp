@@ -74,8 +74,9 @@ TEST(StudyCommand, TheTableIsTheSameOnOneThreadOnTwoAndFromThreeShardsMerged) {
   EXPECT_NE(head.find("; samples 400; rows 0-400"), std::string::npos) << head;
   EXPECT_EQ(header.rfind("sample,status,robot.self_motion,target.tumble,target.tumble.axis_x", 0), 0u) << header;
   int rows = 0;
-  while (std::getline(lines, row)) ++rows;
+  while (std::getline(lines, row) && row.rfind("# end; rows 0-400; crc32 ", 0) != 0) ++rows;
   EXPECT_EQ(rows, 400);
+  EXPECT_FALSE(std::getline(lines, row)) << "the checksum's line is the last";
 }
 
 TEST(StudyCommand, AnInterruptedRunResumesFromTheChunksOnDisk) {
