@@ -1,6 +1,8 @@
 #include "csv_writer.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 
 namespace kdl_space::cli {
@@ -20,6 +22,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
 }
 
 void CsvWriter::write(const MotionSample& s) {
+  errno = 0;  // what a failed flush leaves there says why
   out_ << s.t;
   for (int i = 0; i < 3; ++i) out_ << ',' << s.p(i);
   for (int i = 0; i < 4; ++i) out_ << ',' << s.quat(i);
@@ -35,11 +38,19 @@ void CsvWriter::write(const MotionSample& s) {
   out_ << ',' << toString(s.phase) << ',';
   if (!std::isnan(s.grasp_distance)) out_ << s.grasp_distance;  // empty outside the approach
   out_ << '\n';
+  if (!out_) failed();  // a buffer that could not be flushed sets badbit
+  ++rows_;
 }
 
 void CsvWriter::close() {
+  errno = 0;
   out_.close();
-  if (!out_) throw InputError("--csv " + file_.path() + ": write failed (disk full?)");
+  if (!out_) failed();
+}
+
+void CsvWriter::failed() const {
+  throw InputError("--csv " + file_.path() + ": cannot write after " + std::to_string(rows_) + " rows (disk full?)" +
+                   (errno ? std::string(": ") + std::strerror(errno) : std::string()));
 }
 
 }  // namespace kdl_space::cli

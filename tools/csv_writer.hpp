@@ -16,7 +16,10 @@ class CsvWriter {
   /// Opens the temporary file and writes the header; throws InputError if it cannot.
   /// `base_control`: the base control's wrench columns are written.
   CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control);
+  /// One row; throws InputError at once when it cannot be written (a full disk): the run stops
+  /// there rather than computing rows that are lost.
   void write(const MotionSample& s);
+  std::size_t rows() const { return rows_; }
   /// Flushes and closes the temporary file; throws InputError if a write failed.
   void close();
   /// The file, to commit (or retract) once every output is complete.
@@ -26,6 +29,9 @@ class CsvWriter {
   AtomicFile file_;
   std::ofstream out_;
   bool base_control_;
+  std::size_t rows_ = 0;
+  /// "cannot write after N rows (disk full?)", with the system's reason when it gave one.
+  [[noreturn]] void failed() const;
 };
 
 }  // namespace kdl_space::cli

@@ -2,7 +2,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <memory>
 #include <optional>
 
@@ -42,40 +44,80 @@ void checkOutputs(const SimulateOptions& o) {
 
 std::string title(const Scenario& sc) { return "kdl_space simulate " + fs::path(sc.file).filename().string(); }
 
-/// An approach that never reached its grasp: what happened is written out (the CSV, the plot)
-/// before the run is refused.
-void writeApproachOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& partial) {
-  const std::vector<std::string>& joints = sc.capture.robot.model->jointNames();
-  if (!o.csv.empty()) {
-    CsvWriter csv(o.csv, joints, sc.simulation.base_control.on());
-    for (const MotionSample& x : partial.approach_samples) csv.write(x);
-    csv.close();
-    csv.file().commit();
-  }
-  if (!o.plot.empty()) {
-    AtomicFile plot(o.plot, "--plot");
-    writePlot(plot, partial.approach_samples, joints, title(sc) + ": the approach", true);
-    plot.commit();
-  }
+/// The run's size is known before it starts: refused (exit 2) past --max-output-rows, with what
+/// to change.
+void checkOutputSize(const SimulateOptions& o, const Scenario& sc, const OperationOptions& options) {
+  const double rows = estimatedOutputRows(sc, options);
+  if (rows <= o.max_output_rows) return;
+  std::ostringstream why;
+  const auto count = [&](double n) {  // digits, not 1e+07
+    if (n < 1e18) why << static_cast<unsigned long long>(n); else why << n;
+  };
+  why << std::setprecision(6) << "simulate " << o.scenario << ": the run would give up to ";
+  count(rows);
+  why << " output rows (";
+  if (sc.approach) why << "an approach of up to " << sc.approach->max_duration << " s (approach.max_duration) and ";
+  why << options.duration.value_or(sc.simulation.duration) << " s of motion, a row every "
+      << sc.simulation.output_step << " s), more than --max-output-rows ";
+  count(o.max_output_rows);
+  why << ": give a coarser simulation.output_step, a shorter --duration, or raise --max-output-rows";
+  throw UsageError(why.str());
 }
 
-/// The plot and the scene of a finished run, under temporary names; then every output gets its
-/// name (a failed rename takes the others back).
-void writeOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& r, std::optional<CsvWriter>& csv) {
-  if (csv) csv->close();
-  std::unique_ptr<AtomicFile> plot_file, scene_file;
-  if (!o.plot.empty()) {
-    plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
-    std::vector<MotionSample> all = r.approach_samples;
-    all.insert(all.end(), r.samples.begin(), r.samples.end());
-    writePlot(*plot_file, all, r.model->jointNames(), title(sc), r.record.torques || r.approach,
-              sc.impact && r.approach ? r.t_capture : std::numeric_limits<double>::quiet_NaN());
+/// The files written as the samples come (the CSV's rows, the plot's data): opened at the first
+/// sample, when the system's joints are known; nothing is named until every output is complete.
+struct Streams {
+  std::optional<CsvWriter> csv;
+  std::unique_ptr<AtomicFile> plot_file;
+  std::optional<PlotWriter> plot;
+
+  explicit Streams(const SimulateOptions& o) {
+    if (!o.plot.empty()) plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
   }
+  void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
+    if (!o.csv.empty()) {
+      if (!csv) csv.emplace(o.csv, joints, sc.simulation.base_control.on());
+      csv->write(x);
+    }
+    if (plot_file) {
+      if (!plot) plot.emplace(*plot_file, joints);
+      plot->add(x);
+    }
+  }
+};
+
+/// An approach that never reached its grasp: what happened is written out (the CSV, the plot)
+/// before the run is refused (its samples are held: at most approach.max_duration's).
+void writeApproachOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& partial, Streams& out) {
+  const std::vector<std::string>& joints = sc.capture.robot.model->jointNames();
+  for (const MotionSample& x : partial.approach_samples) out.add(o, sc, joints, x);
+  if (out.csv) out.csv->close();
+  if (out.plot) out.plot->draw(title(sc) + ": the approach", true);
+  if (out.csv) out.csv->file().commit();
+  if (out.plot_file) out.plot_file->commit();
+}
+
+/// Ctrl-C while the outputs are drawn: nothing is named.
+void checkInterrupt() {
+  if (interruptFlag().load()) throw Interrupted("simulate: after the run, while drawing its outputs; no output written");
+}
+
+/// The plot (from the streamed data) and the scene of a finished run, under temporary names; then
+/// every output gets its name (a failed rename takes the others back).
+void writeOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& r, Streams& out) {
+  if (out.csv) out.csv->close();
+  if (out.plot)
+    out.plot->draw(title(sc), r.record.torques || r.approach,
+                   sc.impact && r.approach ? r.t_capture : std::numeric_limits<double>::quiet_NaN());
+  std::unique_ptr<AtomicFile> scene_file;
   if (!o.scene.empty()) {
     scene_file = std::make_unique<AtomicFile>(o.scene, "--scene");
     writeScene(*scene_file, sceneSnapshots(sc, r), title(sc), "--scene");
   }
-  if (csv) csv->file().commit();
+  checkInterrupt();
+  AtomicFile* csv_file = out.csv ? &out.csv->file() : nullptr;
+  AtomicFile* plot_file = out.plot ? out.plot_file.get() : nullptr;
+  if (csv_file) csv_file->commit();
   try {
     if (plot_file) plot_file->commit();
     try {
@@ -85,7 +127,7 @@ void writeOutputs(const SimulateOptions& o, const Scenario& sc, const OperationR
       throw;
     }
   } catch (const InputError&) {
-    if (csv) csv->file().retract();
+    if (csv_file) csv_file->retract();
     throw;
   }
 }
@@ -106,6 +148,10 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
   cmd->add_option("--scene", o.scene, "Draw the scene in 3-D at the start, at the contact and at the end (.svg or .png)")
       ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
+  cmd->add_option("--max-output-rows", o.max_output_rows,
+                  "Refuse a run that could give more output rows (samples of the approach and the motion) than this, "
+                  "before it starts (default 10000000)")
+      ->type_name("N")->check(positiveNumber());
   return cmd;
 }
 
@@ -116,21 +162,24 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     refuseOverwritingInputs(option, path, scenarioInputs(sc));  // the URDFs it names too
   OperationOptions options;
   options.duration = o.duration;
-  options.keep_samples = !o.plot.empty();  // the plot draws them all; the CSV is written as they come
-  std::optional<CsvWriter> csv;
-  if (!o.csv.empty())
+  checkOutputSize(o, sc, options);
+  options.keep_samples = false;  // the CSV and the plot's data are written as the samples come
+  options.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
+  Streams streams(o);
+  if (!o.csv.empty() || !o.plot.empty())
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
-      if (!csv) csv.emplace(o.csv, so_far.model->jointNames(), sc.simulation.base_control.on());
-      csv->write(x);
+      streams.add(o, sc, so_far.model->jointNames(), x);
     };
   OperationResult r;
   try {
     r = runCaptureOperation(sc, options);
   } catch (const OperationError& e) {
-    if (e.partial() && e.partial()->approach && !e.partial()->approach->record.reached) writeApproachOutputs(o, sc, *e.partial());
+    // Ctrl-C: the temporaries go with `streams`; nothing partial is left.
+    if (e.code() == E_CANCELLED) throw Interrupted(std::string(e.what()) + "; no output written");
+    if (e.partial() && e.partial()->approach && !e.partial()->approach->record.reached) writeApproachOutputs(o, sc, *e.partial(), streams);
     throw;  // the temporaries are removed: no file is left
   }
-  writeOutputs(o, sc, r, csv);
+  writeOutputs(o, sc, r, streams);
   const OperationFiles files{o.csv, o.plot};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

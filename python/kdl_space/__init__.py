@@ -74,6 +74,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     E_MAX_STEPS,
     E_BAD_ARGUMENT,
     E_STEP_UNDERFLOW,
+    E_CANCELLED,
 )
 from .study import StudyResult, study  # noqa: F401  (the engines: threads, Dask)
 
@@ -86,5 +87,5 @@ __all__ = [
     "check_urdf", "codes", "load_scenario", "load_study", "load_urdf", "run_operation", "solve_capture", "solve_impact",
     "str_error", "study", "virtual_mass",
     "E_NOERROR", "E_SIZE_MISMATCH", "E_NOT_COMPUTED", "E_NOT_FINITE", "E_NOT_POSITIVE_DEFINITE",
-    "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW",
+    "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW", "E_CANCELLED",
 ]

@@ -135,7 +135,7 @@ void bindErrors(py::module_& m) {
            {"E_NOERROR", E_NOERROR}, {"E_SIZE_MISMATCH", E_SIZE_MISMATCH}, {"E_NOT_COMPUTED", E_NOT_COMPUTED},
            {"E_NOT_FINITE", E_NOT_FINITE}, {"E_NOT_POSITIVE_DEFINITE", E_NOT_POSITIVE_DEFINITE},
            {"E_BAD_CONTACT", E_BAD_CONTACT}, {"E_MAX_STEPS", E_MAX_STEPS}, {"E_BAD_ARGUMENT", E_BAD_ARGUMENT},
-           {"E_STEP_UNDERFLOW", E_STEP_UNDERFLOW}}) {
+           {"E_STEP_UNDERFLOW", E_STEP_UNDERFLOW}, {"E_CANCELLED", E_CANCELLED}}) {
     codes.attr(n) = c;
     m.attr(n) = c;
   }

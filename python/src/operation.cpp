@@ -8,6 +8,7 @@
 #include "conversions.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "operation_report.hpp"
+#include "simulation_types.hpp"
 
 namespace kdl_space::python {
 namespace {
@@ -50,7 +51,8 @@ py::dict samplesDict(const OperationResult& r) {
 }
 
 py::dict runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
-                      py::object observer, py::object controller, py::object control_rate) {
+                      py::object observer, py::object controller, py::object control_rate,
+                      std::uint64_t max_output_rows) {
   const Scenario& sc = ps.scenario;
   OperationOptions o;
   if (!duration.is_none()) {
@@ -64,6 +66,9 @@ py::dict runOperation(const PyScenario& ps, py::object duration, py::object outp
       throw py::value_error("output_step: expected a finite step > 0 s, got " + std::to_string(*o.output_step));
   }
   o.approach = approach, o.motion = motion;
+  // Every sample is kept (the result's arrays): their count is checked before the run.
+  checkOutputRows("run_operation", estimatedOutputRows(sc, o), max_output_rows, "output_step (simulation.output_step)");
+  o.cancelled = SignalPoll();  // Ctrl-C between the samples too
   if (!controller.is_none() && !PyCallable_Check(controller.ptr()))
     throw py::type_error("controller: expected a callable controller(t, q, qdot, base_pose, base_twist) -> tau");
   if (!observer.is_none() && !PyCallable_Check(observer.ptr()))
@@ -106,6 +111,7 @@ void bindOperation(py::module_& m) {
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
         py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,
         py::arg("observer") = py::none(), py::arg("controller") = py::none(), py::arg("control_rate") = py::none(),
+        py::arg("max_output_rows") = std::uint64_t{10'000'000},
         "The scenario's capture operation as `kdl_space simulate` runs it: the approach (if any), the capture at "
         "the contact instant, the system after it and `duration` s of its motion (None: the scenario's). Returns "
         "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
@@ -114,7 +120,9 @@ void bindOperation(py::module_& m) {
         "joint_names). `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
         "`observer(t, phase, q, qdot)` sees every sample. InputError naming the scenario's file for what cannot "
-        "be run or failed.");
+        "be run or failed. The samples are kept in memory: a run that could give more than max_output_rows "
+        "(approach.max_duration and duration over the output step) is refused (ValueError) before it starts. "
+        "Ctrl-C raises KeyboardInterrupt within about 0.1 s.");
 }
 
 }  // namespace kdl_space::python

@@ -80,11 +80,16 @@ struct PySimulator {
 }
 
 PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, py::object controller,
-          py::object control_rate, double t0) {
+          py::object control_rate, double t0, std::uint64_t max_output_rows) {
   w.notFromController();
   const FloatingModel& model = *w.model.ptr;
   SimulationState s = w.stateOf(start, "state");
   s.t = t0;
+  // Every sample is kept: its count (t0, every output_dt, t_end) is checked first (a span or a
+  // step the run refuses with its code is left to it).
+  if (std::isfinite(t_end) && std::isfinite(t0) && output_dt > 0.0 && t_end >= t0)
+    checkOutputRows("Simulator.run", std::ceil((t_end - t0) / output_dt * (1.0 - 1e-12)) + 1.0, max_output_rows,
+                    "output_dt");
   if (!controller.is_none() && !PyCallable_Check(controller.ptr()))
     throw py::type_error("controller: expected a callable controller(t, q, qdot, base_pose, base_twist) -> tau");
   if (controller.is_none() && !control_rate.is_none()) throw py::value_error("control_rate: given without a controller");
@@ -126,9 +131,13 @@ PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, 
     std::lock_guard<std::mutex> lock(w.mutex);
     struct Guard {  // whoever runs: cleared when the run ends, however it ends
       PySimulator& w;
-      ~Guard() { w.runner = std::thread::id(); }
+      ~Guard() {
+        w.runner = std::thread::id();
+        w.sim->setCancelPoll(nullptr);
+      }
     } guard{w};
     w.runner = std::this_thread::get_id();
+    w.sim->setCancelPoll(SignalPoll());  // and between the samples, however rare
     rc = runSampled(*w.sim, s, t_end, output_dt, sampled, rate, observer);
   }
   PyRun result(samples, PyState{w.model.ptr, s.state, s.velocity}, PyStats{w.sim->stats(), model.jointNames()});
@@ -348,13 +357,16 @@ void bindSimulation(py::module_& m) {
       }, "Each joint's Coulomb regularisation v_s of the last run (nj,).")
       .def("run", &run, py::arg("state"), py::arg("t_end"), py::arg("output_dt"), py::kw_only(),
            py::arg("controller") = py::none(), py::arg("control_rate") = py::none(), py::arg("t0") = 0.0,
+           py::arg("max_output_rows") = std::uint64_t{10'000'000},
            "Integrates from `state` at time t0 to t_end; samples at t0, every output_dt and t_end "
            "(SimulationResult). controller(t, q, qdot, base_pose (4, 4), base_twist (6,)) -> tau (nj,) (or a dict "
            "by joint name), added to the joint controls' torques: with control_rate [Hz], called at t0 + k / "
            "control_rate with the state there and held constant until the next (zero-order hold; output_dt and "
            "the period must be commensurate); without, called at every derivative evaluation. The GIL is released "
            "while integrating; an exception in the controller ends the run and propagates; a nonzero return "
-           "code raises ComputeError with .code, .t (how far the run got) and .result (the samples so far).")
+           "code raises ComputeError with .code, .t (how far the run got) and .result (the samples so far). "
+           "Every sample is kept in memory: a run of more than max_output_rows samples is refused (ValueError) "
+           "before it starts. Ctrl-C raises KeyboardInterrupt within about 0.1 s, between samples too.")
       .def("__repr__", [](const PySimulator& w) {
         std::ostringstream s;
         s << "<kdl_space.Simulator of " << w.model.source << ": " << w.model.ptr->nj() << " joints, "

@@ -2,12 +2,50 @@
 // given by name or index, a set of locked joints, a run's samples and its result.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "conversions.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
 namespace kdl_space::python {
+
+/// \brief Ctrl-C in a run that holds no GIL (Simulator::setCancelPoll, OperationOptions::cancelled):
+/// about every 50 ms of the run it takes the GIL and lets Python handle a pending signal, so that
+/// a KeyboardInterrupt (or what a handler raises) ends the run there, however rare its output
+/// samples. By time rather than by steps: a step takes 1 us on a small arm, milliseconds on a
+/// large one with the Rosenbrock method. Between: a counter, and the clock every 8th call.
+class SignalPoll {
+ public:
+  bool operator()() {
+    if (++calls_ % 8 != 0) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(50)) return false;
+    last_ = now;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    return false;
+  }
+
+ private:
+  unsigned calls_ = 0;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/// \brief Refuses (ValueError) a run whose `rows` samples, each kept in memory, would exceed
+/// `limit` (the keyword max_output_rows), saying what to change.
+inline void checkOutputRows(const char* call, double rows, std::uint64_t limit, const std::string& step_name) {
+  if (!(rows > static_cast<double>(limit))) return;
+  std::ostringstream why;
+  why << call << ": the run would keep up to ";
+  if (rows < 1e18) why << static_cast<unsigned long long>(rows); else why << rows;
+  why << " samples in memory, more than max_output_rows = " << limit << ": give a coarser " << step_name
+      << ", a shorter duration, or raise max_output_rows";
+  throw py::value_error(why.str());
+}
 
 struct PyStats {
   SimulationStats stats;

@@ -113,3 +113,36 @@ def test_controller_observer_and_options():
         kdl_space.run_operation(scenario, duration=-1.0)
     with pytest.raises(ValueError, match=r"controller: tau"):
         kdl_space.run_operation(scenario, duration=0.2, controller=lambda *a: np.zeros(3))
+
+
+def test_max_output_rows_refuses_a_run_before_it_starts():
+    """The samples are kept: by hand, 1 s at the scenario's 0.05 s gives 21 (no approach)."""
+    scenario = kdl_space.load_scenario(str(SCENARIOS["tumbling_box_capture"]))
+    seen = []
+    with pytest.raises(ValueError, match=r"up to 21 samples in memory, more than max_output_rows = 20"):
+        kdl_space.run_operation(scenario, duration=1.0, max_output_rows=20, observer=lambda *a: seen.append(a))
+    assert seen == []  # refused before the run
+    assert len(kdl_space.run_operation(scenario, duration=1.0, max_output_rows=21)["samples"]["t"]) == 21
+    # An approach counts with its longest duration: 30 s at 0.05 s (601) and 1 s (21).
+    approach = kdl_space.load_scenario(str(SCENARIOS["approach_tumbling_box"]))
+    with pytest.raises(ValueError, match=r"up to 622 samples"):
+        kdl_space.run_operation(approach, duration=1.0, max_output_rows=621)
+
+
+def test_ctrl_c_ends_run_operation_within_half_a_second_however_rare_its_samples():
+    import os
+    import signal
+    import threading
+    import time
+
+    scenario = kdl_space.load_scenario(str(SCENARIOS["tumbling_box_capture"]))
+    sent = []
+    timer = threading.Timer(1.0, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT)))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):  # samples at 0 and 4e4 s only; 8e5 steps of 0.05 s
+            kdl_space.run_operation(scenario, duration=4e4, output_step=4e4)
+    finally:
+        timer.cancel()
+        timer.join()
+    assert sent and time.monotonic() - sent[0] < 0.5

@@ -415,3 +415,49 @@ def test_ctrl_c_ends_a_run_at_the_next_output_sample(arm):
         timer.join()
         assert time.monotonic() - start < 10.0  # (a KeyboardInterrupt after the run would come too late)
     assert len(sim.run(state, t_end=0.02, output_dt=0.01)) == 3  # usable after it
+
+
+def interrupt_after(seconds, run):
+    """Runs `run()` with SIGINT sent to this process after `seconds`; the seconds from the signal
+    to the KeyboardInterrupt."""
+    import os
+    import signal
+    import threading
+    import time
+
+    sent = []
+    timer = threading.Timer(seconds, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT)))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run()
+    finally:
+        timer.cancel()
+        timer.join()
+    assert sent, "the run ended before the signal"
+    return time.monotonic() - sent[0]
+
+
+def test_ctrl_c_ends_a_run_within_half_a_second_however_rare_its_samples(arm):
+    """Samples only at the start and the end of 1e4 s (minutes of CPU): Ctrl-C is seen between them,
+    without a controller and with one sampled every 1000 s."""
+    sim = kdl_space.Simulator(arm, integrator="rk4", step=1e-3, max_steps=10**9)
+    state = kdl_space.State(arm, qdot=np.full(arm.nj, 0.1))
+    latency = interrupt_after(1.0, lambda: sim.run(state, t_end=1e4, output_dt=1e4))
+    assert latency < 0.5
+    latency = interrupt_after(1.0, lambda: sim.run(state, t_end=1e4, output_dt=1e4, controller=lambda *a: np.zeros(arm.nj),
+                                                   control_rate=1e-3))
+    assert latency < 0.5
+    assert len(sim.run(state, t_end=0.02, output_dt=0.01)) == 3  # usable after it
+
+
+def test_a_run_that_would_keep_more_samples_than_max_output_rows_is_refused(arm):
+    """Every sample is kept: t0, every output_dt, t_end (by hand: 1 s at 0.01 s is 101 samples)."""
+    sim = kdl_space.Simulator(arm)
+    state = kdl_space.State(arm)
+    with pytest.raises(ValueError, match=r"up to 101 samples in memory, more than max_output_rows = 100: give a coarser output_dt"):
+        sim.run(state, t_end=1.0, output_dt=0.01, max_output_rows=100)
+    assert len(sim.run(state, t_end=1.0, output_dt=0.01, max_output_rows=101)) == 101
+    # The default (10 million) refuses 1e5 s at 1e-4 s before any step.
+    with pytest.raises(ValueError, match=r"up to 1000000001 samples in memory, more than max_output_rows = 10000000"):
+        sim.run(state, t_end=1e5, output_dt=1e-4)

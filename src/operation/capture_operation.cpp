@@ -168,6 +168,7 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
 
   std::unique_ptr<Simulator> simulator = operation::simulatorFor(sc, r.model, false);
   Simulator& sim = *simulator;
+  sim.setCancelPoll(o.cancelled);
   SimulationState s;
   s.t = t_capture;
   s.state = r.joined ? r.joined->state : problem.robot.state;
@@ -193,6 +194,12 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, r.record.stiffness))
     throw OperationError(sc.file + ": simulation: " + strError(src), src, std::make_shared<const OperationResult>(r));
+  if (rc == E_CANCELLED) {
+    std::ostringstream why;
+    why << std::setprecision(6) << sc.file << ": the simulation was cancelled at t = " << s.t << " s of "
+        << t_capture + r.duration << " s";
+    throw OperationError(why.str(), rc, std::make_shared<const OperationResult>(r));
+  }
   if (rc || observer_rc) {
     std::ostringstream why;
     why << sc.file << ": simulation failed at t = " << s.t << " s of " << r.duration << " s: "
@@ -200,7 +207,18 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(r));
   }
   if (!r.joined)
-    r.target_motion = operation::separatedTarget(sc, problem, capture, t_capture, t_capture + r.duration, r.output_step);
+    r.target_motion =
+        operation::separatedTarget(sc, problem, capture, t_capture, t_capture + r.duration, r.output_step, o.cancelled);
+}
+
+double estimatedOutputRows(const Scenario& sc, const OperationOptions& o) {
+  const double output_step = o.output_step.value_or(sc.simulation.output_step);
+  // Simulator::run's samples: the start, every multiple of the step after it, and the end.
+  const auto rows = [&](double duration) { return std::ceil(duration / output_step * (1.0 - 1e-12)) + 1.0; };
+  double n = 0.0;
+  if (sc.approach && o.approach) n += rows(sc.approach->max_duration);
+  if (o.motion) n += rows(o.duration.value_or(sc.simulation.duration));
+  return n;
 }
 
 OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& o) {
@@ -211,7 +229,7 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
   if (o.motion) checkStepBudget(sc, r.duration, r.output_step);
   r.at_contact = sc.capture;
   SimulationState s;
-  if (sc.approach && o.approach) operation::approach(sc, r.output_step, r, s);
+  if (sc.approach && o.approach) operation::approach(sc, r.output_step, o.cancelled, r, s);
   std::optional<CaptureResult> capture;
   if (sc.impact) capture = inScenario(sc, [&] { return solveCapture(r.at_contact); });
   const CaptureProblem at_contact = r.at_contact;

@@ -31,9 +31,11 @@ std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
 
 }  // namespace
 
-void approach(const Scenario& sc, double output_step, OperationResult& result, SimulationState& s) {
+void approach(const Scenario& sc, double output_step, const std::function<bool()>& cancelled, OperationResult& result,
+              SimulationState& s) {
   const FloatingSystem& robot = sc.capture.robot;
   std::unique_ptr<Simulator> sim = simulatorFor(sc, robot.model, true);
+  sim->setCancelPoll(cancelled);
   const auto controller = inScenario(sc, [&] {
     try {
       return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach,
@@ -57,7 +59,11 @@ void approach(const Scenario& sc, double output_step, OperationResult& result, S
   const int rc = runApproach(*sim, *controller, s, output_step, observer, outcome.record);
   if (rc || observer_rc) {
     std::ostringstream why;
-    why << sc.file << ": the approach failed at t = " << s.t << " s: " << strError(rc ? rc : observer_rc);
+    if (rc == E_CANCELLED)
+      why << std::setprecision(6) << sc.file << ": the approach was cancelled at t = " << s.t << " s of at most "
+          << sc.approach->max_duration << " s";
+    else
+      why << sc.file << ": the approach failed at t = " << s.t << " s: " << strError(rc ? rc : observer_rc);
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(result));
   }
   if (const int e = controller->target(s.t, outcome.target_at_contact))
@@ -93,12 +99,13 @@ FloatingSystem oneBody(const RigidTarget& t, const Vector3d& contact_point, cons
 
 std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
                                             const std::optional<CaptureResult>& capture, double t0, double t_end,
-                                            double output_step) {
+                                            double output_step, const std::function<bool()>& cancelled) {
   const auto* target = std::get_if<FloatingSystem>(&problem.target);
   if (!target || !capture || !capture->floating_target) return std::nullopt;
   SimulationOptions options = sc.simulation.options;
   options.grounded = target->response == Response::Grounded;
   Simulator sim(target->model, options);
+  sim.setCancelPoll(cancelled);
   JointControl locked;
   locked.mode = JointControl::Mode::Locked;
   for (unsigned int j = 0; j < target->model->nj(); ++j)
@@ -122,8 +129,9 @@ std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CapturePro
   int rc = sim.engageBrakes(m.end);
   if (rc == E_NOERROR) rc = sim.run(m.end, t_end, output_step, observer);
   if (rc || observer_rc)
-    throw OperationError(sc.file + ": the target's motion after the impact failed at t = " + detail::number(m.end.t) +
-                             " s: " + strError(rc ? rc : observer_rc),
+    throw OperationError(sc.file + ": the target's motion after the impact " +
+                             (rc == E_CANCELLED ? "was cancelled" : "failed") + " at t = " + detail::number(m.end.t) +
+                             " s" + (rc == E_CANCELLED ? "" : std::string(": ") + strError(rc ? rc : observer_rc)),
                          rc ? rc : observer_rc, nullptr);
   return m;
 }

@@ -12,15 +12,17 @@ namespace kdl_space::operation {
 /// \brief The approach: from the robot's initial state until the hand holds the grasp point; its
 /// samples (the last one: the contact instant, Phase::Capture) go to result.approach_samples,
 /// the robot's and the target's states at the contact instant to result.at_contact, the robot's
-/// to s. \throws InputError (the scenario's terms) when the approach cannot run or fails.
-void approach(const Scenario& sc, double output_step, OperationResult& result, SimulationState& s);
+/// to s. `cancelled`: the caller's cancel poll (Simulator::setCancelPoll; may be empty).
+/// \throws InputError (the scenario's terms) when the approach cannot run or fails.
+void approach(const Scenario& sc, double output_step, const std::function<bool()>& cancelled, OperationResult& result,
+              SimulationState& s);
 
 /// \brief A free-floating target that separated after a point impact, moved on by itself from
 /// t0 to t_end (its own modes: braked joints stay braked; gravity as the robot's); nothing
 /// unless such a target separated.
 std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
                                             const std::optional<CaptureResult>& capture, double t0, double t_end,
-                                            double output_step);
+                                            double output_step, const std::function<bool()>& cancelled);
 
 /// The simulator as the scenario says, or its refusal in the scenario's words.
 std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,

@@ -39,8 +39,12 @@ int runSampled(Simulator& sim, SimulationState& s, double t_end, double output_d
   Eigen::VectorXd command = Eigen::VectorXd::Zero(n);
   bool commanded = false;
   int controller_rc = E_NOERROR;
+  // The controller's answer and the state at a control instant: sized once per run, not per call.
+  Eigen::VectorXd tau(n);
+  SimulationState now;
   const auto call = [&](const SimulationState& x) {
-    Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
+    if (tau.size() != n) tau.resize(n);  // a controller that resized it was refused: E_SIZE_MISMATCH
+    tau.setZero();
     controller(x, tau);
     if (tau.size() != n) controller_rc = E_SIZE_MISMATCH;
     else if (!tau.allFinite()) controller_rc = E_NOT_FINITE;
@@ -53,7 +57,6 @@ int runSampled(Simulator& sim, SimulationState& s, double t_end, double output_d
     const long i = outputs++;
     const bool last = x.t >= t_end;
     const SimulationState* row = &x;
-    SimulationState now;
     if (grid.a > 0 && i > 0 && i % grid.a == 0 &&
         (!last || std::abs(t0 + static_cast<double>(i) * grid.delta - t_end) <= 1e-9 * grid.delta)) {
       call(x);  // the command held from this instant on

@@ -293,6 +293,7 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   };
   while (t < t_end) {
     if (stats_.accepted_steps + stats_.rejected_steps >= options_.max_steps) return failed(E_MAX_STEPS);
+    if (cancelled_ && cancelled_()) return failed(E_CANCELLED);
     const double t_out = std::min(t0 + outputs * output_dt, t_end);
     const double t_next = std::min(t_out, nextSwitch(t));
     // Land exactly on the output time (or a wrench's switch) when within round-off of it (no

@@ -13,6 +13,7 @@ const char* strError(int code) {
     case E_MAX_STEPS: return "the simulation spent its step budget (is a controller unstable?)";
     case E_BAD_ARGUMENT: return "a parameter is out of its range";
     case E_STEP_UNDERFLOW: return "the adaptive step size fell to round-off (a stiff or singular motion)";
+    case E_CANCELLED: return "cancelled by the caller";
     default: return "unknown error";
   }
 }

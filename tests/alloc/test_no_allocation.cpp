@@ -19,6 +19,7 @@
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 #include "kdl_space/algorithm/recursive_ex_iit.hpp"
 #include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/simulation/sampled_control.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "detail/rosenbrock.hpp"
 #include "generated_chain.hpp"
@@ -343,11 +344,37 @@ TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
       s.state = randomState(*model, rng);
       s.velocity.qdot = KDL::JntArray(model->nj());
       ASSERT_EQ(sim.engageBrakes(s), E_NOERROR);  // a set-up call, outside the count
+      sim.setCancelPoll([] { return false; });  // polled before every step: allocates nothing either
       const auto observer = [&](const SimulationState& x) { EXPECT_TRUE(x.state.q.data.allFinite()); };
       const std::function<void(const SimulationState&)> watch = observer;  // constructed before counting
       ASSERT_EQ(sim.run(s, 0.05, 0.01, watch), E_NOERROR);                  // warm-up
       EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, s.t + 0.2, 0.05, watch), E_NOERROR); }), 0);
     }
+}
+
+TEST_P(EveryComputeCall, SampledControllerCallsAllocateNothing) {
+  // runSampled sets itself up (its callbacks, the controller's torque) once per run: a run with ten
+  // times as many controller calls allocates no more.
+  const auto model = load(GetParam());
+  std::mt19937 rng(7);
+  SimulationOptions options;
+  options.integrator = Integrator::RK4;
+  options.step = 0.005;
+  Simulator sim(model, options);
+  SimulationState start;
+  start.state = randomState(*model, rng);
+  start.velocity.qdot = KDL::JntArray(model->nj());
+  const SampledController controller = [](const SimulationState& s, Eigen::VectorXd& tau) {
+    tau = -0.1 * s.velocity.qdot.data;
+  };
+  const std::function<void(const SimulationState&)> watch = [](const SimulationState&) {};
+  SimulationState s = start;
+  ASSERT_EQ(runSampled(sim, s, 0.02, 0.01, controller, 200.0, watch), E_NOERROR);  // warm-up
+  const auto allocations = [&](double duration) {
+    SimulationState x = start;
+    return allocationsDuring([&] { EXPECT_EQ(runSampled(sim, x, duration, 0.01, controller, 200.0, watch), E_NOERROR); });
+  };
+  EXPECT_EQ(allocations(0.2), allocations(0.02)) << "40 controller calls against 4";
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, EveryComputeCall,

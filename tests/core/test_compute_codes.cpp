@@ -676,7 +676,7 @@ TEST_F(SideCodes, CollideReportsWhichPartRefusedAndKeepsNothing) {
 
 TEST(ErrorText, EveryCodeHasItsOwnText) {
   const int codes[] = {E_NOERROR,     E_SIZE_MISMATCH, E_NOT_COMPUTED,  E_NOT_FINITE, E_NOT_POSITIVE_DEFINITE,
-                       E_BAD_CONTACT, E_MAX_STEPS,     E_BAD_ARGUMENT, E_STEP_UNDERFLOW};
+                       E_BAD_CONTACT, E_MAX_STEPS,     E_BAD_ARGUMENT, E_STEP_UNDERFLOW, E_CANCELLED};
   std::set<std::string> texts{strError(12345)};
   for (int c : codes) texts.insert(strError(c));
   EXPECT_EQ(texts.size(), std::size(codes) + 1) << "distinct, and none is the unknown code's";

@@ -181,5 +181,57 @@ TEST(CaptureOperation, RunBeyondTheStepBudgetIsRefusedBeforeItStarts) {
   EXPECT_FALSE(observed);
 }
 
+TEST(CaptureOperation, CancelledRunStopsInTheApproachOrTheMotionWithWhatItDid) {
+  const Scenario sc = loadScenario(scenarioPath("approach_tumbling_box.yaml"));
+  // Cancelled in the approach: no step of the motion is taken.
+  long polls = 0;
+  OperationOptions o = shortRun(5.0);
+  o.cancelled = [&] { return ++polls > 20; };
+  try {
+    runCaptureOperation(sc, o);
+    FAIL() << "cancelled after 20 steps";
+  } catch (const OperationError& e) {
+    EXPECT_EQ(e.code(), E_CANCELLED);
+    EXPECT_NE(std::string(e.what()).find("the approach was cancelled at t = "), std::string::npos) << e.what();
+    ASSERT_TRUE(e.partial());
+    EXPECT_FALSE(e.partial()->capture);
+  }
+  // Cancelled in the motion after the capture: the polls of the approach, then some of the motion.
+  polls = 0;
+  OperationOptions plain = shortRun(5.0);
+  long approach_polls = 0;
+  plain.motion = false;
+  plain.cancelled = [&] { return ++approach_polls < 0; };
+  const OperationResult reached = runCaptureOperation(sc, plain);
+  o.cancelled = [&] { return ++polls > approach_polls + 10; };
+  try {
+    runCaptureOperation(sc, o);
+    FAIL() << "cancelled 10 steps into the motion";
+  } catch (const OperationError& e) {
+    EXPECT_EQ(e.code(), E_CANCELLED);
+    EXPECT_NE(std::string(e.what()).find("the simulation was cancelled at t = "), std::string::npos) << e.what();
+    ASSERT_TRUE(e.partial() && e.partial()->capture);
+    EXPECT_GT(e.partial()->end.t, reached.t_capture);
+    EXPECT_LT(e.partial()->end.t, reached.t_capture + 5.0);
+  }
+}
+
+TEST(CaptureOperation, OutputRowsAreEstimatedFromTheDurationsAndTheOutputStep) {
+  Scenario sc = loadScenario(scenarioPath("approach_tumbling_box.yaml"));
+  // By hand: each run gives its start, every output step after it, and its end.
+  sc.simulation.output_step = 0.05;
+  sc.approach->max_duration = 30.0;
+  OperationOptions o = shortRun(20.0);
+  EXPECT_EQ(estimatedOutputRows(sc, o), (600.0 + 1.0) + (400.0 + 1.0));
+  o.duration = 20.01;  // a last, shorter interval
+  EXPECT_EQ(estimatedOutputRows(sc, o), (600.0 + 1.0) + (401.0 + 1.0));
+  o.approach = false;
+  EXPECT_EQ(estimatedOutputRows(sc, o), 401.0 + 1.0);
+  o.output_step = 1e-6, o.duration = 1e5;  // beyond any integer row count a vector could hold
+  EXPECT_EQ(estimatedOutputRows(sc, o), 1e11 + 1.0);
+  o.motion = false;
+  EXPECT_EQ(estimatedOutputRows(sc, o), 0.0);
+}
+
 }  // namespace
 }  // namespace kdl_space

@@ -114,5 +114,40 @@ TEST_F(SampledControl, ControllerOfTheWrongSizeEndsTheRun) {
   EXPECT_LT(s.t, 0.5);
 }
 
+TEST_F(SampledControl, CancelPollIsAskedBeforeEveryStepAndStopsTheRunThere) {
+  SimulationOptions o;
+  o.integrator = Integrator::RK4;
+  o.step = 1e-3;
+  Simulator sim(model, o);
+  // A single output at the end: only the poll can stop the run before it.
+  long polls = 0;
+  sim.setCancelPoll([&] { return ++polls > 100; });
+  SimulationState s = start;
+  int outputs = 0;
+  const int rc = runSampled(sim, s, 10.0, 10.0, nullptr, 0.0, [&](const SimulationState&) { ++outputs; });
+  EXPECT_EQ(rc, E_CANCELLED);
+  EXPECT_STREQ(strError(rc), "cancelled by the caller");
+  EXPECT_EQ(polls, 101);
+  EXPECT_EQ(sim.stats().accepted_steps, 100) << "a poll before every step";
+  EXPECT_NEAR(s.t, 0.1, 1e-12) << "s at the last step accepted";
+  EXPECT_TRUE(s.state.q.data.allFinite());
+  EXPECT_EQ(outputs, 1) << "the start only";
+
+  // A poll that throws: the exception propagates (Python's KeyboardInterrupt), the run stops.
+  struct Stop {};
+  sim.setCancelPoll([&] {
+    if (++polls > 150) throw Stop{};
+    return false;
+  });
+  s = start;
+  EXPECT_THROW(runSampled(sim, s, 10.0, 10.0, nullptr, 0.0, nullptr), Stop);
+
+  // Cleared: the run goes to its end.
+  sim.setCancelPoll(nullptr);
+  s = start;
+  EXPECT_EQ(runSampled(sim, s, 0.5, 0.5, nullptr, 0.0, nullptr), E_NOERROR);
+  EXPECT_EQ(s.t, 0.5);
+}
+
 }  // namespace
 }  // namespace kdl_space

@@ -40,7 +40,17 @@ struct OperationOptions {
   /// called at control_rate [Hz] with a zero-order hold, or at every evaluation when 0.
   SampledController controller;
   double control_rate = 0.0;
+  /// Polled before every step of every phase (Simulator::setCancelPoll): once it returns true the
+  /// run stops with an OperationError of code E_CANCELLED (at t = how far it got); it may throw
+  /// instead (the exception propagates). Empty: never cancelled.
+  std::function<bool()> cancelled;
 };
+
+/// \brief How many output samples a run of the operation can produce at most: the approach's (if
+/// the scenario has one and options.approach: approach.max_duration / output_step + 1) and the
+/// motion's (if options.motion: duration / output_step + 1). For a caller that keeps or writes
+/// them to refuse a run too large before it starts (a double: it may exceed any integer).
+KDL_SPACE_EXPORT double estimatedOutputRows(const Scenario& scenario, const OperationOptions& options = {});
 
 /// What the approach did.
 struct ApproachOutcome {

@@ -156,6 +156,12 @@ class KDL_SPACE_EXPORT Simulator {
   /// run() ends at the first output sample (the start included) where `stop` returns true, after
   /// the observer has seen it: s is left there. Empty (the default): run() goes on to t_end.
   void setStopCondition(std::function<bool(const SimulationState&)> stop) { stop_ = std::move(stop); }
+  /// \brief The caller's way to stop a run from outside (Ctrl-C): run() calls `cancelled` before
+  /// every step (accepted or rejected, so also after every output) and returns E_CANCELLED, s at
+  /// the last accepted step, once it returns true. It may throw (e.g. Python's KeyboardInterrupt):
+  /// the exception propagates as an observer's. Keep it cheap (an atomic flag's load); a poll that
+  /// must do more (take a lock) counts its calls. Empty (the default): never cancelled.
+  void setCancelPoll(std::function<bool()> cancelled) { cancelled_ = std::move(cancelled); }
 
   /// \brief Brakes on: the locked joints' rates become zero by an internal impulse (momentum
   /// unchanged), as when brakes engage. Call before run() if locked joints may be moving.
@@ -172,7 +178,8 @@ class KDL_SPACE_EXPORT Simulator {
   /// that resized tau), E_NOT_FINITE (an input, the time bounds, or a state that blew up),
   /// E_BAD_ARGUMENT (output_dt <= 0, t_end < s.t, a grounded base given a twist, or a joint
   /// outside a hard stop at the start), E_MAX_STEPS when options().max_steps are spent,
-  /// E_STEP_UNDERFLOW when the adaptive step falls to round-off, or a code of the dynamics. On an
+  /// E_STEP_UNDERFLOW when the adaptive step falls to round-off, E_CANCELLED when the cancel poll
+  /// (setCancelPoll) asked it to stop, or a code of the dynamics. On an
   /// error found before the first step s's state and velocity are untouched (unless a hard stop
   /// engaged at the start); later, s is left at the last accepted step whose state can be
   /// evaluated (s.t tells how far the run got). A run allocates nothing
@@ -254,6 +261,7 @@ class KDL_SPACE_EXPORT Simulator {
   std::vector<ScheduledWrench> wrenches_;
   TorqueCallback callback_;
   std::function<bool(const SimulationState&)> stop_;
+  std::function<bool()> cancelled_;
   SimulationStats stats_;
   // workspaces
   SimulationState scratch_;

@@ -48,6 +48,7 @@ enum ErrorCode : int {
   E_MAX_STEPS = -105,             ///< a simulation spent its step budget (SimulationOptions::max_steps)
   E_BAD_ARGUMENT = -106,          ///< a parameter is out of its range (impact law, time span, enum value)
   E_STEP_UNDERFLOW = -107,        ///< the adaptive step size fell to round-off of the time
+  E_CANCELLED = -108,             ///< the caller's cancel poll asked a run to stop (Simulator::setCancelPoll)
 };
 
 /// Human-readable text of a return code.
