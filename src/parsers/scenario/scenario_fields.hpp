@@ -44,6 +44,10 @@ class Field {
   void onlyKeys(std::initializer_list<const char*> keys) const;
   /// The keys of a mapping, in file order; refuses a key given twice or one that is not a name.
   std::vector<std::string> keys() const;
+  struct Entry;
+  /// The keys of a mapping with their values, in file order, checked as keys() (O(n) for n keys:
+  /// at() searches the mapping, so a loop of at() over a large mapping would be O(n^2)).
+  std::vector<Entry> entries() const;
 
   std::string text() const;
   /// A finite number, read by readNumber (input_file.hpp); YAML's .inf and .nan are refused as not finite.
@@ -66,10 +70,21 @@ class Field {
   bool isSequence() const { return node_.IsSequence(); }
 
  private:
+  /// path.key, the key cut to a readable length (detail::cut).
+  std::string join(const std::string& key) const;
   Field child(const YAML::Node& node, const std::string& path) const { return Field(node, path, file_); }
   YAML::Node node_;
   std::string path_;
   const std::string* file_;
+};
+
+/// A key of a mapping and its value (Field::entries).
+struct Field::Entry {
+  std::string name;
+  Field key;    ///< the key: its line is where a key without a value is reported
+  Field value;  ///< its value (no value: a null node)
+  /// The value, or "PATH: has no value" at the key's line, as Field::at.
+  const Field& required() const;
 };
 
 }  // namespace kdl_space::fields
