@@ -81,8 +81,8 @@ Distribution distribution(const Field& f) {
     const double p = alpha > 0.0 ? sampling::normalCdf(-alpha) - sampling::normalCdf(-beta)
                                   : sampling::normalCdf(beta) - sampling::normalCdf(alpha);
     if (!(p > 1e-250))
-      n.fail("[min, max] = [" + number(d.min) + ", " + number(d.max) + "] lies more than 30 standard deviations from the "
-             "mean: a normal draws (almost) never there; use {uniform: [min, max]}");
+      n.fail("[min, max] = [" + number(d.min) + ", " + number(d.max) + "] has a probability below 1e-250 under this normal "
+             "(far in its tail, more than ~33 standard deviations from the mean): use {uniform: [min, max]}");
   } else if (f.has("log_normal")) {
     const Field n = f.at("log_normal");
     n.onlyKeys({"median", "factor"});

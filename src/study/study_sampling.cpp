@@ -90,9 +90,14 @@ double quantile(const Distribution& d, double u) {
   // Bounds both above the mean: the mirror image's, in the lower tail, where Phi is exact
   // (1 - Phi(8) would be 6e-16 of rounding, Phi(-8) is 6.2e-16 to 16 digits).
   const bool mirror = alpha > 0.0;
-  if (mirror) std::swap(alpha, beta), alpha = -alpha, beta = -beta;
+  if (mirror) {
+    std::swap(alpha, beta);
+    alpha = -alpha, beta = -beta;
+  }
   const double p_alpha = normalCdf(alpha), p_beta = normalCdf(beta);
-  const double z = std::clamp(normalQuantile(p_alpha + u * (p_beta - p_alpha)), alpha, beta);
+  // p_beta = 1 (no upper bound) can round p to 1, where Phi^-1 is infinite.
+  const double p = std::min(p_alpha + u * (p_beta - p_alpha), highest_unit);
+  const double z = std::clamp(normalQuantile(p), alpha, beta);
   return d.a + d.b * (mirror ? -z : z);
 }
 

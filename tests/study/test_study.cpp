@@ -427,7 +427,7 @@ TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
       {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 1, std: 1, min: 2, max: 2}}}\n",
        "inputs.timing.normal: is truncated to an empty range"},
       {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 0, std: 1, min: 40, max: 41}}}\n",
-       "lies more than 30 standard deviations from the mean"},
+       "has a probability below 1e-250 under this normal"},
       {head + "samples: 10\nseed: 1\ninputs: {timing: {log_normal: {median: 1, factor: 1}}}\n",
        "inputs.timing.log_normal.factor: must be > 1"},
       {head + "samples: 10\nseed: 1\ninputs: {timing: {log_normal: {median: 0, factor: 2}}}\n",

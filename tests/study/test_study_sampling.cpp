@@ -165,8 +165,20 @@ TEST(StudySampling, TruncatedAndLogNormalDrawsFollowTheirDistributionsInEveryStr
 TEST(StudySampling, TheQuantileAtTheExtremeUnitsIsFinite) {
   // The largest unit a Latin hypercube's top stratum rounds to (1 - 2^-53), and the smallest.
   const Distribution normal{Distribution::Kind::Normal, 0.0, 1.0, 0};
+  // Truncated below only (p = Phi(alpha) + u (1 - Phi(alpha)) rounds to 1 at the top), above
+  // only, and far in either tail.
+  const Distribution one_sided[] = {{Distribution::Kind::Normal, 0.0, 1.0, 0, -1.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, -HUGE_VAL, 1.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, 30.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, -HUGE_VAL, -30.0}};
   for (const double u : {sampling::lowest_unit, sampling::highest_unit}) {
     EXPECT_TRUE(std::isfinite(sampling::quantile(normal, u))) << u;
+    for (const Distribution& d : one_sided) {
+      const double x = sampling::quantile(d, u);
+      EXPECT_TRUE(std::isfinite(x)) << u << " " << d.min << " " << d.max;
+      EXPECT_GE(x, d.min);
+      EXPECT_LE(x, d.max);
+    }
   }
   EXPECT_NEAR(sampling::quantile(normal, sampling::highest_unit), -sampling::normalQuantile(0x1p-53), 1e-12);
   // unit() never returns 1 (its top key, 2^53 - 1 + 0.5, would round to 2^53).
