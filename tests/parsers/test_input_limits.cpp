@@ -122,19 +122,13 @@ TEST(InputLimits, DuplicateKeysAreFoundInALargeMappingQuickly) {
 
   const std::string doubled = writeFile("many_keys_twice.yaml", manyKeys(n, true));
   const std::string twice = scenarioRefusal(doubled);
-  // The second place, its line (the scenario's joints section starts at line 24 + 1 of `joints:`).
-  const std::string head = doubled + ":";
-  ASSERT_EQ(twice.rfind(head, 0), 0u) << twice;
-  const int line = std::stoi(twice.substr(head.size()));
+  // Named at its second place: the last line of simulation.joints.
   std::ifstream in(doubled);
   std::string text;
-  int first_line = 0, last_line = 0;
-  for (int l = 1; std::getline(in, text); ++l) {
-    if (text == "    \"joint[1aaaa]\": free") (first_line ? last_line : first_line) = l;
-  }
-  EXPECT_EQ(line, last_line);
-  EXPECT_EQ(twice, doubled + ":" + std::to_string(last_line) + ": simulation.joints.joint[1aaaa]: given twice (first on line " +
-                       std::to_string(first_line) + ")");
+  int last_line = 0;
+  for (int l = 1; std::getline(in, text); ++l)
+    if (text == "    \"joint[1aaaa]\": free") last_line = l;
+  EXPECT_EQ(twice, doubled + ":" + std::to_string(last_line) + ": simulation.joints.joint[1aaaa]: given twice");
 }
 
 TEST(InputLimits, AMessageQuotesAtMost80CharactersOfAField) {
