@@ -102,10 +102,11 @@ Distribution distribution(const Field& f) {
   return d;
 }
 
-/// The least and greatest values a distribution draws (a grid: its ends).
+/// The least and greatest values a distribution draws: a range's (uniform, grid) ends, infinite if
+/// high - low overflows (a + (b - a) u would be); a normal's or log-normal's extreme draws.
 std::pair<double, double> drawnRange(const Distribution& d) {
-  if (d.kind == Distribution::Kind::Grid)
-    return {std::min(d.a, d.b), std::isfinite(d.b - d.a) ? std::max(d.a, d.b) : HUGE_VAL};  // a + (b - a) k / (n - 1)
+  if (d.kind == Distribution::Kind::Grid || d.kind == Distribution::Kind::Uniform)
+    return {std::min(d.a, d.b), std::isfinite(d.b - d.a) ? std::max(d.a, d.b) : HUGE_VAL};
   return {sampling::quantile(d, sampling::lowest_unit), sampling::quantile(d, sampling::highest_unit)};
 }
 
@@ -126,7 +127,7 @@ void checkDomain(const Field& f, const StudyInput& in) {
   const auto [low, high] = drawnRange(d);
   const std::string how = d.kind == Distribution::Kind::Normal ? "this normal" : d.kind == Distribution::Kind::LogNormal
                                                                                      ? "this log-normal" : "this range";
-  if (!std::isfinite(low) || !std::isfinite(high) || (d.kind == Distribution::Kind::Uniform && !std::isfinite(d.b - d.a)))
+  if (!std::isfinite(low) || !std::isfinite(high))
     f.fail(how + " draws values that are not finite numbers (from " + number(low) + " to " + number(high) +
            "): give bounds whose difference is finite, e.g. within +-1e307");
   const bool mass = in.field == F::TargetMass;

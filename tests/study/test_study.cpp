@@ -311,7 +311,7 @@ std::string copyStudyFolder(const fs::path& dir, const std::string& newline) {
   for (const char* file : {"scenarios/study_grasp_configuration.yaml", "scenarios/tumbling_box_capture.yaml", "urdf/space_arm7.urdf"}) {
     std::ifstream in(source / file, std::ios::binary);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    ASSERT_EQ(text.find('\r'), std::string::npos) << file;
+    EXPECT_EQ(text.find('\r'), std::string::npos) << file;
     std::string converted;
     for (const char c : text) converted += c == '\n' ? newline : std::string(1, c);
     fs::create_directories((dir / file).parent_path());
@@ -350,17 +350,13 @@ TEST(Study, TheLoaderBoundsWhatItReads) {
   const std::string field(20u << 20, 'x');
   const std::string length = "(" + std::to_string(field.size()) + " characters)";
   const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\nsamples: 10\nseed: 1\n";
+  // (YAML limits an implicit key to 1024 characters: a longer one is an explicit key, "? KEY".)
   for (const std::string& text : {head + "inputs: {timing: {uniform: [0, 1]}}\nsampling: " + field + "\n",
-                                   head + "inputs: {" + field + ": {uniform: [0, 1]}}\n",
-                                   head + "inputs: {robot.q." + field + ": {uniform: [0, 1]}}\n",
-                                   head + "inputs: {timing: {uniform: [0, 1]}}\nobjective: " + field + "\n",
-                                   "scenario: " + field + "\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n"}) {
+                                   head + "inputs:\n  ? " + field + "\n  : {uniform: [0, 1]}\n",
+                                   head + "inputs:\n  ? robot.q." + field + "\n  : {uniform: [0, 1]}\n"}) {
     const std::string message = refusal("long_field.yaml", text);
-    EXPECT_NE(message, "");
     EXPECT_LT(message.size(), 600u) << message.substr(0, 600);
-    // Quoted cut (with its length), or not quoted (objective: "is no outcome of this study").
-    EXPECT_TRUE(message.find(length) != std::string::npos || message.find("xxxxxxxxxx") == std::string::npos)
-        << message.substr(0, 600);
+    EXPECT_NE(message.find(length), std::string::npos) << message.substr(0, 600);
   }
 }
 

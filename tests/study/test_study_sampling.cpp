@@ -180,7 +180,8 @@ TEST(StudySampling, TheQuantileAtTheExtremeUnitsIsFinite) {
       EXPECT_LE(x, d.max);
     }
   }
-  EXPECT_NEAR(sampling::quantile(normal, sampling::highest_unit), -sampling::normalQuantile(0x1p-53), 1e-12);
+  // (normalQuantile's refinement resolves the upper tail to ~1e-9 only: Phi(x) - p near p = 1.)
+  EXPECT_NEAR(sampling::quantile(normal, sampling::highest_unit), -sampling::normalQuantile(0x1p-53), 1e-8);
   // unit() never returns 1 (its top key, 2^53 - 1 + 0.5, would round to 2^53).
   EXPECT_LT(sampling::highest_unit, 1.0);
 }
