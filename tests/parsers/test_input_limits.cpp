@@ -1,5 +1,5 @@
-// What bounds the readers' work on a hostile file: a file over max_input_file_bytes is refused
-// before it is read (scenario, URDF), a mapping's keys are checked for duplicates in O(n) (a large
+// What bounds the readers' work on a hostile file: a file over its limit is refused before it is
+// read (a scenario over 16 MiB, a URDF over max_input_file_bytes, 64 MiB), a mapping's keys are checked for duplicates in O(n) (a large
 // mapping loads in a fraction of a second), and a message quotes at most ~80 characters of a field.
 #include <gtest/gtest.h>
 
@@ -55,14 +55,18 @@ std::string scenarioRefusal(const std::string& path) {
 }
 
 TEST(InputLimits, AFileOverTheLimitIsRefusedBeforeItIsRead) {
-  // A sparse file: its size is one byte over the limit, its content never written (nor read).
-  const std::uintmax_t size = max_input_file_bytes + 1;
-  const std::string expect = "is " + std::to_string(size) + " bytes (64 MiB), more than the 64 MiB a ";
+  // Sparse files: one byte over the limit, their content never written (nor read). A scenario
+  // (YAML or JSON) may have 16 MiB, a URDF 64 MiB.
+  const std::uintmax_t yaml_limit = std::uintmax_t{16} << 20;
   const std::string scenario = (tempDir() / "huge_scenario.yaml").string();
   std::ofstream(scenario).close();
-  fs::resize_file(scenario, size);
+  fs::resize_file(scenario, yaml_limit + 1);
   const std::string why = scenarioRefusal(scenario);
-  EXPECT_EQ(why, scenario + ": " + expect + "scenario file (YAML or JSON) may have (is it the right file?)");
+  EXPECT_EQ(why, scenario + ": is 16777217 bytes (16 MiB), more than the 16 MiB a scenario file (YAML or JSON) may have "
+                            "(is it the right file?)");
+
+  const std::uintmax_t size = max_input_file_bytes + 1;
+  const std::string expect = "is " + std::to_string(size) + " bytes (64 MiB), more than the 64 MiB a ";
 
   const std::string urdf = (tempDir() / "huge.urdf").string();
   std::ofstream(urdf).close();
@@ -85,8 +89,8 @@ TEST(InputLimits, AFileOverTheLimitIsRefusedBeforeItIsRead) {
   EXPECT_NE(named.find(expect + "URDF file"), std::string::npos) << named;
 
   // At the limit: read (and refused for what it holds, not for its size).
-  fs::resize_file(scenario, max_input_file_bytes);
-  EXPECT_EQ(scenarioRefusal(scenario).find("more than the 64 MiB"), std::string::npos);
+  fs::resize_file(scenario, yaml_limit);
+  EXPECT_EQ(scenarioRefusal(scenario).find("more than the 16 MiB"), std::string::npos);
   fs::remove(scenario);
   fs::remove(urdf);
 }

@@ -12,7 +12,6 @@
 #include <map>
 #include <sstream>
 
-#include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/study/study.hpp"
 #include "test_util.hpp"
 
@@ -337,15 +336,15 @@ TEST(Study, TheFingerprintDoesNotDependOnLineEndings) {
 TEST(Study, TheLoaderBoundsWhatItReads) {
   // A study file over the size limit: refused before it is read, its size said.
   const std::string huge = studyFile("huge_study.yaml", "");
-  fs::resize_file(huge, max_input_file_bytes + 1);  // sparse: nothing written
+  fs::resize_file(huge, (std::uintmax_t{16} << 20) + 1);  // sparse: nothing written
   std::string why;
   try {
     loadStudy(huge);
   } catch (const InputError& e) {
     why = e.what();
   }
-  EXPECT_EQ(why, huge + ": is " + std::to_string(max_input_file_bytes + 1) +
-                     " bytes (64 MiB), more than the 64 MiB a study file (YAML or JSON) may have (is it the right file?)");
+  EXPECT_EQ(why, huge + ": is 16777217 bytes (16 MiB), more than the 16 MiB a study file (YAML or JSON) may have (is it "
+                        "the right file?)");
   // A field of 20 MiB: quoted cut, with its length.
   const std::string field(20u << 20, 'x');
   const std::string length = "(" + std::to_string(field.size()) + " characters)";

@@ -11,9 +11,8 @@
 
 namespace kdl_space {
 
-/// The largest scenario, study (YAML or JSON) or URDF file the library reads: 64 MiB. The files
-/// of a capture are kilobytes; a parsed YAML file holds a node of some hundred bytes per scalar,
-/// so this bounds the loaders' memory too (a few GB at most).
+/// The largest URDF file the library reads: 64 MiB (the largest robots' are a few MB). Scenario
+/// and study files (YAML or JSON), whose parse costs more per byte, are bounded at 16 MiB.
 inline constexpr std::uintmax_t max_input_file_bytes = std::uintmax_t{64} << 20;
 
 /// \brief Refuses an input file that cannot be read: missing, a folder, not a regular file (a

@@ -21,8 +21,7 @@ bool yamlNotFinite(const std::string& text) {
 }  // namespace
 
 YAML::Node parseFile(const std::string& file, const std::string& kind) {
-  // yaml-cpp holds a node of some hundred bytes per scalar: the limit bounds its memory too.
-  checkInputFile(file, kind, max_input_file_bytes);
+  checkInputFile(file, kind, max_yaml_file_bytes);  // before it is read: it bounds yaml-cpp's memory too
   try {
     return YAML::LoadFile(file);
   } catch (const YAML::BadFile&) {

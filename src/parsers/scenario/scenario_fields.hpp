@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -17,6 +18,12 @@ namespace kdl_space::fields {
 
 /// A text from the file, quoted for a message (detail/text.hpp).
 using detail::echo;
+
+/// The largest scenario or study file (YAML or JSON) parseFile reads: 16 MiB. Such files are
+/// kilobytes; yaml-cpp holds ~55 bytes of nodes per byte of a file (a 5 MB mapping of 200,000 keys
+/// takes 300 MB), so this bounds the parse to about 1 GB (max_input_file_bytes, 64 MiB, would
+/// allow 3.5 GB).
+inline constexpr std::uintmax_t max_yaml_file_bytes = std::uintmax_t{16} << 20;
 
 /// A file's YAML (or JSON, which YAML reads), or an InputError "FILE[:LINE]: what is wrong";
 /// `kind` names what the file should be ("scenario file (YAML or JSON)").
