@@ -16,7 +16,7 @@ seconds="${1:-60}"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DKDL_SPACE_FUZZ=ON \
   -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF -DKDL_SPACE_BUILD_BENCHMARK=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" >/dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study >/dev/null
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
@@ -25,7 +25,7 @@ trap 'rm -rf "$work"' EXIT
 artifacts="$build/artifacts"
 failed=0
 # target  max_len: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow.
-for spec in "urdf 16384" "scenario 4096"; do
+for spec in "urdf 16384" "scenario 4096" "study 4096"; do
   read -r name max_len <<<"$spec"
   target="fuzz_$name"
   mkdir -p "$work/$name" "$artifacts/$name"

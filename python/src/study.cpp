@@ -33,7 +33,13 @@ std::string hex(std::uint64_t fingerprint) {
 }
 
 const char* kindName(Distribution::Kind k) {
-  return k == Distribution::Kind::Uniform ? "uniform" : k == Distribution::Kind::Normal ? "normal" : "grid";
+  switch (k) {
+    case Distribution::Kind::Uniform: return "uniform";
+    case Distribution::Kind::Normal: return "normal";
+    case Distribution::Kind::LogNormal: return "log_normal";
+    case Distribution::Kind::Grid: break;
+  }
+  return "grid";
 }
 
 /// `name`: a whole number 0 <= value <= most, else ValueError naming it.
@@ -174,10 +180,13 @@ void bindStudy(py::module_& m) {
           py::dict one;
           one["kind"] = kindName(x.kind), one["a"] = x.a, one["b"] = x.b;
           if (x.kind == Distribution::Kind::Grid) one["count"] = x.count;
+          if (std::isfinite(x.min)) one["min"] = x.min;  // a truncated normal's bounds
+          if (std::isfinite(x.max)) one["max"] = x.max;
           d[py::str(in.name)] = one;
         }
         return d;
-      }, "Input name -> {kind: uniform (a, b: range) | normal (a: mean, b: std) | grid (a, b, count)}.")
+      }, "Input name -> {kind: uniform (a, b: range) | normal (a: mean, b: std; min, max: truncated to) | "
+         "log_normal (a: median, b: factor) | grid (a, b, count)}.")
       .def_readonly("columns", &PyStudy::columns,
                     "The table's columns: sample, status, the inputs drawn (target.tumble adds its axis), the outcomes.")
       .def_property_readonly("objective", [](const PyStudy& s) { return s.study->objective; },

@@ -7,6 +7,7 @@ import ctypes
 import json
 import math
 import os
+import pathlib
 import signal
 import struct
 import subprocess
@@ -255,18 +256,32 @@ def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
 
 
 def test_a_failure_keeps_its_message(tmp_path):
-    # a target mass drawn <= 0 is refused: the status column says E_BAD_ARGUMENT, the summary why
+    # joint3 drawn beyond its hard stop (2.96706 rad): the motion's set-up refuses to start it, so
+    # the status column says E_BAD_ARGUMENT, the summary why. (A normal target mass, which could
+    # draw <= 0, is refused when the study loads.)
+    scenario = tmp_path / "stops.yaml"
+    text = pathlib.Path(CAPTURE_SCENARIO).read_text().replace("../urdf/", f"{SOURCE_DIR}/urdf/")
+    scenario.write_text(text.replace("  atol:", "  limits: stop\n  atol:"))
     path = tmp_path / "failing.yaml"
-    path.write_text(f"scenario: {CAPTURE_SCENARIO}\nsamples: 30\nseed: 5\n"
-                    "inputs: {target.mass: {normal: {mean: 10, std: 20}}}\n")
+    path.write_text(f"scenario: {scenario}\nsamples: 30\nseed: 5\n"
+                    "inputs: {robot.q.joint3: {normal: {mean: 2.9, std: 0.1}}}\nmotion: {duration: 0.05}\n")
+    with pytest.raises(kdl_space.InputError, match="target.mass: takes values > 0"):
+        bad = tmp_path / "mass.yaml"
+        bad.write_text(f"scenario: {CAPTURE_SCENARIO}\nsamples: 30\nseed: 5\n"
+                       "inputs: {target.mass: {normal: {mean: 10, std: 20}}}\n")
+        kdl_space.load_study(str(bad))
     r = kdl_space.study(str(path), threads=2)
     status = r["status"]
     failed = np.flatnonzero(status != 0)
     assert len(failed) > 0 and np.all(status[failed] == kdl_space.E_BAD_ARGUMENT)
-    assert np.all(r["target.mass"][failed] <= 0)
+    q = r["robot.q.joint3"]
+    assert np.array_equal(failed, np.flatnonzero(np.abs(q) > 2.96706))
+    first = f"{q[failed[0]]:.6g}"
     assert r.summary["failures"] == [{"status": kdl_space.E_BAD_ARGUMENT, "count": len(failed),
                                       "first_sample": int(failed[0]),
-                                      "message": "target: mass must be a finite value > 0"}]
+                                      "message": f"{scenario}: simulation.limits: joint 'joint3' starts at {first}, "
+                                                 "outside its limits [-2.96706, 2.96706] (a hard stop keeps it inside "
+                                                 "them): start it inside, or let its limits warn"}]
     # rows in any order: the same first sample and message
     assert r.study.summary(r.table[::-1])["failures"] == r.summary["failures"]
 

@@ -7,26 +7,36 @@
 
 namespace kdl_space::detail {
 
-/// 'name', as every message quotes a link, joint or file.
-inline std::string quoted(const std::string& s) { return "'" + s + "'"; }
+/// A text from an input as a message shows it: whole up to 80 characters, else its first 40 and
+/// last 36 around "...", and how long it was ("abc...xyz (20971520 characters)"): a field of
+/// megabytes must not become a message of megabytes.
+inline std::string cut(const std::string& text) {
+  if (text.size() <= 80) return text;
+  return text.substr(0, 40) + "..." + text.substr(text.size() - 36) + " (" + std::to_string(text.size()) + " characters)";
+}
 
-/// A text from an input, quoted for a message: at most 40 characters, anything but printable
-/// ASCII shown as '?' (a binary file must not flood the terminal).
+/// 'name', as every message quotes a link, joint or file (cut as cut() says).
+inline std::string quoted(const std::string& s) {
+  if (s.size() <= 80) return "'" + s + "'";
+  return "'" + s.substr(0, 40) + "..." + s.substr(s.size() - 36) + "' (" + std::to_string(s.size()) + " characters)";
+}
+
+/// A text from an input, quoted for a message: cut as quoted(), anything but printable ASCII
+/// shown as '?' (a binary file must not flood the terminal).
 inline std::string echo(const std::string& text) {
-  std::string shown;
-  for (std::size_t i = 0; i < text.size() && i < 40; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    shown += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
-  }
-  return "'" + shown + (text.size() > 40 ? "...'" : "'");
+  const auto printable = [](std::string t) {
+    for (char& c : t)
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    return t;
+  };
+  if (text.size() <= 80) return "'" + printable(text) + "'";
+  return "'" + printable(text.substr(0, 40)) + "..." + printable(text.substr(text.size() - 36)) + "' (" +
+         std::to_string(text.size()) + " characters)";
 }
 
-/// A path as a message shows it: whole up to 80 characters, else its first 40 and last 36 around
-/// "..." (a field of megabytes named as a file must not become a message of megabytes).
-inline std::string shownPath(const std::string& path) {
-  if (path.size() <= 80) return path;
-  return path.substr(0, 40) + "..." + path.substr(path.size() - 36);
-}
+/// A path as a message shows it: cut as cut() says (a field of megabytes named as a file must
+/// not become a message of megabytes).
+inline std::string shownPath(const std::string& path) { return cut(path); }
 
 /// A number as a message shows it: 6 significant digits, the stream's default ("0.2", "1e+06").
 inline std::string number(double x) {

@@ -13,14 +13,12 @@ namespace {
 /// every step is at most max_step (dopri5) or step (rk4) long, and each output row ends a step.
 void checkStepBudget(const Scenario& sc, double duration, double output_step) {
   const SimulationSpec& spec = sc.simulation;
-  const bool rk4 = spec.options.integrator == Integrator::RK4;
-  const double longest = std::min(rk4 ? spec.options.step : spec.options.max_step, output_step);
-  const double needed = std::ceil(duration / longest * (1.0 - 1e-12));
-  if (needed > static_cast<double>(spec.options.max_steps)) {
+  const StepEstimate e = fewestSteps(spec, duration, output_step);
+  if (e.steps > static_cast<double>(spec.options.max_steps)) {
     std::ostringstream why;
-    why << std::setprecision(12) << sc.file << ": simulation: " << duration << " s in steps of at most " << longest << " s ("
-        << (longest == output_step ? "simulation.output_step" : rk4 ? "simulation.step" : "simulation.max_step")
-        << ") needs " << needed << " steps, more than simulation.max_steps = " << spec.options.max_steps;
+    why << std::setprecision(12) << sc.file << ": simulation: " << duration << " s in steps of at most " << e.longest
+        << " s (simulation." << e.limited_by << ") needs " << e.steps << " steps, more than simulation.max_steps = "
+        << spec.options.max_steps;
     throw InputError(why.str());
   }
 }

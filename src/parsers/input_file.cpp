@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <locale>
 #include <sstream>
 
@@ -14,7 +15,20 @@
 
 namespace kdl_space {
 
-void checkInputFile(const std::string& path, const std::string& kind) {
+std::string fileTooLarge(const std::string& path, const std::string& kind, std::uintmax_t max_bytes) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size <= max_bytes) return "";
+  const auto mib = [](std::uintmax_t bytes) {
+    std::ostringstream s;
+    s << std::setprecision(3) << static_cast<double>(bytes) / (1 << 20) << " MiB";
+    return s.str();
+  };
+  return "is " + std::to_string(size) + " bytes (" + mib(size) + "), more than the " + mib(max_bytes) + " a " + kind +
+         " may have (is it the right file?)";
+}
+
+void checkInputFile(const std::string& path, const std::string& kind, std::uintmax_t max_bytes) {
   namespace fs = std::filesystem;
   const std::string shown = detail::shownPath(path);  // a path of megabytes is not a message of megabytes
   std::error_code ec;
@@ -23,6 +37,7 @@ void checkInputFile(const std::string& path, const std::string& kind) {
   if (fs::is_directory(status)) throw InputError(shown + ": is a folder, not a " + kind);
   // A device, FIFO or socket could block or never end (/dev/zero): only regular files are read.
   if (!fs::is_regular_file(status)) throw InputError(shown + ": is not a regular file; expected a " + kind);
+  if (const std::string why = fileTooLarge(path, kind, max_bytes); !why.empty()) throw InputError(shown + ": " + why);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(shown + ": cannot open the file: " + std::strerror(errno));
   if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(shown + ": the file is empty; expected a " + kind);
@@ -77,15 +92,15 @@ bool parseFiniteNumber(const std::string& text, double& value, std::string& why)
     case NumberText::Finite:
       return true;
     case NumberText::TooLarge:
-      why = "'" + text + "' is too large (not a finite number)";
+      why = detail::echo(text) + " is too large (not a finite number)";
       return false;
     case NumberText::NotFinite:
-      why = "'" + text + "' is not a finite number";
+      why = detail::echo(text) + " is not a finite number";
       return false;
     case NumberText::NotANumber:
       break;
   }
-  why = "'" + text + "' is not a number";
+  why = detail::echo(text) + " is not a number";
   return false;
 }
 

@@ -1,9 +1,11 @@
 // loadStudy: the study file's fields, each checked where it is read, in the words of the file.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 #include "detail/text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -19,14 +21,24 @@ using detail::number;
 using fields::echo;
 using fields::Field;
 
-/// FNV-1a over a file's bytes, folded into h (a missing file folds in nothing).
+/// FNV-1a over a file's bytes, folded into h (a missing file folds in nothing). Each "\r\n" is
+/// folded as "\n": a copy whose line endings were converted (git's autocrlf, an editor) is the
+/// same study.
 std::uint64_t fold(std::uint64_t h, const std::string& path) {
   if (path.empty()) return h;
   std::ifstream in(path, std::ios::binary);
-  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) {
-    h ^= static_cast<unsigned char>(*it);
+  const auto byte = [&h](unsigned char c) {
+    h ^= c;
     h *= 0x100000001b3ULL;
+  };
+  bool carriage_return = false;  // a '\r' held until the next byte says whether it ends a line
+  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) {
+    const unsigned char c = static_cast<unsigned char>(*it);
+    if (carriage_return && c != '\n') byte('\r');
+    carriage_return = c == '\r';
+    if (!carriage_return) byte(c);
   }
+  if (carriage_return) byte('\r');
   return h;
 }
 
@@ -47,8 +59,9 @@ std::uint64_t whole(const Field& f, std::uint64_t most, const std::string& what)
 
 Distribution distribution(const Field& f) {
   if (f.isScalar() || f.isSequence() || f.keys().size() != 1)
-    f.fail("give one distribution: {uniform: [low, high]}, {normal: {mean: m, std: s}} or {grid: [from, to, count]}");
-  f.onlyKeys({"uniform", "normal", "grid"});
+    f.fail("give one distribution: {uniform: [low, high]}, {normal: {mean: m, std: s}} (with min and max: truncated), "
+           "{log_normal: {median: m, factor: f}} or {grid: [from, to, count]}");
+  f.onlyKeys({"uniform", "normal", "log_normal", "grid"});
   Distribution d;
   if (f.has("uniform")) {
     const Field u = f.at("uniform");
@@ -57,9 +70,26 @@ Distribution distribution(const Field& f) {
     d.kind = Distribution::Kind::Uniform, d.a = v(0), d.b = v(1);
   } else if (f.has("normal")) {
     const Field n = f.at("normal");
-    n.onlyKeys({"mean", "std"});
+    n.onlyKeys({"mean", "std", "min", "max"});
     d.kind = Distribution::Kind::Normal, d.a = n.at("mean").number(), d.b = n.at("std").number();
     if (!(d.b > 0.0)) n.at("std").fail("must be > 0, got " + number(d.b));
+    if (n.has("min")) d.min = n.at("min").number();
+    if (n.has("max")) d.max = n.at("max").number();
+    if (!(d.min < d.max)) n.fail("is truncated to an empty range: min must be < max, got [" + number(d.min) + ", " + number(d.max) + "]");
+    // The draws between the bounds must have a probability a double resolves (Phi^-1 of it finite).
+    const double alpha = (d.min - d.a) / d.b, beta = (d.max - d.a) / d.b;
+    const double p = alpha > 0.0 ? sampling::normalCdf(-alpha) - sampling::normalCdf(-beta)
+                                  : sampling::normalCdf(beta) - sampling::normalCdf(alpha);
+    if (!(p > 1e-250))
+      n.fail("[min, max] = [" + number(d.min) + ", " + number(d.max) + "] has a probability below 1e-250 under this normal "
+             "(far in its tail, more than ~33 standard deviations from the mean): use {uniform: [min, max]}");
+  } else if (f.has("log_normal")) {
+    const Field n = f.at("log_normal");
+    n.onlyKeys({"median", "factor"});
+    d.kind = Distribution::Kind::LogNormal, d.a = n.at("median").number(), d.b = n.at("factor").number();
+    if (!(d.a > 0.0)) n.at("median").fail("must be > 0, got " + number(d.a));
+    if (!(d.b > 1.0)) n.at("factor").fail("must be > 1 (the spread: 68 % of the draws lie within median / factor and "
+                                          "median * factor), got " + number(d.b));
   } else {
     const Field g = f.at("grid");
     const std::vector<Field> items = g.items("from, to, count");
@@ -70,6 +100,45 @@ Distribution distribution(const Field& f) {
     if (d.count > 1 && !(d.a != d.b)) g.fail("is an empty range: from and to are both " + number(d.a));
   }
   return d;
+}
+
+/// The least and greatest values a distribution draws: a range's (uniform, grid) ends, infinite if
+/// high - low overflows (a + (b - a) u would be); a normal's or log-normal's extreme draws.
+std::pair<double, double> drawnRange(const Distribution& d) {
+  if (d.kind == Distribution::Kind::Grid || d.kind == Distribution::Kind::Uniform)
+    return {std::min(d.a, d.b), std::isfinite(d.b - d.a) ? std::max(d.a, d.b) : HUGE_VAL};
+  return {sampling::quantile(d, sampling::lowest_unit), sampling::quantile(d, sampling::highest_unit)};
+}
+
+/// What to draw instead of `d` for an input that takes values > 0 (`positive`: a mass) or >= 0.
+std::string positiveAdvice(const Distribution& d, bool positive) {
+  if (d.kind == Distribution::Kind::LogNormal) return "give a smaller factor";
+  const std::string normal = "{normal: {mean: " + number(d.a) + ", std: " + number(d.b) + ", min: " +
+                             (positive ? "M}} with M > 0" : "0}}") + " (truncated)";
+  const std::string log_normal = "{log_normal: {median: " + number(d.a > 0.0 ? d.a : 1.0) + ", factor: F}}";
+  return "use " + normal + " or " + log_normal;
+}
+
+/// Refuses a distribution that can draw outside its input's domain, before any sample: values
+/// that are not finite, and for target.mass (> 0), target.tumble and timing (>= 0) values below.
+void checkDomain(const Field& f, const StudyInput& in) {
+  using F = StudyInput::Field;
+  const Distribution& d = in.distribution;
+  const auto [low, high] = drawnRange(d);
+  const std::string how = d.kind == Distribution::Kind::Normal ? "this normal" : d.kind == Distribution::Kind::LogNormal
+                                                                                     ? "this log-normal" : "this range";
+  if (!std::isfinite(low) || !std::isfinite(high))
+    f.fail(how + " draws values that are not finite numbers (from " + number(low) + " to " + number(high) +
+           "): give bounds whose difference is finite, e.g. within +-1e307");
+  const bool mass = in.field == F::TargetMass;
+  if (!mass && in.field != F::TargetTumble && in.field != F::Timing) return;
+  if (mass ? low > 0.0 : low >= 0.0) return;
+  const std::string what = mass ? "a mass" : in.field == F::Timing ? "a delay" : "a rate";
+  if (d.kind == Distribution::Kind::Uniform || d.kind == Distribution::Kind::Grid)
+    f.fail(mass && low == 0.0 ? "a mass must be > 0 kg, but the range reaches 0"
+                              : "takes values >= 0 (" + what + "), but the range reaches " + number(low));
+  f.fail("takes values " + std::string(mass ? "> 0" : ">= 0") + " (" + what + "), but " + how + " draws down to " +
+         number(low) + ": " + positiveAdvice(d, mass));
 }
 
 /// The input a field name sets, checked against the scenario.
@@ -130,14 +199,7 @@ StudyInput input(const Field& f, const std::string& name, const Scenario& sc) {
            "target.grasp.{x,y,z}, timing, robot.q.JOINT, robot.qdot.JOINT, robot.self_motion, "
            "robot.contact.offset.{x,y,z})");
   }
-  const Distribution& d = in.distribution;
-  const bool signed_value = in.field == F::TargetTwist || in.field == F::TargetGrasp || in.field == F::JointPosition ||
-                            in.field == F::JointRate || in.field == F::SelfMotion || in.field == F::ContactOffset;
-  if (!signed_value && d.kind != Distribution::Kind::Normal && std::min(d.a, d.b) < 0.0)
-    f.fail("takes values >= 0 (" + std::string(in.field == F::TargetMass ? "a mass" : in.field == F::Timing ? "a delay" : "a rate") +
-           "), but the range reaches " + number(std::min(d.a, d.b)));
-  if (in.field == F::TargetMass && d.kind != Distribution::Kind::Normal && !(std::min(d.a, d.b) > 0.0))
-    f.fail("a mass must be > 0 kg, but the range reaches 0");
+  checkDomain(f, in);
   return in;
 }
 
@@ -195,7 +257,7 @@ Study loadStudy(const std::string& path) {
     else if (s != "random") top.at("sampling").fail(echo(s) + " is not one of random, latin_hypercube");
   }
   const Field inputs = top.at("inputs");
-  for (const std::string& name : inputs.keys()) st.inputs.push_back(input(inputs.at(name), name, sc));
+  for (const Field::Entry& e : inputs.entries()) st.inputs.push_back(input(e.required(), e.name, sc));
   if (st.inputs.empty()) inputs.fail("a study varies at least one input");
   const std::uint64_t grid = sampling::gridSize(st);
   if (grid > Study::max_samples) inputs.fail("its grid has " + std::to_string(grid) + " points, more than a study's 1e9 samples");
@@ -217,6 +279,17 @@ Study loadStudy(const std::string& path) {
     if (!(st.motion_duration > 0.0)) m.at("duration").fail("must be > 0 s, got " + number(st.motion_duration));
     st.motion_output_step = m.has("output_step") ? m.at("output_step").number() : st.motion_duration / 100.0;
     if (!(st.motion_output_step > 0.0)) m.at("output_step").fail("must be > 0 s, got " + number(st.motion_output_step));
+    // As `simulate`: a motion that cannot fit the step budget would spend it in every sample.
+    const StepEstimate e = fewestSteps(sc.simulation, st.motion_duration, st.motion_output_step);
+    const long budget = sc.simulation.options.max_steps;
+    if (e.steps > static_cast<double>(budget)) {
+      const std::string by = std::string(e.limited_by) == "output_step" ? "motion.output_step" : "the scenario's simulation." + std::string(e.limited_by);
+      m.at("duration").fail(number(st.motion_duration) + " s in steps of at most " + number(e.longest) + " s (" + by +
+                            ") needs " + number(e.steps) + " steps, more than the scenario's simulation.max_steps = " +
+                            std::to_string(budget) + ": give a duration of at most " +
+                            number(e.longest * static_cast<double>(budget)) + " s (or raise simulation.max_steps in " +
+                            detail::shownPath(sc.file) + ")");
+    }
     try {
       CaptureResult probe;
       probe.contact_body_pose = KDL::Frame::Identity();

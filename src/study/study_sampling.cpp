@@ -1,6 +1,8 @@
 #include "study/study_sampling.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace kdl_space::sampling {
 
@@ -18,7 +20,8 @@ std::uint64_t key(std::uint64_t seed, std::uint64_t sample, std::uint64_t stream
 }  // namespace
 
 double unit(std::uint64_t seed, std::uint64_t sample, std::uint64_t stream) {
-  return (static_cast<double>(key(seed, sample, stream) >> 11) + 0.5) * 0x1.0p-53;
+  // (2^53 - 1) + 0.5 rounds to 2^53 (to even): the top key would give 1.
+  return std::min((static_cast<double>(key(seed, sample, stream) >> 11) + 0.5) * 0x1.0p-53, highest_unit);
 }
 
 std::uint64_t permute(std::uint64_t i, std::uint64_t n, std::uint64_t seed, std::uint64_t stream) {
@@ -70,6 +73,34 @@ double normalQuantile(double p) {
   return x - u / (1.0 + 0.5 * x * u);
 }
 
+double normalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+double quantile(const Distribution& d, double u) {
+  switch (d.kind) {
+    case Distribution::Kind::Uniform:
+      return d.a + (d.b - d.a) * u;
+    case Distribution::Kind::LogNormal:
+      return d.a * std::exp(std::log(d.b) * normalQuantile(u));
+    case Distribution::Kind::Normal:
+    case Distribution::Kind::Grid:
+      break;
+  }
+  if (d.min == -HUGE_VAL && d.max == HUGE_VAL) return d.a + d.b * normalQuantile(u);
+  double alpha = (d.min - d.a) / d.b, beta = (d.max - d.a) / d.b;
+  // Bounds both above the mean: the mirror image's, in the lower tail, where Phi is exact
+  // (1 - Phi(8) would be 6e-16 of rounding, Phi(-8) is 6.2e-16 to 16 digits).
+  const bool mirror = alpha > 0.0;
+  if (mirror) {
+    std::swap(alpha, beta);
+    alpha = -alpha, beta = -beta;
+  }
+  const double p_alpha = normalCdf(alpha), p_beta = normalCdf(beta);
+  // p_beta = 1 (no upper bound) can round p to 1, where Phi^-1 is infinite.
+  const double p = std::min(p_alpha + u * (p_beta - p_alpha), highest_unit);
+  const double z = std::clamp(normalQuantile(p), alpha, beta);
+  return d.a + d.b * (mirror ? -z : z);
+}
+
 std::uint64_t gridSize(const Study& study) {
   std::uint64_t g = 1;
   for (const StudyInput& in : study.inputs)
@@ -98,7 +129,7 @@ void draw(const Study& study, std::uint64_t i, double* values) {
       double u = unit(study.seed, i, stream);
       if (study.latin_hypercube)  // stratum permute(i) of `samples`, a uniform point inside it
         u = (static_cast<double>(permute(i, study.samples, study.seed, stream)) + u) / static_cast<double>(study.samples);
-      value = d.kind == Distribution::Kind::Uniform ? d.a + (d.b - d.a) * u : d.a + d.b * normalQuantile(u);
+      value = quantile(d, std::min(u, highest_unit));  // the top stratum's u can round to 1: Phi^-1(1) = inf
     }
     *values++ = value;
     if (in.field == StudyInput::Field::TargetTumble) {  // an axis uniform on the sphere

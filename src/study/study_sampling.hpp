@@ -25,6 +25,20 @@ std::uint64_t permute(std::uint64_t i, std::uint64_t n, std::uint64_t seed, std:
 /// rational approximation, refined by one Halley step on erfc).
 double normalQuantile(double p);
 
+/// The standard normal distribution function Phi(x) = erfc(-x / sqrt 2) / 2, accurate in the
+/// lower tail (relative error ~1e-16 down to x = -37).
+double normalCdf(double x);
+
+/// The probabilities a draw uses: unit() lies in [2^-54, 1 - 2^-53] (draw() keeps a Latin
+/// hypercube's below 1), a Latin hypercube's down to 2^-54 / Study::max_samples.
+constexpr double lowest_unit = 0x1p-54 / 1e9, highest_unit = 1.0 - 0x1p-53;
+
+/// \brief The value of a non-grid distribution at probability u, 0 < u < 1 (its quantile
+/// function, increasing in u): a + (b - a) u; a + b Phi^-1(u), truncated to [min, max] as
+/// a + b Phi^-1(Phi(alpha) + u (Phi(beta) - Phi(alpha))) with alpha, beta the bounds in standard
+/// deviations (mirrored into the lower tail, where Phi resolves them); a b^Phi^-1(u).
+double quantile(const Distribution& d, double u);
+
 /// The number of points of the study's grid (the product of its grid inputs' counts; 1 without).
 std::uint64_t gridSize(const Study& study);
 

@@ -298,7 +298,7 @@ TEST_F(HostileFiles, ScenarioFilesThatAreNoScenario) {
   } cases[] = {
       {"capture " + bytes, "kdl_space: " + bytes +
                                ":1: a scenario is a mapping with robot, target and law (or robot and simulation), not "
-                               "'????????????????????????????????????????...'\n"},
+                               "'" + std::string(40, '?') + "..." + std::string(36, '?') + "' (1508 characters)\n"},
       {"simulate " + folder, "kdl_space: " + folder + ": is a folder, not a scenario file (YAML or JSON)\n"},
       {"capture /nonexistent/scenario.yaml", "kdl_space: /nonexistent/scenario.yaml: no such file\n"},
       // An endless device: refused, not read until memory runs out.

@@ -128,10 +128,15 @@ TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
 }
 
 TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {
-  // A target mass drawn <= 0 is refused (status E_BAD_ARGUMENT, -106): the summary keeps the
-  // library's message, the same from one run, from shards merged and in the text summary.
-  const std::string study = write("failing.yaml", "scenario: " + kScenarios + "tumbling_box_capture.yaml\n"
-                                  "samples: 30\nseed: 5\ninputs: {target.mass: {normal: {mean: 10, std: 20}}}\n");
+  // joint3 drawn beyond its hard stop (2.96706 rad) is refused by the motion's set-up (status
+  // E_BAD_ARGUMENT, -106): the summary keeps the library's message, the same from one run, from
+  // shards merged and in the text summary. (A target mass that could be drawn <= 0 is refused at load.)
+  std::string text = slurp(kScenarios + "tumbling_box_capture.yaml");
+  text.replace(text.find("../urdf/"), 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  text.replace(text.find("  atol:"), 0, "  limits: stop\n");
+  const std::string scenario = write("stops.yaml", text);
+  const std::string study = write("failing.yaml", "scenario: " + scenario + "\nsamples: 30\nseed: 5\n"
+                                  "inputs: {robot.q.joint3: {normal: {mean: 2.9, std: 0.1}}}\nmotion: {duration: 0.05}\n");
   const std::string table = scratch("failing.csv");
   const ToolRun r = kdlSpace("study " + study + " -o " + table + " --json");
   ASSERT_EQ(r.rc, 0) << r.err;
@@ -141,16 +146,20 @@ TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {
   EXPECT_EQ(f["status"], -106);
   EXPECT_EQ(f["count"], j["failed"]);
   EXPECT_GT(f["count"].get<int>(), 0);
-  EXPECT_EQ(f["message"], "target: mass must be a finite value > 0");
-  // The first sample: the first row whose status is -106.
+  // The first sample: the first row whose status is -106; its joint3 (the third column) in the message.
   std::istringstream lines(slurp(table));
   std::string line;
   std::getline(lines, line);
   std::getline(lines, line);
   long first = -1;
+  double q = 0.0;
   for (long i = 0; first < 0 && std::getline(lines, line); ++i)
-    if (line.find(",-106,") != std::string::npos) first = i;
+    if (line.find(",-106,") != std::string::npos) first = i, q = std::stod(line.substr(line.find(",-106,") + 6));
   EXPECT_EQ(f["first_sample"], first);
+  std::ostringstream message;
+  message << scenario << ": simulation.limits: joint 'joint3' starts at " << q
+          << ", outside its limits [-2.96706, 2.96706] (a hard stop keeps it inside them): start it inside, or let its limits warn";
+  EXPECT_EQ(f["message"], message.str());
   // From two shards merged: the same failures.
   std::string parts;
   for (int i = 1; i <= 2; ++i) {
@@ -165,7 +174,7 @@ TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {
   const ToolRun t = kdlSpace("study " + study + " -o " + table);
   ASSERT_EQ(t.rc, 0) << t.err;
   const std::string expected = "  status -106: " + std::to_string(f["count"].get<int>()) + " samples, the first " +
-                               std::to_string(first) + ": target: mass must be a finite value > 0\n";
+                               std::to_string(first) + ": " + message.str() + "\n";
   EXPECT_NE(t.out.find(" could not be computed), seed 5; table " + table + "\n" + expected), std::string::npos) << t.out;
 }
 

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <sstream>
 
 #include "kdl_space/study/study.hpp"
 #include "test_util.hpp"
@@ -177,17 +178,32 @@ TEST(Study, SummaryQuantilesProbabilitiesAndRanks) {
   EXPECT_EQ(s.best[0].inputs[0].first, "robot.q.joint2");
 }
 
-/// A study of the tumbling box whose samples fail for known reasons: a target mass drawn <= 0
-/// (RigidBodySide refuses it: E_BAD_ARGUMENT) and, for the others, a motion after the capture
-/// whose step budget (3 steps) is spent (E_MAX_STEPS).
+/// The path of the failing study's scenario (failingStudy).
+std::string failingScenario() { return (fs::path(::testing::TempDir()) / "kdl_space_study_tests" / "failing_scenario.yaml").string(); }
+
+/// A study of the tumbling box whose samples fail for known reasons: joint2 drawn beyond its
+/// limit (2.967 rad), where the scenario's hard stops refuse to start the motion (an InputError
+/// from the motion's set-up: E_BAD_ARGUMENT) and, for the others, a motion after the capture whose
+/// step budget (3 steps) is spent (E_MAX_STEPS): it fits the budget by the estimate (one step of
+/// 0.5 s: max_step and output_step 0.5 s), but the adaptive steps start at 1 ms. (A mass drawn <= 0
+/// is refused at load now: no sample fails for it.)
 std::string failingStudy() {
   std::ifstream in(kScenarios + "tumbling_box_capture.yaml");
   std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   scenario.replace(scenario.find("../urdf/"), 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
-  scenario.replace(scenario.find("  atol:"), 0, "  max_steps: 3\n");
+  scenario.replace(scenario.find("  atol:"), 0, "  max_steps: 3\n  max_step: 0.5\n  limits: stop\n");
   const std::string path = studyFile("failing_scenario.yaml", scenario);
+  EXPECT_EQ(path, failingScenario());
   return studyFile("failing.yaml", "scenario: " + path + "\nsamples: 40\nseed: 5\n"
-                   "inputs: {target.mass: {normal: {mean: 10, std: 20}}}\nmotion: {duration: 0.5}\n");
+                   "inputs: {robot.q.joint3: {normal: {mean: 2.9, std: 0.1}}}\nmotion: {duration: 0.5, output_step: 0.5}\n");
+}
+
+/// What the motion's set-up says of joint3 started at q (capture_operation.cpp's checkStart).
+std::string outsideItsStop(double q) {
+  std::ostringstream why;
+  why << failingScenario() << ": simulation.limits: joint 'joint3' starts at " << q
+      << ", outside its limits [-2.96706, 2.96706] (a hard stop keeps it inside them): start it inside, or let its limits warn";
+  return why.str();
 }
 
 TEST(Study, TheSummaryKeepsTheMessageOfTheFirstSampleOfEachFailure) {
@@ -197,16 +213,18 @@ TEST(Study, TheSummaryKeepsTheMessageOfTheFirstSampleOfEachFailure) {
   StudyEvaluator evaluator(st);
   std::vector<double> row(m);
   std::map<int, std::uint64_t> count, first;
+  double first_q = 0.0;
   for (std::uint64_t i = 0; i < st->samples; ++i) {
     evaluator.evaluate(i, row.data());
     const int status = static_cast<int>(row[1]);
     ASSERT_TRUE(status == E_BAD_ARGUMENT || status == E_MAX_STEPS) << i << ": " << status;
     if (count[status]++ == 0) first[status] = i;
-    const double mass = row[2];
-    EXPECT_EQ(status == E_BAD_ARGUMENT, mass <= 0.0) << i;
-    EXPECT_EQ(evaluator.failure(), status == E_BAD_ARGUMENT ? "target: mass must be a finite value > 0"
+    const double q = row[2];
+    EXPECT_EQ(status == E_BAD_ARGUMENT, std::abs(q) > 2.96706) << i;
+    EXPECT_EQ(evaluator.failure(), status == E_BAD_ARGUMENT ? outsideItsStop(q)
                                                             : "motion: the motion after the capture cannot be simulated "
                                                               "for 0.5 s: " + std::string(strError(E_MAX_STEPS)));
+    if (status == E_BAD_ARGUMENT && count[status] == 1) first_q = q;
   }
   ASSERT_GT(count[E_BAD_ARGUMENT], 0u);
   ASSERT_GT(count[E_MAX_STEPS], 0u);
@@ -232,7 +250,7 @@ TEST(Study, TheSummaryKeepsTheMessageOfTheFirstSampleOfEachFailure) {
     EXPECT_EQ(f.first_sample, first[f.status]);
   }
   const StudyFailure& bad = s.failures[s.failures[0].status == E_BAD_ARGUMENT ? 0 : 1];
-  EXPECT_EQ(bad.message, "target: mass must be a finite value > 0");
+  EXPECT_EQ(bad.message, outsideItsStop(first_q));
   const StudyFailure& steps = s.failures[s.failures[0].status == E_MAX_STEPS ? 0 : 1];
   EXPECT_EQ(steps.message, "motion: the motion after the capture cannot be simulated for 0.5 s: " +
                                std::string(strError(E_MAX_STEPS)));
@@ -256,6 +274,90 @@ std::string refusal(const std::string& name, const std::string& text) {
     return e.what();
   }
   return "";
+}
+
+TEST(Study, DrawsThatStayInTheirDomainLoad) {
+  const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\nsamples: 50\nseed: 3\n";
+  for (const std::string inputs : {"{target.mass: {normal: {mean: 10, std: 20, min: 1}}}",
+                                   "{target.mass: {log_normal: {median: 50, factor: 1.5}}}",
+                                   "{target.mass: {normal: {mean: 50, std: 2}}}",  // 0 lies 25 std below: never drawn
+                                   "{timing: {normal: {mean: 1, std: 1, min: 0, max: 3}}}",
+                                   "{target.tumble: {normal: {mean: 0.1, std: 0.1, min: 0}}}"}) {
+    SCOPED_TRACE(inputs);
+    const std::string why = refusal("in_domain.yaml", head + "inputs: " + inputs + "\n");
+    EXPECT_EQ(why, "");
+  }
+  // A truncated mass draws only masses inside its bounds, and each sample computes.
+  const auto st = std::make_shared<const Study>(
+      loadStudy(studyFile("truncated_mass.yaml", head + "inputs: {target.mass: {normal: {mean: 10, std: 20, min: 1, max: 25}}}\n")));
+  ASSERT_EQ(st->inputs[0].distribution.kind, Distribution::Kind::Normal);
+  EXPECT_EQ(st->inputs[0].distribution.min, 1.0);
+  EXPECT_EQ(st->inputs[0].distribution.max, 25.0);
+  StudyEvaluator evaluator(st);
+  std::vector<double> row(studyColumns(*st).size());
+  for (std::uint64_t i = 0; i < st->samples; ++i) {
+    evaluator.evaluate(i, row.data());
+    EXPECT_EQ(row[1], 0.0) << i << ": " << evaluator.failure();
+    EXPECT_GE(row[2], 1.0);
+    EXPECT_LE(row[2], 25.0);
+  }
+}
+
+/// A copy of the repository's study folder (the grasp study, its scenario, its URDF) under `dir`,
+/// each file's "\n" written as `newline`.
+std::string copyStudyFolder(const fs::path& dir, const std::string& newline) {
+  const fs::path source = KDL_SPACE_SOURCE_DIR;
+  for (const char* file : {"scenarios/study_grasp_configuration.yaml", "scenarios/tumbling_box_capture.yaml", "urdf/space_arm7.urdf"}) {
+    std::ifstream in(source / file, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text.find('\r'), std::string::npos) << file;
+    std::string converted;
+    for (const char c : text) converted += c == '\n' ? newline : std::string(1, c);
+    fs::create_directories((dir / file).parent_path());
+    std::ofstream(dir / file, std::ios::binary) << converted;
+  }
+  return (dir / "scenarios/study_grasp_configuration.yaml").string();
+}
+
+TEST(Study, TheFingerprintDoesNotDependOnLineEndings) {
+  const fs::path root = fs::path(::testing::TempDir()) / "kdl_space_study_tests";
+  const Study lf = loadStudy(copyStudyFolder(root / "lf", "\n"));
+  const Study crlf = loadStudy(copyStudyFolder(root / "crlf", "\r\n"));
+  EXPECT_EQ(crlf.fingerprint, lf.fingerprint);
+  EXPECT_EQ(lf.fingerprint, loadStudy(kScenarios + "study_grasp_configuration.yaml").fingerprint);
+  // A change of the content is another study; so is a lone "\r" (no line ending).
+  std::ofstream(root / "lf/scenarios/study_grasp_configuration.yaml", std::ios::app) << "# edited\n";
+  EXPECT_NE(loadStudy((root / "lf/scenarios/study_grasp_configuration.yaml").string()).fingerprint, lf.fingerprint);
+  copyStudyFolder(root / "cr", "\n");
+  std::ofstream(root / "cr/urdf/space_arm7.urdf", std::ios::app) << "\r";
+  EXPECT_NE(loadStudy((root / "cr/scenarios/study_grasp_configuration.yaml").string()).fingerprint, lf.fingerprint);
+}
+
+TEST(Study, TheLoaderBoundsWhatItReads) {
+  // A study file over the size limit: refused before it is read, its size said.
+  const std::string huge = studyFile("huge_study.yaml", "");
+  fs::resize_file(huge, (std::uintmax_t{16} << 20) + 1);  // sparse: nothing written
+  std::string why;
+  try {
+    loadStudy(huge);
+  } catch (const InputError& e) {
+    why = e.what();
+  }
+  EXPECT_EQ(why, huge + ": is 16777217 bytes (16 MiB), more than the 16 MiB a study file (YAML or JSON) may have (is it "
+                        "the right file?)");
+  // A field of 15 MiB (the largest a study file of at most 16 MiB holds, in round numbers): quoted
+  // cut, with its length.
+  const std::string field(15u << 20, 'x');
+  const std::string length = "(" + std::to_string(field.size()) + " characters)";
+  const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\nsamples: 10\nseed: 1\n";
+  // (YAML limits an implicit key to 1024 characters: a longer one is an explicit key, "? KEY".)
+  for (const std::string& text : {head + "inputs: {timing: {uniform: [0, 1]}}\nsampling: " + field + "\n",
+                                   head + "inputs:\n  ? " + field + "\n  : {uniform: [0, 1]}\n",
+                                   head + "inputs:\n  ? robot.q." + field + "\n  : {uniform: [0, 1]}\n"}) {
+    const std::string message = refusal("long_field.yaml", text);
+    EXPECT_LT(message.size(), 600u) << message.substr(0, 600);
+    EXPECT_NE(message.find(length), std::string::npos) << message.substr(0, 600);
+  }
 }
 
 TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
@@ -288,6 +390,44 @@ TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
        "the target is a free-floating system"},
       {"scenario: " + kScenarios + "robot_to_robot_capture.yaml\nsamples: 10\nseed: 1\ninputs: {robot.q.joint2: {uniform: [0, 0.1]}}\n"
        "motion: {duration: 1}\n", "motion: no motion follows"},
+      // Checked up front: the motion against the step budget, as `simulate` does (the tumbling box:
+      // max_step 0.05 s, max_steps 1e6): every sample would spend it.
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\nmotion: {duration: 1e9}\n",
+       "motion.duration: 1e+09 s in steps of at most 0.05 s (the scenario's simulation.max_step) needs 2e+10 steps, more "
+       "than the scenario's simulation.max_steps = 1000000: give a duration of at most 50000 s (or raise "
+       "simulation.max_steps in " + kScenarios + "tumbling_box_capture.yaml)"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\nmotion: {duration: 10, output_step: 1e-6}\n",
+       "motion.duration: 10 s in steps of at most 1e-06 s (motion.output_step) needs 1e+07 steps"},
+      // Draws that leave the input's domain: refused at load, with what to use.
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {normal: {mean: 10, std: 20}}}\n",
+       "inputs.target.mass: takes values > 0 (a mass), but this normal draws down to -"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {normal: {mean: 10, std: 20}}}\n",
+       "use {normal: {mean: 10, std: 20, min: M}} with M > 0 (truncated) or {log_normal: {median: 10, factor: F}}"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {normal: {mean: 10, std: 20, min: 0}}}\n",
+       "inputs.target.mass: takes values > 0 (a mass), but this normal draws down to 0"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 1, std: 1}}}\n",
+       "inputs.timing: takes values >= 0 (a delay), but this normal draws down to -"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.tumble: {normal: {mean: 0.1, std: 0.1}}}\n",
+       "use {normal: {mean: 0.1, std: 0.1, min: 0}} (truncated)"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {uniform: [0, 3]}}\n", "inputs.target.mass: a mass must be > 0 kg"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {grid: [0, 3, 4]}}\n", "inputs.target.mass: a mass must be > 0 kg"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.mass: {log_normal: {median: 10, factor: 1e300}}}\n",
+       "inputs.target.mass: this log-normal draws values that are not finite numbers"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.twist.vx: {uniform: [-1.7e308, 1.7e308]}}\n",
+       "inputs.target.twist.vx: this range draws values that are not finite numbers"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.twist.vx: {grid: [-1.7e308, 1.7e308, 3]}}\n",
+       "inputs.target.twist.vx: this range draws values that are not finite numbers"},
+      {head + "samples: 10\nseed: 1\ninputs: {robot.q.joint2: {normal: {mean: 1e308, std: 1e307}}}\n",
+       "inputs.robot.q.joint2: this normal draws values that are not finite numbers"},
+      {head + "samples: 10\nseed: 1\ninputs: {target.twist.vx: {uniform: [0, .inf]}}\n", "is not a finite number"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 1, std: 1, min: 2, max: 2}}}\n",
+       "inputs.timing.normal: is truncated to an empty range"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {normal: {mean: 0, std: 1, min: 40, max: 41}}}\n",
+       "has a probability below 1e-250 under this normal"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {log_normal: {median: 1, factor: 1}}}\n",
+       "inputs.timing.log_normal.factor: must be > 1"},
+      {head + "samples: 10\nseed: 1\ninputs: {timing: {log_normal: {median: 0, factor: 2}}}\n",
+       "inputs.timing.log_normal.median: must be > 0"},
   };
   int k = 0;
   for (const Case& c : cases) {

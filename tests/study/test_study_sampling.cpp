@@ -99,6 +99,93 @@ TEST(StudySampling, LatinHypercubePutsOneSampleInEveryStratumOfEveryInput) {
   EXPECT_LT(hit.size(), random.samples - 10);
 }
 
+/// A study of three inputs: a normal truncated to [min, max], a log-normal (median 3, factor 2),
+/// a normal truncated on one side far in its upper tail (20 to 20.5 standard deviations above).
+Study boundedInputs(bool lhs) {
+  Study st;
+  st.seed = 8;
+  st.samples = 101;
+  st.latin_hypercube = lhs;
+  StudyInput a, b, c;
+  a.name = "a", a.distribution = {Distribution::Kind::Normal, 10.0, 20.0, 0, 0.5, 30.0};
+  b.name = "b", b.distribution = {Distribution::Kind::LogNormal, 3.0, 2.0, 0};
+  c.name = "c", c.distribution = {Distribution::Kind::Normal, 0.0, 1.0, 0, 20.0, 20.5};
+  st.inputs = {a, b, c};
+  return st;
+}
+
+/// The distribution functions, written from their definitions: a normal truncated to [lo, hi]
+/// (Phi(z) - Phi(alpha)) / (Phi(beta) - Phi(alpha)), in the upper tail through 1 - Phi(z) =
+/// Phi(-z); a log-normal Phi(ln(x / median) / ln(factor)).
+double truncatedCdf(double x, double mean, double std, double lo, double hi) {
+  const auto upper = [](double z) { return 0.5 * std::erfc(z / std::sqrt(2.0)); };  // 1 - Phi(z)
+  const double z = (x - mean) / std, alpha = (lo - mean) / std, beta = (hi - mean) / std;
+  return (upper(alpha) - upper(z)) / (upper(alpha) - upper(beta));
+}
+double logNormalCdf(double x, double median, double factor) {
+  return 0.5 * std::erfc(-std::log(x / median) / std::log(factor) / std::sqrt(2.0));
+}
+
+TEST(StudySampling, TruncatedAndLogNormalDrawsFollowTheirDistributionsInEveryStratum) {
+  for (const bool lhs : {false, true}) {
+    SCOPED_TRACE(lhs ? "latin hypercube" : "random");
+    const Study st = boundedInputs(lhs);
+    std::vector<std::vector<int>> strata(3, std::vector<int>(st.samples, 0));
+    double v[3];
+    double sum_log = 0.0;
+    for (std::uint64_t i = 0; i < st.samples; ++i) {
+      sampling::draw(st, i, v);
+      ASSERT_GE(v[0], 0.5) << i;
+      ASSERT_LE(v[0], 30.0) << i;
+      ASSERT_GT(v[1], 0.0) << i;
+      ASSERT_GE(v[2], 20.0) << i;
+      ASSERT_LE(v[2], 20.5) << i;
+      // Each value's probability: the unit it was drawn from, so its stratum.
+      const double p[3] = {truncatedCdf(v[0], 10.0, 20.0, 0.5, 30.0), logNormalCdf(v[1], 3.0, 2.0),
+                           truncatedCdf(v[2], 0.0, 1.0, 20.0, 20.5)};
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_GT(p[k], 0.0) << k;
+        ASSERT_LT(p[k], 1.0) << k;
+        ++strata[k][static_cast<std::size_t>(p[k] * static_cast<double>(st.samples))];
+      }
+      sum_log += std::log(v[1] / 3.0) / std::log(2.0);
+      // Deterministic: the same (seed, i), the same values.
+      double again[3];
+      sampling::draw(st, i, again);
+      EXPECT_EQ(std::vector<double>(v, v + 3), std::vector<double>(again, again + 3));
+    }
+    if (lhs)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(std::count(strata[k].begin(), strata[k].end(), 1), static_cast<long>(st.samples)) << "input " << k;
+    // ln(x / median) / ln(factor) is a standard normal: its mean within 5 standard errors of 0.
+    EXPECT_NEAR(sum_log / static_cast<double>(st.samples), 0.0, 5.0 / std::sqrt(static_cast<double>(st.samples)));
+  }
+}
+
+TEST(StudySampling, TheQuantileAtTheExtremeUnitsIsFinite) {
+  // The largest unit a Latin hypercube's top stratum rounds to (1 - 2^-53), and the smallest.
+  const Distribution normal{Distribution::Kind::Normal, 0.0, 1.0, 0};
+  // Truncated below only (p = Phi(alpha) + u (1 - Phi(alpha)) rounds to 1 at the top), above
+  // only, and far in either tail.
+  const Distribution one_sided[] = {{Distribution::Kind::Normal, 0.0, 1.0, 0, -1.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, -HUGE_VAL, 1.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, 30.0},
+                                    {Distribution::Kind::Normal, 0.0, 1.0, 0, -HUGE_VAL, -30.0}};
+  for (const double u : {sampling::lowest_unit, sampling::highest_unit}) {
+    EXPECT_TRUE(std::isfinite(sampling::quantile(normal, u))) << u;
+    for (const Distribution& d : one_sided) {
+      const double x = sampling::quantile(d, u);
+      EXPECT_TRUE(std::isfinite(x)) << u << " " << d.min << " " << d.max;
+      EXPECT_GE(x, d.min);
+      EXPECT_LE(x, d.max);
+    }
+  }
+  // (normalQuantile's refinement resolves the upper tail to ~1e-9 only: Phi(x) - p near p = 1.)
+  EXPECT_NEAR(sampling::quantile(normal, sampling::highest_unit), -sampling::normalQuantile(0x1p-53), 1e-8);
+  // unit() never returns 1 (its top key, 2^53 - 1 + 0.5, would round to 2^53).
+  EXPECT_LT(sampling::highest_unit, 1.0);
+}
+
 TEST(StudySampling, SampleIDependsOnlyOnSeedAndI) {
   const Study st = twoInputs(true);
   double forward[2], again[2];

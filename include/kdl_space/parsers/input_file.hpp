@@ -3,6 +3,7 @@
 // parser sees them.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "kdl_space/spatial/errors.hpp"
@@ -10,10 +11,21 @@
 
 namespace kdl_space {
 
+/// The largest URDF file the library reads: 64 MiB (the largest robots' are a few MB). Scenario
+/// and study files (YAML or JSON), whose parse costs more per byte, are bounded at 16 MiB.
+inline constexpr std::uintmax_t max_input_file_bytes = std::uintmax_t{64} << 20;
+
 /// \brief Refuses an input file that cannot be read: missing, a folder, not a regular file (a
-/// device or FIFO could block or never end), unreadable or empty. A set-up call: \throws
-/// InputError "PATH: what is wrong"; `kind` names what the file should be ("URDF file").
-KDL_SPACE_EXPORT void checkInputFile(const std::string& path, const std::string& kind);
+/// device or FIFO could block or never end), larger than `max_bytes` (checked before it is read),
+/// unreadable or empty. A set-up call: \throws InputError "PATH: what is wrong"; `kind` names
+/// what the file should be ("URDF file"). The default `max_bytes` sets no limit (a study's table
+/// may be any size): the loaders pass max_input_file_bytes.
+KDL_SPACE_EXPORT void checkInputFile(const std::string& path, const std::string& kind,
+                                     std::uintmax_t max_bytes = ~std::uintmax_t{0});
+
+/// \brief "" if the file at `path` (a regular file) has at most `max_bytes`, else why it is
+/// refused: "is 70000000 bytes (66.8 MiB), more than the 64 MiB a KIND may have".
+KDL_SPACE_EXPORT std::string fileTooLarge(const std::string& path, const std::string& kind, std::uintmax_t max_bytes);
 
 /// What a text is as a number (readNumber).
 enum class NumberText {

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,13 +22,16 @@ namespace kdl_space {
 /// How one input is drawn.
 struct Distribution {
   enum class Kind {
-    Uniform,  ///< uniform on [a, b]
-    Normal,   ///< normal, mean a, standard deviation b
-    Grid,     ///< `count` evenly spaced values from a to b (a factor of the study's full grid)
+    Uniform,    ///< uniform on [a, b]
+    Normal,     ///< normal, mean a, standard deviation b; truncated to [min, max] (drawn given it lies there)
+    Grid,       ///< `count` evenly spaced values from a to b (a factor of the study's full grid)
+    LogNormal,  ///< log-normal: median a > 0, factor b > 1 (exp of the log's standard deviation)
   };
   Kind kind = Kind::Uniform;
   double a = 0.0, b = 0.0;
   long count = 0;  ///< Grid only
+  /// Normal only: the bounds it is truncated to (infinite: not truncated on that side).
+  double min = -std::numeric_limits<double>::infinity(), max = std::numeric_limits<double>::infinity();
 };
 
 /// What one input of a study sets in the scenario (see docs/studies.md for the field names).

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -17,6 +18,12 @@ namespace kdl_space::fields {
 
 /// A text from the file, quoted for a message (detail/text.hpp).
 using detail::echo;
+
+/// The largest scenario or study file (YAML or JSON) parseFile reads: 16 MiB. Such files are
+/// kilobytes; yaml-cpp holds ~55 bytes of nodes per byte of a file (a 5 MB mapping of 200,000 keys
+/// takes 300 MB), so this bounds the parse to about 1 GB (max_input_file_bytes, 64 MiB, would
+/// allow 3.5 GB).
+inline constexpr std::uintmax_t max_yaml_file_bytes = std::uintmax_t{16} << 20;
 
 /// A file's YAML (or JSON, which YAML reads), or an InputError "FILE[:LINE]: what is wrong";
 /// `kind` names what the file should be ("scenario file (YAML or JSON)").
@@ -44,6 +51,10 @@ class Field {
   void onlyKeys(std::initializer_list<const char*> keys) const;
   /// The keys of a mapping, in file order; refuses a key given twice or one that is not a name.
   std::vector<std::string> keys() const;
+  struct Entry;
+  /// The keys of a mapping with their values, in file order, checked as keys() (O(n) for n keys:
+  /// at() searches the mapping, so a loop of at() over a large mapping would be O(n^2)).
+  std::vector<Entry> entries() const;
 
   std::string text() const;
   /// A finite number, read by readNumber (input_file.hpp); YAML's .inf and .nan are refused as not finite.
@@ -66,10 +77,21 @@ class Field {
   bool isSequence() const { return node_.IsSequence(); }
 
  private:
+  /// path.key, the key cut to a readable length (detail::cut).
+  std::string join(const std::string& key) const;
   Field child(const YAML::Node& node, const std::string& path) const { return Field(node, path, file_); }
   YAML::Node node_;
   std::string path_;
   const std::string* file_;
+};
+
+/// A key of a mapping and its value (Field::entries).
+struct Field::Entry {
+  std::string name;
+  Field key;    ///< the key: its line is where a key without a value is reported
+  Field value;  ///< its value (no value: a null node)
+  /// The value, or "PATH: has no value" at the key's line, as Field::at.
+  const Field& required() const;
 };
 
 }  // namespace kdl_space::fields

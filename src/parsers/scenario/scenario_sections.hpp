@@ -17,10 +17,10 @@ template <typename T, typename Read>
 std::vector<std::pair<unsigned int, T>> byJoint(const fields::Field& f, const FloatingModel& robot, Read read) {
   const std::vector<std::string>& names = robot.jointNames();
   std::vector<std::pair<int, T>> chosen(names.size(), {-1, T{}});  // (rank, value)
-  const std::vector<std::string> keys = f.keys();
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    const std::string& key = keys[k];
-    const fields::Field entry = f.at(key);
+  const std::vector<fields::Field::Entry> entries = f.entries();  // not at(key): O(n) each
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const std::string& key = entries[k].name;
+    const fields::Field& entry = entries[k].required();
     const bool pattern = key.find_first_of("*?[") != std::string::npos;
     const int rank = key == "*" ? 0 : pattern ? 1 + static_cast<int>(k) : 1 << 30;
     bool matched = false;

@@ -1,6 +1,19 @@
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace kdl_space {
+
+StepEstimate fewestSteps(const SimulationSpec& spec, double duration, double output_step) {
+  const bool rk4 = spec.options.integrator == Integrator::RK4;
+  const double step = rk4 ? spec.options.step : spec.options.max_step;
+  StepEstimate e;
+  e.longest = std::min(step, output_step);
+  e.limited_by = e.longest == output_step ? "output_step" : rk4 ? "step" : "max_step";
+  e.steps = std::ceil(duration / e.longest * (1.0 - 1e-12));  // 1e-12: a duration a whole number of steps
+  return e;
+}
 
 std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                          bool approach) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "detail/text.hpp"
+#include "kdl_space/parsers/input_file.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
 #include "parsers/urdf/urdf_summary.hpp"
@@ -266,9 +267,7 @@ UrdfReport checkUrdfFile(const std::string& path, const std::vector<std::string>
   if (status.type() == std::filesystem::file_type::directory) return unreadable("is a directory, not a URDF file");
   if (std::filesystem::exists(status) && status.type() != std::filesystem::file_type::regular)
     return unreadable("not a regular file (a device, pipe or socket)");
-  constexpr std::uintmax_t kMaxBytes = 256u << 20;
-  if (const std::uintmax_t size = std::filesystem::file_size(path, ec); !ec && size > kMaxBytes)
-    return unreadable("larger than 256 MiB (" + std::to_string(size) + " bytes): not a URDF file");
+  if (const std::string why = fileTooLarge(path, "URDF file", max_input_file_bytes); !why.empty()) return unreadable(why);
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) return unreadable(std::string("cannot open the file") + (errno ? std::string(": ") + std::strerror(errno) : ""));

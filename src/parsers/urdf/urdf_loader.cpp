@@ -4,12 +4,14 @@
 #include <kdl_parser/kdl_parser.hpp>
 #include <urdf_parser/urdf_parser.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
 
 #include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/parsers/input_file.hpp"
 #include "detail/text.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
@@ -196,8 +198,15 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
 }
 
 FloatingModel loadUrdfFile(const std::string& path) {
+  // Before it is read: a device never ends, and a file of gigabytes is no robot.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw ModelError(detail::shownPath(path) + ": is not a regular file; expected a URDF file");
+  if (const std::string why = fileTooLarge(path, "URDF file", max_input_file_bytes); !why.empty())
+    throw ModelError(detail::shownPath(path) + ": " + why);
   std::ifstream in(path);
-  if (!in) throw ModelError(path + ": cannot open the file");
+  if (!in) throw ModelError(detail::shownPath(path) + ": cannot open the file");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw ModelError(path + ": cannot read the file");

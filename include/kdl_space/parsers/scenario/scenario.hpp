@@ -64,6 +64,19 @@ struct Scenario {
 /// "FILE:LINE: robot.urdf: " in front (catch Error for both).
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
 
+/// The fewest steps a run can take (fewestSteps).
+struct StepEstimate {
+  double steps = 0.0;           ///< ceil(duration / longest)
+  double longest = 0.0;         ///< the longest step [s]
+  const char* limited_by = "";  ///< what bounds it: "output_step", "step" (rk4) or "max_step" (adaptive)
+};
+
+/// \brief The fewest steps a run of `duration` [s] with rows every `output_step` [s] takes under
+/// `spec`'s options: every step is at most max_step (adaptive) or step (rk4) long, and each output
+/// row ends a step. A run whose estimate exceeds options.max_steps cannot finish: `simulate` and
+/// a study's `motion` are refused before they start.
+KDL_SPACE_EXPORT StepEstimate fewestSteps(const SimulationSpec& spec, double duration, double output_step);
+
 /// \brief The simulator as the scenario says, for `model` (the robot's, or the robot with a
 /// captured payload, or a joined system: the robot's joints are found by name). The robot's mode
 /// holds through the motion (a grounded base stays grounded, braked joints stay braked) unless the
