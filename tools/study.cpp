@@ -1,5 +1,6 @@
 #include "study.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <chrono>
