@@ -1,8 +1,10 @@
 #include "study.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iostream>
@@ -32,6 +34,9 @@ CLI::App* addStudy(CLI::App& app, StudyOptions& o) {
   cmd->add_option("--plot", o.plot, "Draw a histogram of each outcome (.svg or .png)")->type_name("FILE");
   cmd->add_option("--heat-map", o.heat_map, "Draw the study's heat_map (.svg or .png)")->type_name("FILE");
   cmd->add_option("--summary", o.summary, "Write the summary as JSON")->type_name("FILE");
+  cmd->add_option("--groups", o.groups,
+                  "Write the per-grid-point aggregates (mean, q95, max of each outcome, P(exceeds.*)) as CSV")
+      ->type_name("FILE");
   cmd->add_flag("--json", o.json, "Print the summary as one JSON object instead of text");
   return cmd;
 }
@@ -68,6 +73,29 @@ std::pair<std::uint64_t, std::uint64_t> shardRange(const std::string& text, std:
 Json quantiles(const OutcomeSummary& o) {
   return Json{{"min", o.min}, {"q05", o.q05}, {"q25", o.q25}, {"median", o.median}, {"q75", o.q75},
               {"q95", o.q95}, {"max", o.max}, {"mean", o.mean}};
+}
+
+Json gridDigests(const std::vector<GridPointDigest>& list) {
+  Json a = Json::array();
+  for (const GridPointDigest& d : list) {
+    Json inputs = Json::object();
+    for (const auto& [name, value] : d.inputs) inputs[name] = value;
+    a.push_back(Json{{"grid_point", d.index}, {"count", d.count}, {"objective", d.objective}, {"inputs", inputs}});
+  }
+  return a;
+}
+
+Json gridPointsJson(const StudySummary& s) {
+  Json a = Json::array();
+  for (const GridPointSummary& g : s.grid_points) {
+    Json inputs = Json::object(), outcomes = Json::object(), probabilities = Json::object();
+    for (const auto& [name, value] : g.inputs) inputs[name] = value;
+    for (const GridPointSummary::Outcome& o : g.outcomes) outcomes[o.name] = Json{{"mean", o.mean}, {"q95", o.q95}, {"max", o.max}};
+    for (const auto& [name, p] : g.probabilities) probabilities[name] = p;
+    a.push_back(Json{{"grid_point", g.index}, {"inputs", inputs}, {"count", g.count}, {"failed", g.failed},
+                     {"outcomes", outcomes}, {"probabilities", probabilities}});
+  }
+  return a;
 }
 
 Json digests(const std::vector<SampleDigest>& list) {
@@ -110,6 +138,18 @@ void printSummary(std::ostream& out, const Study& st, const StudySummary& s, con
   };
   list("best (smallest)", s.best);
   list("worst (largest)", s.worst);
+  const auto points = [&](const char* title, const std::vector<GridPointDigest>& ds) {
+    out << "\n" << title << " by the " << st.objective_statistic << " of " << st.objective << ":\n";
+    for (const GridPointDigest& d : ds) {
+      out << "  grid point " << d.index << " (" << d.count << " samples): " << d.objective << "  (";
+      for (std::size_t k = 0; k < d.inputs.size(); ++k) out << (k ? ", " : "") << d.inputs[k].first << " = " << d.inputs[k].second;
+      out << ")\n";
+    }
+  };
+  if (!st.objective_statistic.empty()) {
+    points("best grid points (smallest)", s.best_grid_points);
+    points("worst grid points (largest)", s.worst_grid_points);
+  }
 }
 
 /// Called with each row of the table as it is written (sample order).
@@ -255,29 +295,66 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
 
 }  // namespace
 
+void writeStudyGroups(std::ostream& out, const StudySummary& s) {
+  if (s.grid_points.empty()) return;
+  const GridPointSummary& first = s.grid_points.front();
+  for (const auto& [name, v] : first.inputs) out << name << ",";
+  out << "count,failed";
+  for (const GridPointSummary::Outcome& o : first.outcomes) out << "," << o.name << ".mean," << o.name << ".q95," << o.name << ".max";
+  for (const auto& [name, p] : first.probabilities) out << ",P(" << name << ")";
+  out << "\n";
+  char buf[32];
+  const auto number = [&](double v) {
+    std::snprintf(buf, sizeof buf, "%.17g", v);  // reads back exactly, as the table's
+    return buf;
+  };
+  for (const GridPointSummary& g : s.grid_points) {
+    for (const auto& [name, v] : g.inputs) out << number(v) << ",";
+    out << g.count << "," << g.failed;
+    for (const GridPointSummary::Outcome& o : g.outcomes)
+      for (const double v : {o.mean, o.q95, o.max}) out << "," << number(v);
+    for (const auto& [name, p] : g.probabilities) out << "," << number(p);
+    out << "\n";
+  }
+}
+
 Json studySummaryJson(const Study& st, const StudySummary& s, const std::string& table) {
   Json outcomes = Json::object(), probabilities = Json::object(), failures = Json::array();
   for (const OutcomeSummary& o : s.outcomes) outcomes[o.name] = quantiles(o);
   for (const auto& [name, p] : s.probabilities) probabilities[name] = p;
   for (const StudyFailure& f : s.failures)
     failures.push_back(Json{{"status", f.status}, {"count", f.count}, {"first_sample", f.first_sample}, {"message", f.message}});
-  return Json{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
-              {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
-              {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
-              {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures},
-              {"quantile_rank_error", s.quantile_rank_error}};
+  Json grid_inputs = Json::array();
+  for (const StudyInput& in : st.inputs)
+    if (in.distribution.kind == Distribution::Kind::Grid) grid_inputs.push_back(in.name);
+  Json j{{"study", st.file},       {"fingerprint", fingerprintText(st)},          {"table", table},
+         {"samples", s.samples},   {"failed", s.failed},         {"seed", st.seed},
+         {"outcomes", outcomes},   {"probabilities", probabilities}, {"objective", st.objective},
+         {"best", digests(s.best)}, {"worst", digests(s.worst)}, {"failures", failures},
+         {"quantile_rank_error", s.quantile_rank_error},
+         {"grid_inputs", grid_inputs}, {"grid_points", gridPointsJson(s)}};
+  if (!st.objective_statistic.empty()) {  // the grid points ranked (a plain objective ranks samples only)
+    j["objective_statistic"] = st.objective_statistic;
+    j["best_grid_points"] = gridDigests(s.best_grid_points);
+    j["worst_grid_points"] = gridDigests(s.worst_grid_points);
+  }
+  return j;
 }
 
 void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   if (!o.shard.empty() && !o.merge.empty()) throw UsageError("--shard and --merge: a run computes a shard or merges them, not both");
   if (!o.plot.empty()) plotTerminal(o.plot);
-  if (!o.heat_map.empty() && !(o.heat_map.size() > 4 && (o.heat_map.substr(o.heat_map.size() - 4) == ".svg" ||
-                                                          o.heat_map.substr(o.heat_map.size() - 4) == ".png")))
-    throw UsageError("--heat-map " + o.heat_map + ": the file name must end in .svg or .png");
+  const std::string map_ext = o.heat_map.size() > 4 ? o.heat_map.substr(o.heat_map.size() - 4) : "";
+  if (!o.heat_map.empty() && map_ext != ".svg" && map_ext != ".png" && map_ext != ".csv")
+    throw UsageError("--heat-map " + o.heat_map + ": the file name must end in .svg or .png (or .csv for its cells' data)");
   const auto study = std::make_shared<const Study>(loadStudy(o.study));
   const Study& st = *study;
   if (!o.heat_map.empty() && !st.heat_map)
     throw UsageError("--heat-map " + o.heat_map + ": the study names no heat_map (x, y, outcome) in " + st.file);
+  if (!o.groups.empty() && std::none_of(st.inputs.begin(), st.inputs.end(), [](const StudyInput& in) {
+        return in.distribution.kind == Distribution::Kind::Grid;
+      }))
+    throw UsageError("--groups " + o.groups + ": the study has no grid input (grid: [from, to, count]) to group its samples by");
   const std::vector<std::string> columns = studyColumns(st);
   std::uint64_t begin = 0, end = st.samples, shard_i = 0, shard_n = 0;
   if (!o.shard.empty()) std::tie(begin, end) = shardRange(o.shard, st.samples, shard_i, shard_n);
@@ -286,7 +363,7 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     table = fs::path(st.file).stem().string() +
             (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
   const std::pair<const char*, std::string> outputs[] = {
-      {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}};
+      {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}, {"--groups", o.groups}};
   if (o.merge.empty() && chunkCount(StudyGrid{begin, end, chunkSize(o, st)}) > kMaxChunks)
     throw UsageError("--chunk-size " + std::to_string(chunkSize(o, st)) + ": " +
                      std::to_string(chunkCount(StudyGrid{begin, end, chunkSize(o, st)})) + " chunk files for samples " +
@@ -301,7 +378,7 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     checkOutputFile(path, option);
     refuseOverwritingInputs(option, path, inputs);
   }
-  if ((!o.plot.empty() || !o.heat_map.empty()) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
+  if ((!o.plot.empty() || (!o.heat_map.empty() && map_ext != ".csv")) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 
   // The summary from the rows as the table is written, a block at a time: never the whole table.
@@ -338,6 +415,14 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     if (!s) throw InputError("--summary " + o.summary + ": cannot write the file");
     f.commit();
   }
+  if (!o.groups.empty()) {
+    AtomicFile f(o.groups, "--groups");
+    std::ofstream g(f.tmp());
+    writeStudyGroups(g, summary);
+    g.close();
+    if (!g) throw InputError("--groups " + o.groups + ": cannot write the file");
+    f.commit();
+  }
   if (!o.plot.empty()) {
     AtomicFile f(o.plot, "--plot");
     writeStudyHistograms(f, st, columns, table, summary);
@@ -345,7 +430,7 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   }
   if (!o.heat_map.empty()) {
     AtomicFile f(o.heat_map, "--heat-map");
-    writeStudyHeatMap(f, st, columns, table);
+    writeStudyHeatMap(f, st, summary);
     f.commit();
   }
   if (o.json) {

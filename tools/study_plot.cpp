@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 
 #include "gnuplot_text.hpp"
 #include "plot_writer.hpp"
@@ -81,27 +82,57 @@ void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::
   runGnuplot(script.path(), out.tmp(), where);
 }
 
-void writeStudyHeatMap(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
-                       const std::string& table) {
+std::vector<HeatMapCell> studyHeatMapCells(const Study& study, const StudySummary& summary) {
+  const StudyHeatMap& h = *study.heat_map;
+  std::vector<HeatMapCell> cells;
+  for (const GridPointSummary& g : summary.grid_points) {
+    HeatMapCell c;
+    c.value = std::numeric_limits<double>::quiet_NaN();
+    for (const auto& [name, v] : g.inputs) {
+      if (name == h.x) c.x = v;
+      if (name == h.y) c.y = v;
+    }
+    for (const GridPointSummary::Outcome& o : g.outcomes)
+      if (o.name == h.outcome) c.value = h.statistic == "q95" ? o.q95 : h.statistic == "max" ? o.max : o.mean;
+    for (const auto& [name, p] : g.probabilities)
+      if (name == h.outcome) c.value = p;
+    cells.push_back(c);
+  }
+  return cells;
+}
+
+void writeStudyHeatMap(const AtomicFile& out, const Study& study, const StudySummary& summary) {
   const std::string where = "--heat-map " + out.path() + ": ";
   const StudyHeatMap& h = *study.heat_map;
-  const std::size_t x = columnOf(columns, h.x), y = columnOf(columns, h.y), v = columnOf(columns, h.outcome);
+  const std::vector<HeatMapCell> cells = studyHeatMapCells(study, summary);
+  const std::string label = h.outcome + " (" + h.statistic + " per grid point)";
+  const bool csv = out.path().size() > 4 && out.path().substr(out.path().size() - 4) == ".csv";
   const ScratchFile data(out.tmp() + ".dat"), script(out.tmp() + ".gp");
   {
-    std::ofstream d(data.path());
-    d << std::setprecision(12);
-    StudyPartReader rows(table, study, columns);
-    while (rows.next())
-      if (rows.row()[1] == 0.0) d << rows.row()[x] << " " << rows.row()[y] << " " << rows.row()[v] << "\n";
+    std::ofstream d(csv ? out.tmp() : data.path());
+    d << std::setprecision(17);
+    if (csv) d << h.x << "," << h.y << "," << h.outcome << "." << h.statistic << "\n";
+    for (const HeatMapCell& c : cells)
+      if (csv) d << c.x << "," << c.y << "," << c.value << "\n";
+      else if (std::isfinite(c.value)) d << c.x << " " << c.y << " " << c.value << "\n";
     d.close();
-    if (!d) throw InputError(where + "cannot write the plot's data next to it");
+    if (!d) throw InputError(where + (csv ? "cannot write the file" : "cannot write the plot's data next to it"));
   }
+  if (csv) return;
+  // Each cell a rectangle of the grid's steps (the grid inputs are evenly spaced).
+  const auto step = [&](const std::string& name) {
+    for (const StudyInput& in : study.inputs)
+      if (in.name == name && in.distribution.count > 1) return (in.distribution.b - in.distribution.a) / double(in.distribution.count - 1);
+    return 1.0;
+  };
   std::ofstream g(script.path());
+  g << std::setprecision(17);
   g << "set terminal " << plotTerminal(out.path(), 2) << "\nset output " << gnuplotQuoted(out.tmp()) << "\n"
-    << "set title " << gnuplotLabel(study.file + ": " + h.outcome + " over " + h.x + " and " + h.y) << "\n"
+    << "set title " << gnuplotLabel(study.file + ": " + label + " over " + h.x + " and " + h.y) << "\n"
     << "set xlabel " << gnuplotLabel(h.x) << "\nset ylabel " << gnuplotLabel(h.y) << "\nset cblabel "
-    << gnuplotLabel(h.outcome) << "\nset palette rgb 33,13,10\nset grid\nunset key\n"
-    << "plot " << gnuplotQuoted(data.path()) << " using 1:2:3 with points pt 5 ps 1.2 palette\n";
+    << gnuplotLabel(label) << "\nset palette rgb 33,13,10\nunset key\nset style fill solid 1.0 noborder\n"
+    << "plot " << gnuplotQuoted(data.path()) << " using 1:2:(" << std::abs(step(h.x)) / 2 << "):(" << std::abs(step(h.y)) / 2
+    << "):3 with boxxyerror fillcolor palette\n";
   g.close();
   if (!g) throw InputError(where + "cannot write the plot's script next to it");
   runGnuplot(script.path(), out.tmp(), where);

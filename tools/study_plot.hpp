@@ -1,8 +1,8 @@
 // The pictures of a study, drawn by gnuplot: a histogram of each outcome (`--plot`) and a heat
-// map of one outcome over two inputs (`--heat-map`, the study's heat_map). Both read the table
-// file row by row (never the whole table in memory): the histograms are counted here, in bins
-// over the summary's min..max, and gnuplot gets the counts; the heat map's points go to a
-// scratch file beside the picture.
+// map of one aggregate over the grid (`--heat-map`, the study's heat_map). The histograms read the
+// table file row by row (never the whole table in memory), counted here in bins over the summary's
+// min..max; the heat map's cells come from the summary's per-grid-point aggregates. gnuplot gets
+// their data in a scratch file beside the picture.
 #pragma once
 
 #include <string>
@@ -20,9 +20,19 @@ namespace kdl_space::cli {
 void writeStudyHistograms(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
                           const std::string& table, const StudySummary& summary);
 
-/// \brief The study's heat map: each computed sample of the table file a square at (x, y)
-/// coloured by the outcome.
-void writeStudyHeatMap(const AtomicFile& out, const Study& study, const std::vector<std::string>& columns,
-                       const std::string& table);
+/// One cell of a heat map: a grid point's (x, y) and its aggregate.
+struct HeatMapCell {
+  double x = 0, y = 0, value = 0;
+};
+
+/// \brief The study's heat map's cells: one per grid point of the summary (x and y are the study's
+/// grid inputs), its value the heat map's statistic of its outcome there, however many samples
+/// the point has (NaN: none computed).
+std::vector<HeatMapCell> studyHeatMapCells(const Study& study, const StudySummary& summary);
+
+/// \brief The study's heat map from the summary's per-grid-point aggregates: each cell a rectangle
+/// coloured by its value (studyHeatMapCells); a FILE ending in .csv gets the cells as CSV (x, y,
+/// OUTCOME.STATISTIC) instead of a picture.
+void writeStudyHeatMap(const AtomicFile& out, const Study& study, const StudySummary& summary);
 
 }  // namespace kdl_space::cli

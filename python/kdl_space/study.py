@@ -245,6 +245,14 @@ class StudyResult:
         return self._summary
 
     @property
+    def grid_points(self):
+        """The per-grid-point aggregates (the summary's ``grid_points``): one dict per point of the
+        study's grid that has samples, in the grid's order: ``grid_point``, ``inputs`` {grid input:
+        value}, ``count`` (computed), ``failed``, ``outcomes`` {name: {mean, q95, max}},
+        ``probabilities`` {exceeds.*: p}. Empty without grid inputs."""
+        return self.summary["grid_points"]
+
+    @property
     def failed(self):
         """How many samples could not be computed (status != 0)."""
         return int(np.count_nonzero(self.table[:, 1] != 0.0))

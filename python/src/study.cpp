@@ -118,6 +118,35 @@ py::list digests(const std::vector<SampleDigest>& list) {
   return a;
 }
 
+py::dict named(const std::vector<std::pair<std::string, double>>& values) {
+  py::dict d;
+  for (const auto& [name, v] : values) d[py::str(name)] = v;
+  return d;
+}
+
+/// A grid point's aggregates, as in `kdl_space study --json`'s grid_points.
+py::dict gridPoint(const GridPointSummary& g) {
+  py::dict d, outcomes;
+  for (const GridPointSummary::Outcome& o : g.outcomes) {
+    py::dict x;
+    x["mean"] = o.mean, x["q95"] = o.q95, x["max"] = o.max;
+    outcomes[py::str(o.name)] = x;
+  }
+  d["grid_point"] = g.index, d["inputs"] = named(g.inputs), d["count"] = g.count, d["failed"] = g.failed;
+  d["outcomes"] = outcomes, d["probabilities"] = named(g.probabilities);
+  return d;
+}
+
+py::list gridDigests(const std::vector<GridPointDigest>& list) {
+  py::list a;
+  for (const GridPointDigest& x : list) {
+    py::dict d;
+    d["grid_point"] = x.index, d["count"] = x.count, d["objective"] = x.objective, d["inputs"] = named(x.inputs);
+    a.append(d);
+  }
+  return a;
+}
+
 /// The summary as `kdl_space study --json` writes it (tools/study.cpp), without "table" (no file).
 py::dict summary(const PyStudy& s, py::handle given) {
   const Study& st = *s.study;
@@ -152,6 +181,15 @@ py::dict summary(const PyStudy& s, py::handle given) {
     failures.append(x);
   }
   d["failures"] = failures;
+  py::list grid_inputs, points;
+  for (const StudyInput& in : st.inputs)
+    if (in.distribution.kind == Distribution::Kind::Grid) grid_inputs.append(in.name);
+  for (const GridPointSummary& g : sum.grid_points) points.append(gridPoint(g));
+  d["grid_inputs"] = grid_inputs, d["grid_points"] = points;
+  if (!st.objective_statistic.empty()) {
+    d["objective_statistic"] = st.objective_statistic;
+    d["best_grid_points"] = gridDigests(sum.best_grid_points), d["worst_grid_points"] = gridDigests(sum.worst_grid_points);
+  }
   return d;
 }
 
@@ -191,6 +229,11 @@ void bindStudy(py::module_& m) {
                     "The table's columns: sample, status, the inputs drawn (target.tumble adds its axis), the outcomes.")
       .def_property_readonly("objective", [](const PyStudy& s) { return s.study->objective; },
                              "The outcome the best (smallest) and worst samples rank by.")
+      .def_property_readonly("objective_statistic", [](const PyStudy& s) -> py::object {
+        if (s.study->objective_statistic.empty()) return py::none();
+        return py::str(s.study->objective_statistic);
+      }, "`objective: {outcome, statistic}`'s statistic (mean, q95, max, probability): the grid points rank by it; "
+         "None: the samples rank by the outcome.")
       .def_property_readonly("scenario", [](const PyStudy& s) { return PyScenario{s.study->scenario}; }, "Its Scenario.")
       .def_property_readonly("motion_duration", [](const PyStudy& s) { return s.study->motion_duration; },
                              "[s]; 0: no motion after the capture.")
@@ -199,6 +242,10 @@ void bindStudy(py::module_& m) {
         const StudyHeatMap& h = *s.study->heat_map;
         return py::make_tuple(h.x, h.y, h.outcome);
       }, "(x, y, outcome) column names, or None.")
+      .def_property_readonly("heat_map_statistic", [](const PyStudy& s) -> py::object {
+        if (!s.study->heat_map) return py::none();
+        return py::str(s.study->heat_map->statistic);
+      }, "The per-grid-point aggregate the heat map draws (mean, q95, max, probability), or None.")
       .def_property_readonly("default_chunk_size", [](const PyStudy& s) { return defaultChunkSize(s.study->samples); },
                              "Samples per chunk on the study's grid of chunks (what the engines use by default).")
       .def("chunks", [](const PyStudy& s, long long chunk_size, long long begin, py::object end_arg) {
@@ -232,6 +279,22 @@ void bindStudy(py::module_& m) {
         r << "], columns (" << s.columns.size() << ",)>";
         return r.str();
       });
+
+  m.def("self_motion", [](const PyScenario& scenario, double s) {
+    std::vector<double> q;
+    {
+      py::gil_scoped_release nogil;
+      q = selfMotionJoints(scenario.scenario, s);
+    }
+    py::dict out;
+    const std::vector<std::string>& names = scenario.scenario.capture.robot.model->jointNames();
+    for (std::size_t j = 0; j < names.size(); ++j) out[py::str(names[j])] = q[j];
+    return out;
+  }, py::arg("scenario"), py::arg("s"),
+        "The joint angles {joint: angle} a study's `robot.self_motion` value s gives: the scenario's capture "
+        "configuration moved s [rad, joint-space arc length] along the 7-joint arm's self-motion, the hand's pose "
+        "held (a study's q.JOINT columns). InputError 'robot.self_motion: ...' for an arm with no one-parameter "
+        "self-motion, or a singularity on the way.");
 
   m.def("load_study", [](const std::string& path) {
     auto st = std::make_shared<const Study>(loadStudy(path));

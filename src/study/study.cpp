@@ -2,6 +2,7 @@
 // the capture solved (CaptureSolver, its robot side kept between samples), and the outcomes.
 #include "kdl_space/study/study.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -37,6 +38,14 @@ std::vector<std::string> studyColumns(const Study& study) {
   if (study.limits.joint_torque) c.emplace_back("exceeds.joint_torque");
   if (study.limits.base_rate) c.emplace_back("exceeds.base_rate");
   if (study.limits.joint_rate || study.limits.joint_torque || study.limits.base_rate) c.emplace_back("exceeds.any");
+  // Added after the columns above (whose positions stay): the configuration a self-motion value
+  // gives (no other column says it), and the joint rates after the capture (the jumps alone do
+  // not say what exceeds.joint_rate tests).
+  const bool self_motion = std::any_of(study.inputs.begin(), study.inputs.end(),
+                                       [](const StudyInput& in) { return in.field == StudyInput::Field::SelfMotion; });
+  if (self_motion)
+    for (const std::string& j : joints) c.push_back("q." + j);
+  for (const std::string& j : joints) c.push_back("qdot." + j);
   return c;
 }
 
@@ -230,7 +239,22 @@ void StudyEvaluator::sample(std::uint64_t i, double* row) {
   if (st.limits.joint_torque) flag(torque_ratio > 1.0);
   if (st.limits.base_rate) flag(peak_base_rate > *st.limits.base_rate);
   if (st.limits.joint_rate || st.limits.joint_torque || st.limits.base_rate) flag(any);
+  if (w.self_motion)
+    for (unsigned int j = 0; j < n; ++j) *out++ = robot.state.q(j);
+  for (unsigned int j = 0; j < n; ++j) *out++ = r->robot.after.qdot(j);
   row[1] = E_NOERROR;
+}
+
+std::vector<double> selfMotionJoints(const Scenario& scenario, double s) {
+  const FloatingSystem& robot = scenario.capture.robot;
+  SelfMotion motion(robot.model, robot.contact, robot.state);  // or InputError "robot.self_motion: ..."
+  State state = robot.state;
+  if (const int rc = motion.move(state, s))
+    throw InputError("robot.self_motion: the arm cannot move " + detail::number(s) + " rad along its self-motion (" +
+                     strError(rc) + "): a singularity lies on the way; give a value closer to 0");
+  std::vector<double> q(robot.model->nj());
+  for (unsigned int j = 0; j < robot.model->nj(); ++j) q[j] = state.q(j);
+  return q;
 }
 
 }  // namespace kdl_space

@@ -228,6 +228,18 @@ void checkColumn(const Field& f, const std::vector<std::string>& columns, const 
     f.fail("is no " + what + " of this study (its columns: " + detail::listNames(columns) + ")");
 }
 
+bool isGrid(const StudyInput& in) { return in.distribution.kind == Distribution::Kind::Grid; }
+
+/// An aggregate of an outcome at a grid point: mean, q95, max; probability for an exceeds.* column.
+std::string statistic(const Field& f, const std::string& outcome) {
+  const std::string s = f.text();
+  const bool limit = outcome.rfind("exceeds.", 0) == 0;
+  if (limit ? s != "probability" : (s != "mean" && s != "q95" && s != "max"))
+    f.fail(echo(s) + " is no statistic of " + outcome + ": " +
+           (limit ? "an exceeds.* column has `probability`" : "one of mean, q95, max"));
+  return s;
+}
+
 }  // namespace
 
 Study loadStudy(const std::string& path) {
@@ -315,14 +327,40 @@ Study loadStudy(const std::string& path) {
   }
   const std::vector<std::string> columns = studyColumns(st);
   if (top.has("objective")) {
-    checkColumn(top.at("objective"), columns, "outcome");
-    st.objective = top.at("objective").text();
+    const Field o = top.at("objective");
+    if (o.isScalar()) {  // a column: the samples ranked by it
+      checkColumn(o, columns, "outcome");
+      st.objective = o.text();
+    } else {  // {outcome, statistic}: the grid points ranked by that aggregate
+      o.onlyKeys({"outcome", "statistic"});
+      checkColumn(o.at("outcome"), columns, "outcome");
+      st.objective = o.at("outcome").text();
+      st.objective_statistic = statistic(o.at("statistic"), st.objective);
+      if (!std::any_of(st.inputs.begin(), st.inputs.end(), isGrid))
+        o.fail("ranks grid points, and the study has no grid input: give one (grid: [from, to, count]), or "
+               "rank the samples with `objective: " + st.objective + "`");
+    }
   }
   if (top.has("heat_map")) {
     const Field h = top.at("heat_map");
-    h.onlyKeys({"x", "y", "outcome"});
+    h.onlyKeys({"x", "y", "outcome", "statistic"});
     for (const char* k : {"x", "y", "outcome"}) checkColumn(h.at(k), columns, "column");
-    st.heat_map = StudyHeatMap{h.at("x").text(), h.at("y").text(), h.at("outcome").text()};
+    st.heat_map = StudyHeatMap{h.at("x").text(), h.at("y").text(), h.at("outcome").text(), "mean"};
+    if (h.at("outcome").text().rfind("exceeds.", 0) == 0) st.heat_map->statistic = "probability";
+    if (h.has("statistic")) st.heat_map->statistic = statistic(h.at("statistic"), st.heat_map->outcome);
+    // One value a cell: the cells are the grid's points, so x and y are its grid inputs, all of them.
+    std::vector<std::string> grid;
+    for (const StudyInput& in : st.inputs)
+      if (isGrid(in)) grid.push_back(in.name);
+    for (const char* k : {"x", "y"})
+      if (std::find(grid.begin(), grid.end(), h.at(k).text()) == grid.end())
+        h.at(k).fail("is no grid input of this study: a heat map's cells are the grid's points (one value a cell); "
+                     "give " + h.at(k).text() + " a grid: [from, to, count]" +
+                     (grid.empty() ? std::string() : " (its grid inputs: " + detail::listNames(grid) + ")"));
+    if (h.at("x").text() == h.at("y").text()) h.at("y").fail("is x too: give two grid inputs");
+    if (grid.size() != 2)
+      h.fail("the study has " + std::to_string(grid.size()) + " grid inputs (" + detail::listNames(grid) +
+             "): a heat map's cells are its grid points, so it needs exactly two (x and y)");
   }
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (const std::string& file : {path, scenario_path, sc.robot_urdf, sc.target_urdf}) h = fold(h, file);

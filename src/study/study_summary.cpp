@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 
 #include "kdl_space/study/study.hpp"
 #include "study/quantile_sketch.hpp"
@@ -86,6 +88,60 @@ struct StudySummarizer::State {
   std::vector<Failed> failures;  ///< in the order first seen
   std::vector<Column> outcomes;  ///< columns first_outcome..m-1
   std::vector<Ranked> best, worst;  ///< ascending; descending
+  /// One grid point's samples (sample i is at point i mod grid): per outcome column its exact sum,
+  /// a quantile sketch (for its q95; exact up to 65,536 values) and its max.
+  struct Point {
+    std::uint64_t count = 0, failed = 0;
+    std::vector<double> inputs;  ///< the grid inputs' values (the same in every row of the point)
+    std::vector<sketch::ExactSum> sum;
+    std::vector<sketch::QuantileSketch> values;
+    std::vector<double> max;
+  };
+  std::vector<std::size_t> grid_columns;  ///< the grid inputs' columns; empty: no grid
+  std::uint64_t grid = 1;
+  std::map<std::uint64_t, Point> points;  ///< bounded by the grid's size, not the samples
+
+  Point& point(std::uint64_t index, const double* row) {
+    auto [it, added] = points.try_emplace(index);
+    Point& p = it->second;
+    if (added) {
+      for (const std::size_t c : grid_columns) p.inputs.push_back(row[c]);
+      p.sum.resize(outcomes.size());
+      p.values.resize(outcomes.size());
+      p.max.assign(outcomes.size(), 0.0);
+    }
+    return p;
+  }
+
+  void addToPoint(const double* row, bool computed_row) {
+    const std::uint64_t i = sampleOf(row[0]);
+    Point& p = point(i == ~std::uint64_t{0} ? i : i % grid, row);
+    if (!computed_row) {
+      ++p.failed;
+      return;
+    }
+    const bool first = p.count++ == 0;
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+      const double v = row[first_outcome + k];
+      p.sum[k].add(v);
+      if (outcomes[k].limit) continue;
+      p.values[k].add(v);
+      if (first || sketch::before(p.max[k], v)) p.max[k] = v;
+    }
+  }
+
+  void mergePoint(std::uint64_t index, const Point& o) {
+    auto [it, added] = points.try_emplace(index, o);
+    if (added) return;
+    Point& p = it->second;
+    for (std::size_t k = 0; k < outcomes.size() && o.count > 0; ++k) {
+      p.sum[k].merge(o.sum[k]);
+      if (outcomes[k].limit) continue;
+      p.values[k].merge(o.values[k]);
+      if (p.count == 0 || sketch::before(p.max[k], o.max[k])) p.max[k] = o.max[k];
+    }
+    p.count += o.count, p.failed += o.failed;
+  }
 
   void fail(int status, std::uint64_t count, std::uint64_t first) {
     auto f = std::find_if(failures.begin(), failures.end(), [&](const Failed& x) { return x.status == status; });
@@ -105,6 +161,7 @@ struct StudySummarizer::State {
 
   void add(const double* row) {
     ++samples;
+    if (!grid_columns.empty()) addToPoint(row, row[1] == 0.0);
     if (row[1] != 0.0) {
       ++failed;
       fail(statusOf(row[1]), 1, sampleOf(row[0]));
@@ -139,6 +196,12 @@ StudySummarizer::StudySummarizer(std::shared_ptr<const Study> study) : state_(st
   s.objective = static_cast<std::size_t>(std::find(s.columns.begin(), s.columns.end(), study->objective) - s.columns.begin());
   s.outcomes.resize(s.m - s.first_outcome);
   for (std::size_t c = s.first_outcome; c < s.m; ++c) s.outcomes[c - s.first_outcome].limit = s.columns[c].rfind("exceeds.", 0) == 0;
+  std::size_t c = 2;
+  for (const StudyInput& in : study->inputs) {
+    if (in.distribution.kind == Distribution::Kind::Grid) s.grid_columns.push_back(c);
+    c += static_cast<std::size_t>(sampling::valuesOf(in));
+  }
+  s.grid = sampling::gridSize(*study);
   s.study = std::move(study);
 }
 
@@ -163,9 +226,63 @@ void StudySummarizer::merge(const StudySummarizer& other) {
     if (s.computed == 0 || sketch::before(b.min, a.min)) a.min = b.min;
     if (s.computed == 0 || sketch::before(a.max, b.max)) a.max = b.max;
   }
+  for (const auto& [index, p] : o.points) s.mergePoint(index, p);
   for (const Ranked& r : o.best) State::rank(s.best, r, ranksBefore);
   for (const Ranked& r : o.worst) State::rank(s.worst, r, State::worse);
   s.samples += o.samples, s.failed += o.failed, s.computed += o.computed;
+}
+
+namespace {
+
+/// A grid point's aggregate by name: an outcome's mean, q95 or max, an exceeds.* probability.
+std::optional<double> statisticOf(const GridPointSummary& p, const std::string& outcome, const std::string& statistic) {
+  for (const GridPointSummary::Outcome& o : p.outcomes)
+    if (o.name == outcome) return statistic == "q95" ? o.q95 : statistic == "max" ? o.max : o.mean;
+  for (const auto& [name, v] : p.probabilities)
+    if (name == outcome) return v;
+  return std::nullopt;
+}
+
+}  // namespace
+
+/// The summary's grid points (their aggregates) and, with an objective's statistic, their ranking.
+void StudySummarizer::gridPoints(const State& st, StudySummary& s) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& [index, p] : st.points) {
+    GridPointSummary g;
+    g.index = index, g.count = p.count, g.failed = p.failed;
+    for (std::size_t k = 0; k < st.grid_columns.size(); ++k) g.inputs.emplace_back(st.columns[st.grid_columns[k]], p.inputs[k]);
+    const double n = static_cast<double>(p.count);
+    for (std::size_t k = 0; k < st.outcomes.size(); ++k) {
+      const std::string& name = st.columns[st.first_outcome + k];
+      const double mean = p.count ? p.sum[k].value() / n : nan;
+      if (st.outcomes[k].limit) {
+        g.probabilities.emplace_back(name, mean);
+        continue;
+      }
+      g.outcomes.push_back({name, mean, p.count ? p.values[k].quantiles({0.95})[0] : nan, p.count ? p.max[k] : nan});
+    }
+    s.grid_points.push_back(std::move(g));
+  }
+  const Study& study = *st.study;
+  if (study.objective_statistic.empty()) return;
+  std::vector<GridPointDigest> ranked;
+  for (const GridPointSummary& g : s.grid_points) {
+    const std::optional<double> v = statisticOf(g, study.objective, study.objective_statistic);
+    if (g.count > 0 && v) ranked.push_back(GridPointDigest{g.index, g.count, *v, g.inputs});
+  }
+  // By the statistic (NaN last), ties by the point's index: the same for any order of the rows.
+  std::sort(ranked.begin(), ranked.end(), [](const GridPointDigest& a, const GridPointDigest& b) {
+    if (sketch::before(a.objective, b.objective)) return true;
+    if (sketch::before(b.objective, a.objective)) return false;
+    return a.index < b.index;
+  });
+  const std::size_t k = std::min(kRanked, ranked.size());
+  s.best_grid_points.assign(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(k));
+  std::stable_sort(ranked.begin(), ranked.end(), [](const GridPointDigest& a, const GridPointDigest& b) {
+    return sketch::before(b.objective, a.objective);  // largest first, ties keep the index order
+  });
+  s.worst_grid_points.assign(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(k));
 }
 
 StudySummary StudySummarizer::finish() const {
@@ -202,6 +319,7 @@ StudySummary StudySummarizer::finish() const {
   };
   digests(st.best, s.best);
   digests(st.worst, s.worst);
+  gridPoints(st, s);
   return s;
 }
 

@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <unistd.h>
 
@@ -46,8 +48,7 @@ const std::string kGrasp = write("grasp.yaml", "scenario: " + kScenarios + "tumb
                                  "samples: 400\nseed: 20261123\nsampling: latin_hypercube\n"
                                  "inputs:\n  robot.self_motion: {grid: [-1.2, 1.2, 25]}\n"
                                  "  target.tumble: {uniform: [0.05, 0.16]}\n"
-                                 "limits: {joint_rate: urdf, base_rate: 0.0015}\nobjective: base_rate\n"
-                                 "heat_map: {x: robot.self_motion, y: target.tumble, outcome: base_rate}\n");
+                                 "limits: {joint_rate: urdf, base_rate: 0.0015}\nobjective: base_rate\n");
 
 TEST(StudyCommand, TheTableIsTheSameOnOneThreadOnTwoAndFromThreeShardsMerged) {
   const std::string one = scratch("one.csv"), two = scratch("two.csv"), merged = scratch("merged.csv");
@@ -125,6 +126,81 @@ TEST(StudyCommand, SummaryJsonPlotsAndTheBestConfigurations) {
   EXPECT_GT(fs::file_size(plot), 1000u);
   EXPECT_GT(fs::file_size(map), 1000u);
   EXPECT_NE(slurp(map).find("<svg"), std::string::npos);
+}
+
+/// The CSV lines of a file, each split at its commas.
+std::vector<std::vector<std::string>> csvLines(const std::string& path) {
+  std::vector<std::vector<std::string>> lines;
+  std::istringstream in(slurp(path));
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::istringstream l(line);
+    for (std::string cell; std::getline(l, cell, ',');) cells.push_back(cell);
+    lines.push_back(cells);
+  }
+  return lines;
+}
+
+// 3 x 4 grid points, 5 samples each (a random tumble): the heat map's cells and the groups' CSV.
+const std::string kCells = write("cells.yaml", "scenario: " + kScenarios + "tumbling_box_capture.yaml\n"
+                                 "samples: 60\nseed: 3\ninputs:\n  robot.q.joint6: {grid: [-0.2, 0.2, 3]}\n"
+                                 "  robot.q.joint7: {grid: [-0.3, 0.3, 4]}\n  target.tumble: {uniform: [0.02, 0.2]}\n"
+                                 "limits: {base_rate: 0.0015}\nobjective: {outcome: base_rate, statistic: q95}\n"
+                                 "heat_map: {x: robot.q.joint7, y: robot.q.joint6, outcome: base_rate, statistic: max}\n");
+
+TEST(StudyCommand, TheHeatMapHasOneValueACellTheGroupsCsvOneRowAPoint) {
+  const std::string table = scratch("cells.csv"), map = scratch("cells_map.csv"), groups = scratch("cells_groups.csv");
+  const ToolRun r = kdlSpace("study " + kCells + " -o " + table + " --heat-map " + map + " --groups " + groups + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["grid_inputs"], json::array({"robot.q.joint6", "robot.q.joint7"}));
+  ASSERT_EQ(j["grid_points"].size(), 12u);
+  EXPECT_EQ(j["objective_statistic"], "q95");
+  ASSERT_EQ(j["best_grid_points"].size(), 5u);
+  // The heat map: 12 cells (not 60 points), each (x, y) once, its value the max of its 5 samples.
+  const auto cells = csvLines(map);
+  ASSERT_EQ(cells.size(), 13u);
+  EXPECT_EQ(cells[0], (std::vector<std::string>{"robot.q.joint7", "robot.q.joint6", "base_rate.max"}));
+  std::set<std::pair<double, double>> seen;
+  for (std::size_t k = 1; k < cells.size(); ++k) {
+    ASSERT_EQ(cells[k].size(), 3u);
+    EXPECT_TRUE(seen.insert({std::stod(cells[k][0]), std::stod(cells[k][1])}).second) << "a cell twice";
+  }
+  // The same maxima from the raw table, grouped here.
+  std::map<std::pair<double, double>, double> max_by_cell;
+  const auto rows = csvLines(table);
+  const auto& header = rows[1];
+  const auto at = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  for (std::size_t k = 2; k + 1 < rows.size(); ++k) {
+    const std::pair<double, double> key{std::stod(rows[k][at("robot.q.joint7")]), std::stod(rows[k][at("robot.q.joint6")])};
+    const double v = std::stod(rows[k][at("base_rate")]);
+    max_by_cell[key] = max_by_cell.count(key) ? std::max(max_by_cell[key], v) : v;
+  }
+  ASSERT_EQ(max_by_cell.size(), 12u);
+  for (std::size_t k = 1; k < cells.size(); ++k)
+    EXPECT_EQ(std::stod(cells[k][2]), (max_by_cell[{std::stod(cells[k][0]), std::stod(cells[k][1])}]));
+  // The groups' CSV: the grid inputs, count, failed, each outcome's mean, q95, max, P(exceeds.*).
+  const auto g = csvLines(groups);
+  ASSERT_EQ(g.size(), 13u);
+  EXPECT_EQ(g[0][0], "robot.q.joint6");
+  EXPECT_EQ(g[0][1], "robot.q.joint7");
+  EXPECT_EQ(g[0][2], "count");
+  EXPECT_NE(std::find(g[0].begin(), g[0].end(), "base_rate.q95"), g[0].end());
+  EXPECT_EQ(g[0].back(), "P(exceeds.any)");
+  for (std::size_t k = 1; k < g.size(); ++k) {
+    EXPECT_EQ(g[k].size(), g[0].size());
+    EXPECT_EQ(g[k][2], "5");
+    const json& point = j["grid_points"][k - 1];
+    EXPECT_EQ(std::stod(g[k][0]), point["inputs"]["robot.q.joint6"].get<double>());
+    const std::size_t q95 = static_cast<std::size_t>(std::find(g[0].begin(), g[0].end(), "base_rate.q95") - g[0].begin());
+    EXPECT_EQ(std::stod(g[k][q95]), point["outcomes"]["base_rate"]["q95"].get<double>());
+  }
+  // The picture: drawn from the same cells.
+  const std::string svg = scratch("cells_map.svg");
+  ASSERT_EQ(kdlSpace("study " + kCells + " -o " + table + " --heat-map " + svg).rc, 0);
+  EXPECT_NE(slurp(svg).find("<svg"), std::string::npos);
 }
 
 TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {

@@ -63,7 +63,10 @@ struct StudyLimits {
 
 /// A heat map of one outcome over two inputs.
 struct StudyHeatMap {
-  std::string x, y, outcome;  ///< column names
+  std::string x, y, outcome;  ///< column names: x and y the study's grid inputs
+  /// The per-grid-point aggregate drawn in each cell (one value a cell, however many samples):
+  /// "mean" (default), "q95", "max", or "probability" for an exceeds.* outcome.
+  std::string statistic = "mean";
 };
 
 /// A study file, read and checked.
@@ -79,10 +82,20 @@ struct Study {
   double motion_output_step = 0.0; ///< [s] where the motion's peaks are read
   StudyLimits limits;
   std::string objective = "base_rate";  ///< the outcome the best (smallest) and worst samples rank by
+  /// `objective: {outcome, statistic}`: the grid points (not the samples) are ranked by this
+  /// aggregate of the outcome ("mean", "q95", "max"; "probability" for exceeds.*); empty: plain.
+  std::string objective_statistic;
   std::optional<StudyHeatMap> heat_map;
   /// The most samples a study may ask for.
   static constexpr std::uint64_t max_samples = 1000000000ULL;
 };
+
+/// \brief The joint angles (model order) a `robot.self_motion` value s gives: the scenario's
+/// capture configuration moved s [rad, joint-space arc length] along the arm's self-motion, the
+/// hand's pose held (what a study's sample with that input computes; its q.JOINT columns).
+/// \throws InputError "robot.self_motion: ..." for an arm with no one-parameter self-motion, or
+/// one that cannot move that far (a singularity on the way).
+KDL_SPACE_EXPORT std::vector<double> selfMotionJoints(const Scenario& scenario, double s);
 
 /// \brief Reads and checks a study file (YAML or JSON): its scenario (loadScenario, relative to
 /// the study's folder), each input's field and distribution, the sample count, seed, limits.
@@ -180,6 +193,27 @@ struct StudyFailure {
   std::string message;
 };
 
+/// The aggregates of the samples at one point of the study's grid (one value of each grid input).
+struct GridPointSummary {
+  std::uint64_t index = 0;  ///< the grid point: sample i is at point i mod (the grid's size)
+  std::vector<std::pair<std::string, double>> inputs;  ///< the grid inputs' values, in file order
+  std::uint64_t count = 0, failed = 0;  ///< its samples that computed; that failed
+  /// Per outcome (not exceeds.*), over the point's computed samples: the mean, the 95 %
+  /// quantile (as OutcomeSummary's), the max; NaN when none computed.
+  struct Outcome {
+    std::string name;
+    double mean = 0, q95 = 0, max = 0;
+  };
+  std::vector<Outcome> outcomes;
+  std::vector<std::pair<std::string, double>> probabilities;  ///< per exceeds.* column
+};
+/// A grid point as the objective ranks it.
+struct GridPointDigest {
+  std::uint64_t index = 0, count = 0;
+  double objective = 0.0;  ///< the objective's statistic of its outcome at this point
+  std::vector<std::pair<std::string, double>> inputs;
+};
+
 /// What a whole table says.
 struct StudySummary {
   std::uint64_t samples = 0, failed = 0;
@@ -194,6 +228,12 @@ struct StudySummary {
   /// exact order statistics of ranks p (n - 1) -+ quantile_rank_error n; at most
   /// 1/65536 + floor(log2(n / 16384)) / 16384 (under 0.001 for 1e9 samples). See docs/studies.md.
   double quantile_rank_error = 0.0;
+  /// With grid inputs: the aggregates at each grid point that has samples, in the grid's order
+  /// (empty without grid inputs). Each point's q95 is exact up to 65,536 computed samples there.
+  std::vector<GridPointSummary> grid_points;
+  /// With `objective: {outcome, statistic}`: the grid points by that statistic, up to 5 each
+  /// (smallest first; largest first), ties by index; points with no computed sample left out.
+  std::vector<GridPointDigest> best_grid_points, worst_grid_points;
 };
 
 /// \brief A study's summary from its rows fed a block at a time, in memory that does not grow
@@ -219,6 +259,7 @@ class KDL_SPACE_EXPORT StudySummarizer {
 
  private:
   struct State;
+  static void gridPoints(const State& state, StudySummary& summary);
   std::unique_ptr<State> state_;
 };
 
