@@ -253,17 +253,20 @@ def test_inside_the_limits_away_from_singularities_nothing_is_warned(cli, arm):
     assert json.loads(out.stdout)["warnings"] == []
 
 
-def test_a_near_singular_configuration_is_warned_about(cli, arm):
-    # joint4 at 0 stretches the forearm along the upper arm (a wrist-elbow singularity of the
-    # default arm); 1e-5 rad away, sigma_min / sigma_max of J* is far below 1e-3.
-    q = {"joint2": 0.7, "joint4": 1e-5}
-    state = kdl_space.State(arm, q=q)
-    contact = arm.contact("end_effector")
-    solver = kdl_space.FreeFloatingSolver(arm)
-    solver.compute(state)
-    sigma = np.linalg.svd(solver.J_star(contact), compute_uv=False)
-    assert sigma[-1] / sigma[0] < kdl_space.NEAR_SINGULAR_RATIO == 1e-3
-    r = kdl_space.inspect_contact(state, contact)
-    assert ("near_singular", "contact 'end_effector'") in kinds(r["warnings"])
-    j = inspect_json(cli, "--urdf", ARM, "--tip", "end_effector", "--q", *[f"{k}={v}" for k, v in q.items()])
-    assert ("near_singular", "contact 'end_effector'") in kinds(j["warnings"])
+def test_a_near_singular_configuration_is_warned_about(cli):
+    # The dual arm's wrist (roll-pitch-roll) with its pitch left_joint5 at 0: the two roll axes
+    # nearly line up (only the links' small offsets keep them apart), sigma_min / sigma_max of J*
+    # below 1e-3 by NumPy's own SVD; at left_joint5 = 0.8 it is well above.
+    model = kdl_space.load_urdf(str(DUAL_ARM))
+    contact = model.contact("left_tool")
+    solver = kdl_space.FreeFloatingSolver(model)
+    for wrist, singular in ((0.0, True), (0.8, False)):
+        q = {"left_joint2": 0.5, "left_joint3": -1.0, "left_joint5": wrist}
+        state = kdl_space.State(model, q=q)
+        solver.compute(state)
+        sigma = np.linalg.svd(solver.J_star(contact), compute_uv=False)
+        assert (sigma[-1] / sigma[0] < kdl_space.NEAR_SINGULAR_RATIO == 1e-3) == singular
+        r = kdl_space.inspect_contact(state, contact)
+        assert (("near_singular", "contact 'left_tool'") in kinds(r["warnings"])) == singular
+        j = inspect_json(cli, "--urdf", DUAL_ARM, "--tip", "left_tool", "--q", *[f"{k}={v}" for k, v in q.items()])
+        assert (("near_singular", "contact 'left_tool'") in kinds(j["warnings"])) == singular
