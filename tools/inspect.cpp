@@ -108,6 +108,44 @@ void printPoseAndConditioning(std::ostream& report, const PoseFigures& f, const 
   printWrapped(report, k.str(), width);
 }
 
+/// The model's diagnostics, less "limits exclude 0" for a joint given by --q (it is not at 0) or
+/// one a warning says is outside its limits here (said once, by the warning).
+std::vector<std::string> modelDiagnostics(const FloatingModel& model, const std::map<std::string, double>& q_by_name,
+                                          const std::vector<Diagnostic>& warnings) {
+  std::vector<std::string> given;
+  for (const auto& entry : q_by_name) given.push_back(entry.first);
+  for (const Diagnostic& d : warnings) given.push_back(d.element);
+  std::vector<std::string> diagnostics;
+  for (const Diagnostic& d : diagnosticsForGivenJoints(model.diagnostics(), given)) diagnostics.push_back(describe(d));
+  return diagnostics;
+}
+
+void printJointMargins(std::ostream& out, const FloatingModel& model, const KDL::JntArray& q, std::size_t width) {
+  Eigen::MatrixXd rows(model.nj(), 3);
+  for (const JointMargin& m : jointMargins(model, q)) rows.row(m.joint) << m.to_lower, m.to_upper, m.margin();
+  printMatrix(out, "Joint margins to the limits [rad or m] (inf: no limit; negative: outside)", rows,
+              model.jointNames(), {"above lower", "below upper", "margin"}, width);
+}
+
+Json inspectJson(const FreeFloatingSolver& solver, const State& state, const Json& json_contacts,
+                 const Eigen::MatrixXd& G_all, const std::vector<std::string>& diagnostics,
+                 const std::vector<Diagnostic>& warnings) {
+  const FloatingModel* model = &solver.model();
+  Json j;
+  j["mass"] = solver.w();
+  j["com"] = toJson(solver.r_g());
+  j["I_g"] = toJson(solver.I_g());
+  j["joint_names"] = model->jointNames();
+  j["joints_treated_as_fixed"] = fixedJointsJson(*model);
+  j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
+  j["contacts"] = json_contacts;
+  j["G_star_all"] = toJson(G_all);
+  j["joint_margins"] = jointMarginsJson(*model, jointMargins(*model, state.q));
+  j["diagnostics"] = diagnostics;
+  j["warnings"] = warningsJson(warnings);
+  return j;
+}
+
 }  // namespace
 
 CLI::App* addInspect(CLI::App& app, InspectOptions& o) {
@@ -196,16 +234,10 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   // The configuration's warnings: joints outside their limits here, then (per contact) J* near a
   // singularity. They are also diagnostics (inspect's one list of what to look at).
   std::vector<Diagnostic> warnings = configurationWarnings(*model, state.q, nullptr, "");
+  std::vector<std::string> diagnostics = modelDiagnostics(*model, q_by_name, warnings);
   Kinematics kin(*model);
   if (const int rc = forwardKinematics(*model, state, kin))
     throw InputError(o.urdf + ": the link poses cannot be computed at this state: " + strError(rc));
-  // The model's warnings, less "limits exclude 0" for a joint given by --q (it is not at 0) or
-  // outside its limits here (said once, by the warning above).
-  std::vector<std::string> given;
-  for (const auto& entry : q_by_name) given.push_back(entry.first);
-  for (const Diagnostic& d : warnings) given.push_back(d.element);
-  std::vector<std::string> diagnostics;
-  for (const Diagnostic& d : diagnosticsForGivenJoints(model->diagnostics(), given)) diagnostics.push_back(describe(d));
   const std::vector<std::string>& joints = model->jointNames();
   const unsigned int n = model->nj();
   const std::size_t width = outputWidth();
@@ -277,19 +309,8 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
 
   for (const Diagnostic& d : warnings) diagnostics.push_back("warning: " + describe(d));
   if (o.json) {
-    Json j;
-    j["mass"] = solver.w();
-    j["com"] = toJson(solver.r_g());
-    j["I_g"] = toJson(solver.I_g());
-    j["joint_names"] = joints;
-    j["joints_treated_as_fixed"] = fixedJointsJson(*model);
-    j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
-    j["contacts"] = json_contacts;
-    j["G_star_all"] = toJson(G_all);
-    j["joint_margins"] = jointMarginsJson(*model, jointMargins(*model, state.q));
-    j["diagnostics"] = diagnostics;
-    j["warnings"] = warningsJson(warnings);
-    out << std::setprecision(17) << j.dump(2) << "\n";
+    out << std::setprecision(17) << inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings).dump(2)
+        << "\n";
     return;
   }
   std::ostringstream what;
@@ -301,12 +322,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
               {"x", "y", "z"}, width);
   printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints, width);
-  const std::vector<JointMargin> margins = jointMargins(*model, state.q);
-  Eigen::MatrixXd margin_rows(n, 3);
-  for (const JointMargin& m : margins)
-    margin_rows.row(m.joint) << m.to_lower, m.to_upper, m.margin();
-  printMatrix(out, "Joint margins to the limits [rad or m] (inf: no limit; negative: outside)", margin_rows, joints,
-              {"above lower", "below upper", "margin"}, width);
+  printJointMargins(out, *model, state.q, width);
   out << report.str();
   if (contacts.size() > 1) {
     std::vector<std::string> labels;
