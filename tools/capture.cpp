@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "inspect.hpp"
+#include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "scene_writer.hpp"
 
@@ -91,6 +93,19 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
   j["G_star"] = toJson(r.G_robot);
   j["G_B"] = toJson(r.G_target);
   return j;
+}
+
+std::vector<Diagnostic> captureWarnings(const CaptureProblem& p) {
+  Conditioning c;
+  std::vector<Diagnostic> warnings;
+  // A state the solver refuses has failed the capture already; the limit warnings stand alone then.
+  checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, warnings);
+  return warnings;
+}
+
+void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings) {
+  for (const Diagnostic& d : warnings)
+    out << "Warning: " << (d.element.empty() ? "" : d.element + ": ") << d.message << "\n";
 }
 
 void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureResult& r) {
@@ -191,12 +206,15 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
                "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
     scene.commit();
   }
+  const std::vector<Diagnostic> warnings = captureWarnings(sc.capture);
   if (o.json) {
     Json j = captureJson(sc, result);
     j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);
+    j["warnings"] = warningsJson(warnings);
     out << j.dump(2) << "\n";
   } else {
     printCaptureSummary(out, sc, result);
+    printWarnings(out, warnings);
     if (!o.scene.empty()) out << "Scene: " << o.scene << "\n";
   }
 }

@@ -36,6 +36,12 @@ std::vector<InputFile> scenarioInputs(const Scenario& scenario);
 
 /// The capture JSON object (the keys are a contract: see the README).
 Json captureJson(const Scenario& scenario, const CaptureResult& result);
+/// \brief The warnings about the robot's configuration at the capture (`problem`'s state and
+/// contact): a joint outside its limits, J* near a singularity (checkConfiguration).
+std::vector<Diagnostic> captureWarnings(const CaptureProblem& problem);
+/// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
+void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
+
 /// The readable summary.
 void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);
 

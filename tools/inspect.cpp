@@ -7,7 +7,9 @@
 
 #include "cli_common.hpp"
 #include "detail/text.hpp"
+#include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/multibody/poses.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
@@ -54,6 +56,94 @@ std::string contactOption(const ContactRequest& r) {
   s << "--tip " << r.link;
   if (r.has_offset) s << " --offset " << r.offset.x() << " " << r.offset.y() << " " << r.offset.z();
   return s.str();
+}
+
+}  // namespace
+
+Json poseJson(const PoseFigures& f) {
+  return Json{{"position", toJson(f.position)},
+              {"rotation", toJson(f.rotation)},
+              {"quaternion", toJson(f.quaternion)},  // (x, y, z, w), as every *_quaternion of the JSON
+              {"rpy", toJson(f.rpy)}};
+}
+
+Json conditioningJson(const Conditioning& c) {
+  const auto finite = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  return Json{{"J_star_singular_values", toJson(c.sigma_J_star)},
+              {"J_star_condition_number", finite(c.condition_number)},  // null: singular
+              {"J_star_manipulability", c.manipulability_J_star},
+              {"J_manipulability", c.manipulability_J}};
+}
+
+Json jointMarginsJson(const FloatingModel& model, const std::vector<JointMargin>& margins) {
+  Json j = Json::object();
+  for (const JointMargin& m : margins)
+    j[model.jointNames()[m.joint]] = m.limited ? Json{{"margin", m.margin()},
+                                                      {"to_lower", std::isfinite(m.to_lower) ? Json(m.to_lower) : Json(nullptr)},
+                                                      {"to_upper", std::isfinite(m.to_upper) ? Json(m.to_upper) : Json(nullptr)}}
+                                               : Json(nullptr);  // continuous: no limits
+  return j;
+}
+
+Json warningsJson(const std::vector<Diagnostic>& warnings) {
+  Json j = Json::array();
+  for (const Diagnostic& d : warnings) j.push_back(Json{{"kind", d.kind}, {"element", d.element}, {"message", d.message}});
+  return j;
+}
+
+namespace {
+
+/// The contact frame's pose and J*'s conditioning, in the text report.
+void printPoseAndConditioning(std::ostream& report, const PoseFigures& f, const Conditioning& c, std::size_t width) {
+  std::ostringstream s;
+  s << std::setprecision(9) << "Contact frame (origin at the point, the link's axes): quaternion (x, y, z, w) ("
+    << f.quaternion(0) << ", " << f.quaternion(1) << ", " << f.quaternion(2) << ", " << f.quaternion(3)
+    << "), roll pitch yaw (" << f.rpy(0) << ", " << f.rpy(1) << ", " << f.rpy(2) << ") rad";
+  printWrapped(report, s.str(), width);
+  printMatrix(report, "Contact frame rotation (world_R_contact)", f.rotation, {"x", "y", "z"}, {"x", "y", "z"}, width);
+  std::ostringstream k;
+  k << "J* singular values: " << c.sigma_J_star.transpose() << "; condition number "
+    << (std::isfinite(c.condition_number) ? std::to_string(c.condition_number) : std::string("infinite (singular)"))
+    << "; manipulability of J* " << c.manipulability_J_star << ", of the fixed-base J " << c.manipulability_J;
+  printWrapped(report, k.str(), width);
+}
+
+/// The model's diagnostics, less "limits exclude 0" for a joint given by --q (it is not at 0) or
+/// one a warning says is outside its limits here (said once, by the warning).
+std::vector<std::string> modelDiagnostics(const FloatingModel& model, const std::map<std::string, double>& q_by_name,
+                                          const std::vector<Diagnostic>& warnings) {
+  std::vector<std::string> given;
+  for (const auto& entry : q_by_name) given.push_back(entry.first);
+  for (const Diagnostic& d : warnings) given.push_back(d.element);
+  std::vector<std::string> diagnostics;
+  for (const Diagnostic& d : diagnosticsForGivenJoints(model.diagnostics(), given)) diagnostics.push_back(describe(d));
+  return diagnostics;
+}
+
+void printJointMargins(std::ostream& out, const FloatingModel& model, const KDL::JntArray& q, std::size_t width) {
+  Eigen::MatrixXd rows(model.nj(), 3);
+  for (const JointMargin& m : jointMargins(model, q)) rows.row(m.joint) << m.to_lower, m.to_upper, m.margin();
+  printMatrix(out, "Joint margins to the limits [rad or m] (inf: no limit; negative: outside)", rows,
+              model.jointNames(), {"above lower", "below upper", "margin"}, width);
+}
+
+Json inspectJson(const FreeFloatingSolver& solver, const State& state, const Json& json_contacts,
+                 const Eigen::MatrixXd& G_all, const std::vector<std::string>& diagnostics,
+                 const std::vector<Diagnostic>& warnings) {
+  const FloatingModel* model = &solver.model();
+  Json j;
+  j["mass"] = solver.w();
+  j["com"] = toJson(solver.r_g());
+  j["I_g"] = toJson(solver.I_g());
+  j["joint_names"] = model->jointNames();
+  j["joints_treated_as_fixed"] = fixedJointsJson(*model);
+  j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
+  j["contacts"] = json_contacts;
+  j["G_star_all"] = toJson(G_all);
+  j["joint_margins"] = jointMarginsJson(*model, jointMargins(*model, state.q));
+  j["diagnostics"] = diagnostics;
+  j["warnings"] = warningsJson(warnings);
+  return j;
 }
 
 }  // namespace
@@ -141,11 +231,13 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
                      "--base-rpy): " + strError(rc));
 
-  // The model's warnings, less "limits exclude 0" for a joint given by --q: it is not at 0.
-  std::vector<std::string> given;
-  for (const auto& entry : q_by_name) given.push_back(entry.first);
-  std::vector<std::string> diagnostics;
-  for (const Diagnostic& d : diagnosticsForGivenJoints(model->diagnostics(), given)) diagnostics.push_back(describe(d));
+  // The configuration's warnings: joints outside their limits here, then (per contact) J* near a
+  // singularity. They are also diagnostics (inspect's one list of what to look at).
+  std::vector<Diagnostic> warnings = configurationWarnings(*model, state.q, nullptr, "");
+  std::vector<std::string> diagnostics = modelDiagnostics(*model, q_by_name, warnings);
+  Kinematics kin(*model);
+  if (const int rc = forwardKinematics(*model, state, kin))
+    throw InputError(o.urdf + ": the link poses cannot be computed at this state: " + strError(rc));
   const std::vector<std::string>& joints = model->jointNames();
   const unsigned int n = model->nj();
   const std::size_t width = outputWidth();
@@ -167,6 +259,13 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     if (rc_grounded != E_NOERROR && rc_grounded != E_NOT_POSITIVE_DEFINITE)
       throw InputError(contactOption(requests[i]) + ": the grounded G cannot be computed: " + strError(rc_grounded));
     const bool grounded = rc_grounded == E_NOERROR;
+    KDL::Jacobian J(n);
+    if (const int rc_J = solver.J(h, J))
+      throw InputError(contactOption(requests[i]) + ": the fixed-base J cannot be computed: " + strError(rc_J));
+    const Conditioning cond = conditioning(J_star.data, J.data);
+    const PoseFigures frame = poseFigures(contactFrame(kin, h));
+    for (const Diagnostic& d : configurationWarnings(*model, state.q, &cond, "contact '" + link + "'"))
+      if (d.kind == "near_singular") warnings.push_back(d);
     if (grounded) {
       const SpectralFigures f = spectralFigures(G_grounded);
       if (f.rank < 6) {
@@ -184,7 +283,9 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
                                  {"J_star", toJsonRows(J_star.data)},  // 6 x n, even for n = 1
                                  {"G_star", toJson(G_star)},
                                  {"G_grounded", grounded ? toJson(G_grounded) : Json(nullptr)},
-                                 {"G_locked", toJson(G_locked)}});
+                                 {"G_locked", toJson(G_locked)},
+                                 {"pose", poseJson(frame)},
+                                 {"conditioning", conditioningJson(cond)}});
     if (!o.json) {
       std::ostringstream where;
       where << "Contact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", "
@@ -199,24 +300,17 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
       if (grounded)
         printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels(), width);
       printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels(), width);
+      printPoseAndConditioning(report, frame, cond, width);
     }
   }
   Eigen::MatrixXd G_all(6 * contacts.size(), 6 * contacts.size());
   if (const int rc = solver.G_star(contacts, G_all))
     throw InputError("--tip: G* over all contact points cannot be computed: " + std::string(strError(rc)));
 
+  for (const Diagnostic& d : warnings) diagnostics.push_back("warning: " + describe(d));
   if (o.json) {
-    Json j;
-    j["mass"] = solver.w();
-    j["com"] = toJson(solver.r_g());
-    j["I_g"] = toJson(solver.I_g());
-    j["joint_names"] = joints;
-    j["joints_treated_as_fixed"] = fixedJointsJson(*model);
-    j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
-    j["contacts"] = json_contacts;
-    j["G_star_all"] = toJson(G_all);
-    j["diagnostics"] = diagnostics;
-    out << std::setprecision(17) << j.dump(2) << "\n";
+    out << std::setprecision(17) << inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings).dump(2)
+        << "\n";
     return;
   }
   std::ostringstream what;
@@ -228,6 +322,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
               {"x", "y", "z"}, width);
   printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints, width);
+  printJointMargins(out, *model, state.q, width);
   out << report.str();
   if (contacts.size() > 1) {
     std::vector<std::string> labels;

@@ -6,6 +6,7 @@
 #include "approach_report.hpp"
 #include "capture.hpp"
 #include "detail/text.hpp"
+#include "inspect.hpp"
 #include "motion_report.hpp"
 
 namespace kdl_space::cli {
@@ -101,6 +102,8 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   j["capture"] = r.capture ? captureJson(sc, *r.capture) : Json(nullptr);
   j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
   j["target_motion"] = targetMotionJson(r);
+  // The robot's configuration at the capture (the contact instant of an approach).
+  j["warnings"] = warningsJson(r.capture ? captureWarnings(r.at_contact) : std::vector<Diagnostic>{});
   if (record.samples == 0) {  // stopped at the capture (OperationOptions::motion false)
     j["simulation"] = nullptr;
     return j;
@@ -149,7 +152,10 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   const MotionRecord& record = r.record;
   const std::vector<std::string>& joints = r.model->jointNames();
   if (r.approach) printApproach(out, sc, *r.approach);
-  if (r.capture) printCaptureSummary(out, sc, *r.capture);
+  if (r.capture) {
+    printCaptureSummary(out, sc, *r.capture);
+    printWarnings(out, captureWarnings(r.at_contact));
+  }
   if (record.samples == 0) return;  // stopped at the capture
   if (r.capture) {
     const std::string& contact_link = r.at_contact.robot.model->bodies()[r.at_contact.robot.contact.body].name;

@@ -57,6 +57,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     attach_target,
     check_urdf,
     codes,
+    inspect_contact,
     load_scenario,
     load_study,
     load_urdf,
@@ -76,6 +77,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     E_BAD_ARGUMENT,
     E_STEP_UNDERFLOW,
     E_CANCELLED,
+    NEAR_SINGULAR_RATIO,
 )
 from .study import StudyResult, study  # noqa: F401  (the engines: threads, Dask)
 

@@ -10,6 +10,7 @@ PYBIND11_MODULE(_kdl_space, m) {
   using namespace kdl_space::python;
   bindErrors(m);
   bindModel(m);
+  bindPoses(m);
   bindSolvers(m);
   bindImpact(m);
   bindCapture(m);

@@ -27,13 +27,14 @@ TEST(Cli, InspectJsonMatchesTheReferenceEngine) {
   for (const auto& item : j.items()) keys.push_back(item.key());
   // Exactly the contract's keys (a JSON object is unordered: compare sorted).
   EXPECT_EQ(keys, (std::vector<std::string>{"G_star_all", "H_star", "I_g", "com", "contacts", "diagnostics",
-                                            "joint_names", "joints_treated_as_fixed", "mass"}));
+                                            "joint_margins", "joint_names", "joints_treated_as_fixed", "mass",
+                                            "warnings"}));
   ASSERT_EQ(j.at("contacts").size(), 1u);
   const nlohmann::json& h = j.at("contacts")[0];
   std::vector<std::string> contact_keys;
   for (const auto& item : h.items()) contact_keys.push_back(item.key());
-  EXPECT_EQ(contact_keys, (std::vector<std::string>{"G_grounded", "G_locked", "G_star", "J_star", "link",
-                                                    "offset", "point"}));
+  EXPECT_EQ(contact_keys, (std::vector<std::string>{"G_grounded", "G_locked", "G_star", "J_star", "conditioning",
+                                                    "link", "offset", "point", "pose"}));
 
   EXPECT_EQ(j.at("joint_names"), e.at("joint_names"));
   EXPECT_EQ(h.at("link"), "hand");

@@ -39,7 +39,7 @@ TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(keys(j), (std::vector<std::string>{"G_B", "G_star", "energy_after", "energy_before", "energy_lost",
                                                "impulse", "momentum_after", "momentum_before", "robot", "scene", "target",
-                                               "virtual_mass"}));
+                                               "virtual_mass", "warnings"}));
   EXPECT_EQ(keys(j.at("robot")), (std::vector<std::string>{"base_twist_after", "base_twist_before",
                                                            "contact_twist_after", "contact_twist_before",
                                                            "joint_names", "joints_treated_as_fixed", "locked_joints",
