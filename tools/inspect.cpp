@@ -108,13 +108,12 @@ void printPoseAndConditioning(std::ostream& report, const PoseFigures& f, const 
   printWrapped(report, k.str(), width);
 }
 
-/// The model's diagnostics, less "limits exclude 0" for a joint given by --q (it is not at 0) or
-/// one a warning says is outside its limits here (said once, by the warning).
-std::vector<std::string> modelDiagnostics(const FloatingModel& model, const std::map<std::string, double>& q_by_name,
-                                          const std::vector<Diagnostic>& warnings) {
+/// The model's diagnostics, less "limits exclude 0" for a joint given by --q: it is not at 0. (A
+/// joint left at 0 outside its limits keeps it beside the state's `joint_outside_limits` warning:
+/// one is about the description, the other about this state.)
+std::vector<std::string> modelDiagnostics(const FloatingModel& model, const std::map<std::string, double>& q_by_name) {
   std::vector<std::string> given;
   for (const auto& entry : q_by_name) given.push_back(entry.first);
-  for (const Diagnostic& d : warnings) given.push_back(d.element);
   std::vector<std::string> diagnostics;
   for (const Diagnostic& d : diagnosticsForGivenJoints(model.diagnostics(), given)) diagnostics.push_back(describe(d));
   return diagnostics;
@@ -234,7 +233,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   // The configuration's warnings: joints outside their limits here, then (per contact) J* near a
   // singularity. They are also diagnostics (inspect's one list of what to look at).
   std::vector<Diagnostic> warnings = configurationWarnings(*model, state.q, nullptr, "");
-  std::vector<std::string> diagnostics = modelDiagnostics(*model, q_by_name, warnings);
+  std::vector<std::string> diagnostics = modelDiagnostics(*model, q_by_name);
   Kinematics kin(*model);
   if (const int rc = forwardKinematics(*model, state, kin))
     throw InputError(o.urdf + ": the link poses cannot be computed at this state: " + strError(rc));

@@ -195,6 +195,7 @@ class CaptureResult:
     energy_lost: float
     virtual_mass: Optional[float]
     contact_body_pose: Array
+    warnings: list[dict[str, str]]  # the robot's configuration at the capture: {kind, element, message}
 
 def load_scenario(path: str) -> Scenario: ...
 def run_operation(scenario: Scenario, *, duration: Optional[float] = None, output_step: Optional[float] = None,

@@ -4,6 +4,7 @@
 
 #include "conversions.hpp"
 #include "capture_types.hpp"
+#include "kdl_space/algorithm/conditioning.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
@@ -20,6 +21,8 @@ PyResult solve(const CaptureProblem& p) {
   PyResult out{r, PySide{r.robot, p.robot.model->jointNames()}, std::nullopt};
   if (r.floating_target)
     out.floating_target = PySide{*r.floating_target, std::get<FloatingSystem>(p.target).model->jointNames()};
+  Conditioning c;  // a state the solver refused has failed the capture above: only the limits then
+  checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, out.warnings);
   return out;
 }
 
@@ -125,6 +128,13 @@ void bindCapture(py::module_& m) {
   result.def_property_readonly("impulse", [](const PyResult& x) { return x.r.impulse; }, "Impulse on the robot.")
       .def_readonly("robot", &PyResult::robot, "The robot before and after (SideResult).")
       .def_readonly("floating_target", &PyResult::floating_target, "The free-floating target's SideResult, or None.")
+      .def_property_readonly("warnings", [](const PyResult& x) {
+        py::list l;
+        for (const Diagnostic& w : x.warnings) l.append(py::dict(py::arg("kind") = w.kind, py::arg("element") = w.element,
+                                                                 py::arg("message") = w.message));
+        return l;
+      }, "The robot's configuration at the capture: list of {kind, element, message} (joint_outside_limits, "
+         "near_singular), as `kdl_space capture --json`'s `warnings`.")
       .def_property_readonly("contact_point", [](const PyResult& x) { return toNumpy(x.r.contact_point, true); }, "(3,) [m].")
       .def_property_readonly("G_robot", [](const PyResult& x) { return toNumpy(x.r.G_robot); }, "The robot's G (6, 6).")
       .def_property_readonly("G_target", [](const PyResult& x) { return toNumpy(x.r.G_target); }, "The target's G (6, 6).")

@@ -32,6 +32,8 @@ struct PyResult {
   CaptureResult r;
   PySide robot;
   std::optional<PySide> floating_target;
+  /// The robot's configuration at the capture (checkConfiguration: limits, a near-singular J*).
+  std::vector<Diagnostic> warnings = {};
 };
 
 }  // namespace kdl_space::python

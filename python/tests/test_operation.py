@@ -44,6 +44,9 @@ def simulate_json(cli, scenario, *args):
 def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library(cli, name):
     before = json.loads((GOLDEN / f"{name}.json").read_text())
     now = simulate_json(cli, SCENARIOS[name], "--duration", "2")
+    # Keys added after the golden files were written (JSON keys are only ever added): the
+    # configuration's warnings at the capture (issue 26; their values: test_poses.py).
+    assert isinstance(now.pop("warnings"), list)
     # The same build type on the same kind of machine: the same floating-point code, so the same
     # numbers but for the last bits of a long adaptive run.
     assert_same(before, now, rel=1e-9, abs_tol=1e-12)

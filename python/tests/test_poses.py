@@ -241,6 +241,7 @@ def test_a_joint_outside_its_limits_is_warned_about(cli, arm, tmp_path):
     assert ("joint_outside_limits", "joint4") in kinds(json.loads(out.stdout)["warnings"])
     out = subprocess.run([cli, "capture", str(scenario)], check=True, capture_output=True, text=True)
     assert "Warning: joint4: at 3, outside its limits" in out.stdout
+    assert ("joint_outside_limits", "joint4") in kinds(kdl_space.solve_capture(kdl_space.load_scenario(str(scenario))).warnings)
     run = kdl_space.run_operation(kdl_space.load_scenario(str(scenario)), duration=0.05)
     assert ("joint_outside_limits", "joint4") in kinds(run["warnings"])
 
@@ -249,6 +250,7 @@ def test_inside_the_limits_away_from_singularities_nothing_is_warned(cli, arm):
     q = {"joint2": 0.7, "joint3": 0.9, "joint4": 0.8, "joint6": -0.6}
     r = kdl_space.inspect_contact(kdl_space.State(arm, q=q), arm.contact("end_effector"))
     assert r["warnings"] == []
+    assert kdl_space.solve_capture(kdl_space.load_scenario(str(CAPTURE_SCENARIO))).warnings == []
     out = subprocess.run([cli, "capture", str(CAPTURE_SCENARIO), "--json"], check=True, capture_output=True, text=True)
     assert json.loads(out.stdout)["warnings"] == []
 
