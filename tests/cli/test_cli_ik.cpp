@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <kdl/treefksolverpos_recursive.hpp>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "test_util.hpp"
 
@@ -90,6 +93,46 @@ TEST(IkTool, UsageMistakesExit2) {
   const ToolRun run = kdlSpace("ik " + kScenario + " --position 1,2,3 --prefer elbow=1");
   EXPECT_EQ(run.rc, 2);
   EXPECT_NE(run.err.find("--prefer"), std::string::npos) << run.err;
+}
+
+/// A scenario whose robot holds the rigid target's grasp frame (robot.place: grasp).
+std::string graspScenario(const std::string& name, const std::string& target_position) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << "robot:\n  urdf: " << KDL_SPACE_URDF_DIR << "/space_arm7.urdf\n"
+                      << "  contact: {link: end_effector, offset: [0, 0, 0.05]}\n"
+                      << "  base: {position: [0.1, -0.2, 0.3], rpy: [0.1, 0.2, -0.3]}\n"
+                      << "  q: {joint2: 0.7, joint3: 0.9, joint4: 0.8, joint6: -0.6}\n"
+                      << "  grasp: {target_frame: {position: [0.1, 0.0, -0.2], rpy: [3.0, 0.1, 0.2]}}\n"
+                      << "  place: grasp\n"
+                      << "target:\n  mass: 50\n  inertia: [[2.1, 0, 0], [0, 2.6, 0], [0, 0, 3.0]]\n"
+                      << "  pose: {position: " << target_position << ", rpy: [0.3, -0.2, 0.5]}\n"
+                      << "law: {type: capture}\n";
+  return path;
+}
+
+TEST(GraspPlacement, TheContactFrameHoldsTheTargetsGraspFrame) {
+  const Scenario sc = loadScenario(graspScenario("grasp_ok.yaml", "[0.32, -2.88, 1.69]"));
+  ASSERT_TRUE(sc.grasp_solution.has_value());
+  const KDL::Frame grasp = KDL::Frame(KDL::Rotation::RPY(0.3, -0.2, 0.5), KDL::Vector(0.32, -2.88, 1.69)) *
+                           KDL::Frame(KDL::Rotation::RPY(3.0, 0.1, 0.2), KDL::Vector(0.1, 0.0, -0.2));
+  std::map<std::string, double> q;
+  const FloatingModel& model = *sc.capture.robot.model;
+  for (unsigned int j = 0; j < model.nj(); ++j) q[model.jointNames()[j]] = sc.capture.robot.state.q(j);
+  // KDL's tree solver, with the scenario's base pose in front
+  const KDL::Frame held = sc.capture.robot.state.world_T_base * contactFrameByKdl(q);
+  EXPECT_LE(std::sqrt(KDL::dot(held.p - grasp.p, held.p - grasp.p)), 1e-9);
+  const KDL::Rotation E = grasp.M.Inverse() * held.M;
+  const KDL::Vector sine(E(2, 1) - E(1, 2), E(0, 2) - E(2, 0), E(1, 0) - E(0, 1));
+  EXPECT_LE(std::atan2(0.5 * std::sqrt(KDL::dot(sine, sine)), 0.5 * (E(0, 0) + E(1, 1) + E(2, 2) - 1.0)), 1e-9);
+  EXPECT_LE(sc.grasp_solution->position_residual, 1e-9);
+  EXPECT_EQ(kdlSpace("capture " + graspScenario("grasp_ok.yaml", "[0.32, -2.88, 1.69]") + " --json").rc, 0);
+}
+
+TEST(GraspPlacement, AGraspOutOfReachNamesTheFieldAndTheDistance) {
+  const ToolRun run = kdlSpace("capture " + graspScenario("grasp_far.yaml", "[40, 0, 0]"));
+  EXPECT_EQ(run.rc, 3);
+  EXPECT_NE(run.err.find("grasp_far.yaml:8: robot.place: the grasp frame: inverse kinematics: the pose is out of reach"),
+            std::string::npos) << run.err;
 }
 
 }  // namespace
