@@ -100,5 +100,6 @@ void bindForwardDynamics(py::module_& m);
 void bindSimulation(py::module_& m);
 void bindStudy(py::module_& m);
 void bindOperation(py::module_& m);
+void bindInverseKinematics(py::module_& m);
 
 }  // namespace kdl_space::python

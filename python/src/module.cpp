@@ -17,4 +17,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindSimulation(m);
   bindStudy(m);
   bindOperation(m);
+  bindInverseKinematics(m);
 }
