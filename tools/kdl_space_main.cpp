@@ -6,6 +6,7 @@
 #include "capture.hpp"
 #include "check.hpp"
 #include "cli_common.hpp"
+#include "ik.hpp"
 #include "inspect.hpp"
 #include "simulate.hpp"
 #include "study.hpp"
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
   CLI::App* check = addCheck(app, check_options);
   StudyOptions study_options;
   CLI::App* study = addStudy(app, study_options);
+  IkCliOptions ik_options;
+  CLI::App* ik = addIk(app, ik_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -48,6 +51,7 @@ int main(int argc, char** argv) {
     if (capture->parsed()) runCapture(capture_options, std::cout);
     if (simulate->parsed()) runSimulate(simulate_options, std::cout);
     if (study->parsed()) runStudyCommand(study_options, std::cout);
+    if (ik->parsed()) runIk(ik_options, std::cout);
     const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
     if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
       std::cerr << "kdl_space: cannot write the output to stdout\n";

@@ -101,5 +101,6 @@ void bindSimulation(py::module_& m);
 void bindStudy(py::module_& m);
 void bindOperation(py::module_& m);
 void bindPoses(py::module_& m);
+void bindInverseKinematics(py::module_& m);
 
 }  // namespace kdl_space::python

@@ -18,4 +18,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindSimulation(m);
   bindStudy(m);
   bindOperation(m);
+  bindInverseKinematics(m);
 }

@@ -118,6 +118,8 @@ const std::vector<Broken>& corpus() {
        false},
       {"target_joints_rigid.yaml",
        "{f}:21: simulation.target_joints: only a free-floating target (target.urdf with movable joints) has joints", false},
+      {"grasp_without_place.yaml",
+       "{f}:9: robot.grasp: is the grasp frame that robot.place: grasp solves the arm for: add robot.place: grasp", false},
       {"place_touch_rigid.yaml",
        "{f}:10: target.place: a rigid target has no contact point of its own (the point hit is the robot's contact "
        "point): place it with pose",

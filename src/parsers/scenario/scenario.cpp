@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "detail/text.hpp"
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
@@ -80,7 +81,7 @@ double rotorInertia(const Field& f) {
 
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp"});
   FloatingSystem s;
   const Field urdf = f.at("urdf");
   urdf_path = urdf.text();
@@ -198,6 +199,28 @@ void place(const Field& f, const FloatingSystem& robot, FloatingSystem& target) 
   target.state.world_T_base.p += toKDL(a.point(robot.contact) - b.point(target.contact));
 }
 
+/// `robot.place: grasp`: the robot's joints solved (inverse kinematics from robot.q, preferring
+/// it) so that its contact frame holds the target's grasp frame `robot.grasp.target_frame`
+/// (position, rpy in the frame `world_T_target`); the base stays where robot.base puts it.
+IkResult placeAtGrasp(const Field& robot_f, FloatingSystem& robot, const KDL::Frame& world_T_target) {
+  const Field f = robot_f.at("place");
+  if (f.text() != "grasp")
+    f.fail(echo(f.text()) + " is not grasp (the robot's joints solved so that its contact frame holds "
+           "robot.grasp.target_frame; a free-floating target is moved by target.place: touch)");
+  robot_f.at("contact");  // reports it missing: the frame that holds the grasp
+  const Field grasp = robot_f.at("grasp");
+  grasp.onlyKeys({"target_frame"});
+  const Field frame = grasp.at("target_frame");
+  frame.onlyKeys({"position", "rpy"});
+  try {
+    const IkResult r = solveInverseKinematics(*robot.model, robot.state, robot.contact, world_T_target * pose(frame));
+    robot.state.q = r.q;
+    return r;
+  } catch (const Error& e) {
+    e.rethrowWithContext(f.where() + "the grasp frame: ");
+  }
+}
+
 /// The impact law; `has_normal` is set when a normal is given.
 ImpactLaw law(const Field& f, bool& has_normal) {
   f.onlyKeys({"type", "normal", "restitution", "friction"});
@@ -245,7 +268,11 @@ Scenario loadScenario(const std::string& path) {
   top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
   s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
-  if (top.at("robot").has("place")) top.at("robot").at("place").fail("only a free-floating target is placed (target.place: touch)");
+  const Field robot = top.at("robot");
+  if (robot.has("grasp") && !robot.has("place"))
+    robot.at("grasp").fail("is the grasp frame that robot.place: grasp solves the arm for: add robot.place: grasp");
+  if (robot.has("place") && !(top.has("target") || top.has("law")))
+    robot.at("place").fail("a plain motion has no target to grasp: give target and law");
   // A plain motion has neither target nor law; an impact needs both.
   s.impact = top.has("target") || top.has("law");
   if (s.impact) {
@@ -257,12 +284,20 @@ Scenario loadScenario(const std::string& path) {
         s.capture.target = rigidUrdfTarget(target, t);  // one rigid body: the robot's contact point is hit
       } else {
         if (!target.has("contact")) target.at("contact");  // reports it missing
+        if (target.has("place") && robot.has("place"))
+          target.at("place").fail("the robot is placed at the grasp (robot.place: grasp): the target stays where "
+                                  "target.base puts it; remove one of them");
+        if (robot.has("place")) s.grasp_solution = placeAtGrasp(robot, s.capture.robot, t.state.world_T_base);
         if (target.has("place")) place(target.at("place"), s.capture.robot, t);
         s.capture.target = std::move(t);
       }
     } else {
       s.capture.target = rigidTarget(target);
     }
+    if (robot.has("place") && !s.grasp_solution) {  // a rigid target: its frame (pose, or its link's)
+      s.grasp_solution = placeAtGrasp(robot, s.capture.robot, std::get<RigidTarget>(s.capture.target).pose);
+    }
+    if (target.has("grasp")) target.at("grasp").fail("the grasp frame is the robot's field: robot.grasp.target_frame");
     s.capture.law = law(top.at("law"), s.capture.has_normal);
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/simulation/approach.hpp"
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/export.hpp"
@@ -51,6 +52,10 @@ struct Scenario {
   /// the moving (rigid) target, and the law applies at the contact instant, from the states then.
   std::optional<ApproachSpec> approach;
   SimulationSpec simulation;
+  /// `robot.place: grasp`: the inverse kinematics that put the robot's contact frame at the
+  /// target's grasp frame (`robot.grasp.target_frame`, in the target's frame); its q is
+  /// capture.robot.state.q (joints off the contact's chain keep robot.q).
+  std::optional<IkResult> grasp_solution;
 };
 
 /// \brief Reads and checks a scenario file; URDF paths are relative to the scenario's folder.

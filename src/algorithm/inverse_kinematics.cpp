@@ -1,0 +1,289 @@
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
+
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <kdl/chainiksolvervel_pinv.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "detail/text.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+
+namespace kdl_space {
+
+IkUnreachable::~IkUnreachable() = default;
+std::exception_ptr IkUnreachable::renamed(const std::string& what) const {
+  return std::make_exception_ptr(IkUnreachable(what, best_));
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// |v|. KDL's Vector::Norm returns 0 when every component is below its epsilon (1e-6): too
+/// coarse for a 1e-9 tolerance.
+double length(const KDL::Vector& v) { return std::sqrt(KDL::dot(v, v)); }
+
+/// The rotation vector (axis times angle) of R, accurate at small angles: KDL's
+/// Rotation::GetRot (and so KDL::diff, which its position solvers' convergence test uses) reads
+/// every angle below about 1e-6 rad as 0, too coarse for a 1e-9 rad tolerance.
+KDL::Vector rotationVector(const KDL::Rotation& R) {
+  const KDL::Vector v(0.5 * (R(2, 1) - R(1, 2)), 0.5 * (R(0, 2) - R(2, 0)), 0.5 * (R(1, 0) - R(0, 1)));  // sin(a) axis
+  const double c = 0.5 * (R(0, 0) + R(1, 1) + R(2, 2) - 1.0);                                        // cos(a)
+  if (c < 0.0) return R.GetRot();  // beyond 90 degrees KDL's own is accurate (and handles 180)
+  const double s = length(v);
+  if (s == 0.0) return KDL::Vector::Zero();
+  return v * (std::atan2(s, c) / s);
+}
+
+/// The error twist that takes `current` to `goal` (base frame, reference point at the tip).
+KDL::Twist poseError(const KDL::Frame& current, const KDL::Frame& goal) {
+  return KDL::Twist(goal.p - current.p, rotationVector(goal.M * current.M.Inverse()));
+}
+
+double clampTo(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
+
+/// The chain from the base to the contact link, its tip moved to the contact offset, and which
+/// model joint each of its joints is.
+struct ContactChain {
+  KDL::Chain chain;
+  std::vector<int> joints;  // model index per chain joint
+  KDL::JntArray lower, upper;
+};
+
+ContactChain contactChain(const FloatingModel& model, const Contact& contact) {
+  ContactChain c;
+  const std::string& link = model.bodies()[contact.body].name;
+  if (contact.body != 0 && !model.tree().getChain(model.tree().getRootSegment()->first, link, c.chain))
+    throw ModelError("inverse kinematics: no chain from the base to link " + detail::quoted(link));
+  c.chain.addSegment(KDL::Segment(link + "#contact", KDL::Joint(KDL::Joint::Fixed), KDL::Frame(contact.offset)));
+  for (const KDL::Segment& s : c.chain.segments) {
+    if (s.getJoint().getType() == KDL::Joint::Fixed) continue;
+    const int j = model.jointIndex(s.getJoint().getName());
+    if (j < 0) throw ModelError("inverse kinematics: joint " + detail::quoted(s.getJoint().getName()) + " is no coordinate");
+    c.joints.push_back(j);
+  }
+  c.lower.resize(c.joints.size());
+  c.upper.resize(c.joints.size());
+  for (std::size_t k = 0; k < c.joints.size(); ++k) {
+    c.lower(k) = model.jointProperties()[c.joints[k]].lower;
+    c.upper(k) = model.jointProperties()[c.joints[k]].upper;
+  }
+  return c;
+}
+
+/// The solvers on one chain (each keeps a reference to it: it outlives them).
+class Search {
+ public:
+  Search(const ContactChain& c, const KDL::JntArray& preferred, const KDL::Frame& goal, const IkOptions& o)
+      : c_(c), preferred_(preferred), goal_(goal), o_(o), fk_(c.chain), jac_(c.chain),
+        vel_(c.chain, 1e-9, 150),
+        lma_(c.chain, 1e-12, static_cast<int>(o.max_iterations), 1e-15) {}
+
+  /// One attempt from `q` (chain order, inside the limits); true when the tolerances are met:
+  /// Newton-Raphson, else KDL's Levenberg-Marquardt (which ignores the limits: clamped into them)
+  /// finished by Newton-Raphson. On failure `q` is the closest configuration either came to.
+  bool attempt(KDL::JntArray& q, unsigned int& iterations) {
+    KDL::JntArray newton = q;
+    if (refine(newton, iterations)) {
+      q = newton;
+      return true;
+    }
+    KDL::JntArray lma(q.rows());
+    lma_.CartToJnt(q, goal_, lma);  // its code is not the verdict: refine measures the residual
+    iterations += static_cast<unsigned int>(std::max(0, lma_.lastNrOfIter));
+    for (unsigned int k = 0; k < q.rows(); ++k) lma(k) = clampTo(lma(k), c_.lower(k), c_.upper(k));
+    const bool ok = refine(lma, iterations);
+    q = ok || distance(lma) < distance(newton) ? lma : newton;
+    return ok;
+  }
+
+  /// Newton-Raphson with the accurate error twist over KDL's pseudo-inverse (no null-space term:
+  /// quadratic convergence), steps of at most 0.5 per joint, clamped to the limits. On failure `q`
+  /// is the iterate closest to the goal (distance + angle).
+  bool refine(KDL::JntArray& q, unsigned int& iterations) {
+    KDL::JntArray dq(q.rows()), best = q;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (unsigned int i = 0; i < o_.max_iterations; ++i) {
+      KDL::Frame f;
+      fk_.JntToCart(q, f);
+      const KDL::Twist e = poseError(f, goal_);
+      if (length(e.vel) <= 0.5 * o_.position_tolerance && length(e.rot) <= 0.5 * o_.orientation_tolerance) return true;
+      if (length(e.vel) + length(e.rot) < best_distance) {
+        best_distance = length(e.vel) + length(e.rot);
+        best = q;
+      }
+      ++iterations;
+      if (vel_.CartToJnt(q, e, dq) < 0) break;
+      const double largest = dq.data.cwiseAbs().maxCoeff();
+      if (largest > 0.5) dq.data *= 0.5 / largest;  // far from the goal the linearisation is poor
+      for (unsigned int k = 0; k < q.rows(); ++k) q(k) = clampTo(q(k) + dq(k), c_.lower(k), c_.upper(k));
+    }
+    q = best;
+    return false;
+  }
+
+  /// Distance + angle (1 m per rad) from the contact frame at `q` to the goal.
+  double distance(const KDL::JntArray& q) {
+    KDL::Frame f;
+    fk_.JntToCart(q, f);
+    const KDL::Twist e = poseError(f, goal_);
+    return length(e.vel) + length(e.rot);
+  }
+
+  /// N (preferred - q): the part of the way to the preferred posture that does not move the tip.
+  Eigen::VectorXd preferenceGradient(const KDL::JntArray& q) {
+    KDL::Jacobian J(q.rows());
+    jac_.JntToJac(q, J);
+    const Eigen::MatrixXd& Jd = J.data;
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jd, Eigen::ComputeFullV);
+    const Eigen::Index rank = svd.rank();
+    const Eigen::MatrixXd Vn = svd.matrixV().rightCols(Jd.cols() - rank);  // null-space basis
+    return Vn * (Vn.transpose() * (preferred_.data - q.data));
+  }
+
+  /// Null-space steps towards the preferred posture, each projected back onto the pose.
+  void preferPosture(KDL::JntArray& q, unsigned int& iterations) {
+    if (q.rows() <= 6) return;
+    double step = 1.0;
+    for (int k = 0; k < 200 && step > 1e-3; ++k) {
+      const Eigen::VectorXd g = preferenceGradient(q);
+      if (g.norm() < 1e-10) return;
+      KDL::JntArray trial(q.rows());
+      for (unsigned int j = 0; j < q.rows(); ++j) trial(j) = clampTo(q(j) + step * g(j), c_.lower(j), c_.upper(j));
+      if (refine(trial, iterations) && (trial.data - preferred_.data).norm() < (q.data - preferred_.data).norm()) {
+        q = trial;
+      } else {
+        step *= 0.5;
+      }
+    }
+  }
+
+  bool withinLimits(const KDL::JntArray& q) const {
+    for (unsigned int k = 0; k < q.rows(); ++k)
+      if (!(q(k) >= c_.lower(k) && q(k) <= c_.upper(k))) return false;
+    return true;
+  }
+
+ private:
+  const ContactChain& c_;
+  KDL::JntArray preferred_;
+  KDL::Frame goal_;
+  IkOptions o_;
+  KDL::ChainFkSolverPos_recursive fk_;
+  KDL::ChainJntToJacSolver jac_;
+  KDL::ChainIkSolverVel_pinv vel_;
+  KDL::ChainIkSolverPos_LMA lma_;
+};
+
+/// The a-th deterministic start (a >= 1): a low-discrepancy point (fractional parts of multiples
+/// of sqrt(prime)) in each joint's range; an unlimited joint ranges over a turn (or 1 m) about
+/// the seed.
+KDL::JntArray start(const ContactChain& c, const KDL::JntArray& seed, unsigned int a) {
+  static const double primes[] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53};
+  KDL::JntArray q(seed.rows());
+  for (unsigned int k = 0; k < q.rows(); ++k) {
+    const double lo = std::isfinite(c.lower(k)) ? c.lower(k) : seed(k) - kPi;
+    const double hi = std::isfinite(c.upper(k)) ? c.upper(k) : seed(k) + kPi;
+    const double alpha = std::sqrt(primes[k % 16] + 16.0 * static_cast<double>(k / 16));
+    const double u = std::fmod(0.5 + a * alpha, 1.0);
+    q(k) = lo + u * (hi - lo);
+  }
+  return q;
+}
+
+/// Residuals of `q` (model order) by the model's own forward kinematics.
+void measure(const FloatingModel& model, const State& seed, const Contact& contact, const KDL::Frame& goal,
+             IkResult& r) {
+  State s = seed;
+  s.q = r.q;
+  const KDL::Frame f = contactFrame(model, s, contact);
+  r.position_residual = length(f.p - goal.p);
+  r.orientation_residual = length(rotationVector(goal.M * f.M.Inverse()));
+}
+
+}  // namespace
+
+KDL::Frame contactFrame(const FloatingModel& model, const State& state, const Contact& contact) {
+  if (contact.body < 0 || static_cast<std::size_t>(contact.body) >= model.bodies().size())
+    throw ModelError("contact frame: body index " + std::to_string(contact.body) + " is outside the model's " +
+                     std::to_string(model.bodies().size()) + " bodies");
+  Kinematics kin(model);
+  const int code = forwardKinematics(model, state, kin);
+  if (code) throw ModelError(std::string("contact frame: forward kinematics failed: ") + strError(code));
+  return kin.pose(contact.body) * KDL::Frame(contact.offset);
+}
+
+IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, const Contact& contact,
+                                const KDL::Frame& world_T_goal, const IkOptions& options) {
+  model.refuseMimic("inverse kinematics");
+  if (seed.q.rows() != model.nj())
+    throw ModelError("inverse kinematics: the seed has " + std::to_string(seed.q.rows()) + " joint values, the model " +
+                     std::to_string(model.nj()) + " joints");
+  if (contact.body < 0 || static_cast<std::size_t>(contact.body) >= model.bodies().size())
+    throw ModelError("inverse kinematics: contact body " + std::to_string(contact.body) + " is outside the model");
+  if (options.preferred && options.preferred->rows() != model.nj())
+    throw ModelError("inverse kinematics: the preferred posture has " + std::to_string(options.preferred->rows()) +
+                     " joint values, the model " + std::to_string(model.nj()) + " joints");
+  const ContactChain c = contactChain(model, contact);
+  const unsigned int n = static_cast<unsigned int>(c.joints.size());
+  KDL::JntArray q0(n), preferred(n);
+  const KDL::JntArray& pref_model = options.preferred ? *options.preferred : seed.q;
+  for (unsigned int k = 0; k < n; ++k) {
+    q0(k) = clampTo(seed.q(c.joints[k]), c.lower(k), c.upper(k));
+    preferred(k) = clampTo(pref_model(c.joints[k]), c.lower(k), c.upper(k));
+  }
+  const KDL::Frame base_T_goal = seed.world_T_base.Inverse() * world_T_goal;  // the chain's frame
+  Search search(c, preferred, base_T_goal, options);
+
+  const auto toModel = [&](const KDL::JntArray& qc) {
+    KDL::JntArray q = seed.q;
+    for (unsigned int k = 0; k < n; ++k) q(c.joints[k]) = qc(k);
+    return q;
+  };
+  IkResult best;
+  best.chain_joints = c.joints;
+  double best_score = std::numeric_limits<double>::infinity();
+  unsigned int iterations = 0;
+  for (unsigned int a = 0; a <= options.restarts; ++a) {
+    KDL::JntArray qc = a == 0 ? q0 : start(c, q0, a);
+    const bool ok = n > 0 && search.attempt(qc, iterations);
+    if (ok) search.preferPosture(qc, iterations);
+    IkResult r;
+    r.q = toModel(qc);
+    r.chain_joints = c.joints;
+    r.attempts = a + 1;
+    measure(model, seed, contact, world_T_goal, r);
+    r.iterations = iterations;
+    if (ok && n > 6) r.preference_gradient = search.preferenceGradient(qc).norm();
+    if (ok && search.withinLimits(qc) && r.position_residual <= options.position_tolerance &&
+        r.orientation_residual <= options.orientation_tolerance)
+      return r;
+    const double score = r.position_residual + r.orientation_residual;  // m + rad (1 m per rad)
+    if (score < best_score && search.withinLimits(qc)) {
+      best_score = score;
+      best = r;
+    }
+  }
+  best.iterations = iterations;
+  best.attempts = options.restarts + 1;
+  std::ostringstream msg;
+  msg.precision(6);
+  msg << "inverse kinematics: the pose is out of reach of the contact frame on link "
+      << detail::quoted(model.bodies()[contact.body].name) << ": after " << best.attempts
+      << " starts the closest came within " << best.position_residual << " m and " << best.orientation_residual
+      << " rad of it (tolerances " << options.position_tolerance << " m, " << options.orientation_tolerance
+      << " rad), with";
+  for (unsigned int k = 0; k < n; ++k)
+    msg << (k ? ", " : " ") << model.jointNames()[c.joints[k]] << " = " << best.q(c.joints[k]);
+  if (n == 0) msg << " no joint between the base and the link";
+  msg << "; move the goal closer or check its frame";
+  throw IkUnreachable(msg.str(), best);
+}
+
+}  // namespace kdl_space

@@ -1,0 +1,153 @@
+// Inverse kinematics of the contact frame (solveInverseKinematics): goals made by forward
+// kinematics of random in-limit configurations (so they are reachable), checked by a second
+// forward kinematics (KDL's TreeFkSolverPos_recursive on the model's tree, joints mapped by name),
+// on the default arm, the dual-arm tree and a 6-joint arm with a prismatic and a continuous joint.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <random>
+#include <string>
+
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
+
+namespace kdl_space {
+namespace {
+
+struct Robot {
+  std::string file, link;
+};
+
+const Robot kRobots[] = {
+    {KDL_SPACE_URDF_DIR "/space_arm7.urdf", "end_effector"},
+    {KDL_SPACE_URDF_DIR "/dual_arm.urdf", "right_tool"},
+    {KDL_SPACE_TEST_DATA_DIR "/reference/models/arm6_public.urdf", "tool"},
+};
+
+/// World pose of link `link` + offset by KDL's tree solver (joints by name): the second route.
+KDL::Frame kdlContactFrame(const FloatingModel& model, const State& s, const std::string& link, const KDL::Vector& offset) {
+  const KDL::Tree& tree = model.tree();
+  KDL::JntArray q(tree.getNrOfJoints());
+  for (const auto& [name, element] : tree.getSegments()) {
+    const KDL::Joint& j = GetTreeElementSegment(element).getJoint();
+    if (j.getType() == KDL::Joint::Fixed) continue;
+    q(GetTreeElementQNr(element)) = s.q(model.jointIndex(j.getName()));
+  }
+  KDL::TreeFkSolverPos_recursive fk(tree);
+  KDL::Frame f;
+  EXPECT_GE(fk.JntToCart(q, f, link), 0);
+  return s.world_T_base * f * KDL::Frame(offset);
+}
+
+/// |v| (KDL's Vector::Norm reads every vector shorter than 1e-6 as 0).
+double length(const KDL::Vector& v) { return std::sqrt(KDL::dot(v, v)); }
+
+double angleBetween(const KDL::Rotation& a, const KDL::Rotation& b) {
+  const Eigen::Quaterniond qa = [&] { double x, y, z, w; a.GetQuaternion(x, y, z, w); return Eigen::Quaterniond(w, x, y, z); }();
+  const Eigen::Quaterniond qb = [&] { double x, y, z, w; b.GetQuaternion(x, y, z, w); return Eigen::Quaterniond(w, x, y, z); }();
+  return qa.angularDistance(qb);
+}
+
+/// A configuration drawn inside the limits (a turn for unlimited joints).
+KDL::JntArray inLimits(const FloatingModel& model, std::mt19937& rng) {
+  KDL::JntArray q(model.nj());
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const JointProperties& p = model.jointProperties()[j];
+    const double lo = std::isfinite(p.lower) ? p.lower : -3.14159, hi = std::isfinite(p.upper) ? p.upper : 3.14159;
+    q(j) = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+  return q;
+}
+
+void expectInLimits(const FloatingModel& model, const KDL::JntArray& q) {
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    EXPECT_GE(q(j), model.jointProperties()[j].lower) << model.jointNames()[j];
+    EXPECT_LE(q(j), model.jointProperties()[j].upper) << model.jointNames()[j];
+  }
+}
+
+TEST(InverseKinematics, ReachesRandomReachablePosesTo1e9InsideTheLimits) {
+  for (const Robot& robot : kRobots) {
+    const FloatingModel model = loadUrdfFile(robot.file);
+    const KDL::Vector offset(0.03, -0.02, 0.05);
+    const Contact h = model.contact(robot.link, offset);
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 12; ++trial) {
+      State truth(model);
+      truth.world_T_base = KDL::Frame(KDL::Rotation::RPY(0.3, -0.2, 1.1), KDL::Vector(1.0, -2.0, 0.5));
+      truth.q = inLimits(model, rng);
+      const KDL::Frame goal = kdlContactFrame(model, truth, robot.link, offset);
+      State seed = truth;
+      seed.q = inLimits(model, rng);  // from elsewhere in the joint space
+      const IkResult r = solveInverseKinematics(model, seed, h, goal);
+      State solved = seed;
+      solved.q = r.q;
+      const KDL::Frame reached = kdlContactFrame(model, solved, robot.link, offset);
+      SCOPED_TRACE(robot.file + " trial " + std::to_string(trial));
+      EXPECT_LE(length(reached.p - goal.p), 1e-9);
+      EXPECT_LE(angleBetween(reached.M, goal.M), 1e-9);
+      EXPECT_LE(r.position_residual, 1e-9);
+      EXPECT_LE(r.orientation_residual, 1e-9);
+      EXPECT_GT(r.iterations, 0u);
+      expectInLimits(model, r.q);
+      for (unsigned int j = 0; j < model.nj(); ++j)  // joints off the chain (the other arm) keep the seed's
+        if (std::find(r.chain_joints.begin(), r.chain_joints.end(), static_cast<int>(j)) == r.chain_joints.end())
+          EXPECT_EQ(r.q(j), seed.q(j)) << model.jointNames()[j];
+    }
+  }
+}
+
+TEST(InverseKinematics, RedundantArmTakesThePreferredPostureOnItsSelfMotion) {
+  const FloatingModel model = loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf");
+  const Contact h = model.contact("end_effector");
+  State truth(model);
+  truth.q = jointsByName(model, {{"joint1", 0.4}, {"joint2", -0.6}, {"joint3", 0.9}, {"joint4", -1.0},
+                                 {"joint5", 0.7}, {"joint6", 0.5}, {"joint7", -0.3}});
+  const KDL::Frame goal = kdlContactFrame(model, truth, "end_effector", KDL::Vector::Zero());
+  State seed = truth;
+  for (unsigned int j = 0; j < model.nj(); ++j) seed.q(j) += 0.15 * ((j % 2) ? 1.0 : -1.0);
+  IkOptions o;
+  o.preferred = truth.q;  // the pose's own posture is on the self-motion: the closest to itself
+  const IkResult r = solveInverseKinematics(model, seed, h, goal, o);
+  EXPECT_LE((r.q.data - truth.q.data).norm(), 1e-6);
+  EXPECT_LE(r.preference_gradient, 1e-8);
+  // Preferring the seed (the default) instead lands elsewhere on the self-motion, still on the pose.
+  const IkResult d = solveInverseKinematics(model, seed, h, goal);
+  EXPECT_LE(d.position_residual, 1e-9);
+  EXPECT_LE(d.preference_gradient, 1e-8);
+  EXPECT_LT((d.q.data - seed.q.data).norm(), (r.q.data - seed.q.data).norm());
+}
+
+TEST(InverseKinematics, UnreachablePoseIsRefusedWithTheRemainingDistance) {
+  const FloatingModel model = loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf");
+  const Contact h = model.contact("end_effector");
+  const State seed(model);
+  // 50 m from the base; the arm reaches 0.8 + 3.5 m from the base's origin: at least 45.7 m short.
+  const KDL::Frame goal(KDL::Rotation::Identity(), KDL::Vector(50.0, 0.0, 0.0));
+  IkOptions o;
+  o.restarts = 3;
+  try {
+    solveInverseKinematics(model, seed, h, goal, o);
+    FAIL() << "an unreachable pose was solved";
+  } catch (const IkUnreachable& e) {
+    EXPECT_GE(e.best().position_residual, 50.0 - 0.8 - 3.5 - 0.2);
+    EXPECT_LE(e.best().position_residual, 50.0);
+    EXPECT_EQ(e.best().attempts, 4u);
+    expectInLimits(model, e.best().q);
+    EXPECT_NE(std::string(e.what()).find("out of reach"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(" m and "), std::string::npos) << e.what();
+    const InputError* as_input = &e;  // an InputError: the tools exit 3
+    EXPECT_NE(as_input, nullptr);
+  }
+}
+
+TEST(InverseKinematics, RefusesAWrongSizedSeed) {
+  const FloatingModel model = loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf");
+  State seed(model);
+  seed.q.resize(3);
+  EXPECT_THROW(solveInverseKinematics(model, seed, model.contact("end_effector"), KDL::Frame::Identity()), ModelError);
+}
+
+}  // namespace
+}  // namespace kdl_space

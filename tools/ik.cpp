@@ -1,0 +1,102 @@
+#include "ik.hpp"
+
+#include <iomanip>
+
+#include "capture.hpp"  // inScenario
+
+namespace kdl_space::cli {
+namespace {
+
+std::string linkName(const Scenario& sc) { return sc.capture.robot.model->bodies()[sc.capture.robot.contact.body].name; }
+
+}  // namespace
+
+CLI::App* addIk(CLI::App& app, IkCliOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "ik", "Inverse kinematics: the joint angles that put the scenario robot's contact frame at a world pose");
+  cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON): robot.urdf, robot.contact, robot.base, robot.q")
+      ->required();
+  cmd->add_option("--position", o.position, "The contact frame's world position X Y Z (or X,Y,Z) [m]")
+      ->required()->expected(3)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--rpy", o.rpy, "Its roll pitch yaw about fixed world axes (or R,P,Y) [rad]; default 0 0 0")
+      ->expected(3)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--prefer", o.prefer,
+                  "A redundant arm's preferred posture NAME=VALUE [rad or m] (default: robot.q; unnamed joints as there)")
+      ->expected(1, -1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--position-tolerance", o.position_tolerance, "Largest accepted position residual [m]")
+      ->check(positiveNumber());
+  cmd->add_option("--orientation-tolerance", o.orientation_tolerance, "Largest accepted orientation residual [rad]")
+      ->check(positiveNumber());
+  cmd->add_option("--restarts", o.restarts, "Deterministic starts tried after the scenario's posture")
+      ->check(CLI::Range(0u, 1000u));
+  cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
+  return cmd;
+}
+
+Json ikJson(const Scenario& sc, const KDL::Frame& goal, const IkResult& r) {
+  const FloatingModel& model = *sc.capture.robot.model;
+  double roll = 0, pitch = 0, yaw = 0;
+  goal.M.GetRPY(roll, pitch, yaw);
+  Json by_name = Json::object(), chain = Json::array();
+  for (unsigned int j = 0; j < model.nj(); ++j) by_name[model.jointNames()[j]] = r.q(j);
+  for (int j : r.chain_joints) chain.push_back(model.jointNames()[j]);
+  const KDL::Vector& off = sc.capture.robot.contact.offset;
+  Json j;
+  j["scenario"] = sc.file;
+  j["contact"] = Json{{"link", linkName(sc)}, {"offset", {off.x(), off.y(), off.z()}}};
+  j["goal"] = Json{{"position", {goal.p.x(), goal.p.y(), goal.p.z()}}, {"rpy", {roll, pitch, yaw}}};
+  j["joint_names"] = model.jointNames();
+  j["q"] = toJson(r.q.data);
+  j["q_by_name"] = by_name;
+  j["moved_joints"] = chain;
+  j["position_residual"] = r.position_residual;
+  j["orientation_residual"] = r.orientation_residual;
+  j["iterations"] = r.iterations;
+  j["attempts"] = r.attempts;
+  j["preference_gradient"] = r.preference_gradient;
+  return j;
+}
+
+void runIk(const IkCliOptions& o, std::ostream& out) {
+  const Scenario sc = loadScenario(o.scenario);
+  const FloatingSystem& robot = sc.capture.robot;
+  if (robot.contact.body == 0 && robot.contact.offset == KDL::Vector::Zero())
+    throw InputError(sc.file + ": robot.contact: missing: ik places the contact frame (give robot.contact.link, and "
+                     "its offset)");
+  IkOptions options;
+  options.position_tolerance = o.position_tolerance;
+  options.orientation_tolerance = o.orientation_tolerance;
+  options.restarts = o.restarts;
+  if (!o.prefer.empty()) {
+    KDL::JntArray preferred = robot.state.q;
+    for (const std::string& text : o.prefer) {
+      const auto [name, value] = parseAssignment(text, "--prefer");
+      const int j = robot.model->jointIndex(name);
+      if (j < 0) throw UsageError("--prefer " + text + ": the robot has no movable joint '" + name + "'");
+      preferred(j) = value;
+    }
+    options.preferred = preferred;
+  }
+  const KDL::Frame goal(KDL::Rotation::RPY(o.rpy[0], o.rpy[1], o.rpy[2]), KDL::Vector(o.position[0], o.position[1], o.position[2]));
+  const IkResult r = inScenario(sc, [&] { return solveInverseKinematics(*robot.model, robot.state, robot.contact, goal, options); });
+  if (o.json) {
+    out << ikJson(sc, goal, r).dump(2) << "\n";
+    return;
+  }
+  const FloatingModel& model = *robot.model;
+  out << "kdl_space ik " << sc.file << ": the contact frame of link '" << linkName(sc) << "' at position ["
+      << o.position[0] << ", " << o.position[1] << ", " << o.position[2] << "] m, rpy [" << o.rpy[0] << ", " << o.rpy[1]
+      << ", " << o.rpy[2] << "] rad (world), the base as the scenario puts it\n";
+  out << std::setprecision(3) << "reached: residual " << r.position_residual << " m, " << r.orientation_residual
+      << " rad; " << r.iterations << " iterations, " << r.attempts << (r.attempts == 1 ? " start" : " starts") << "\n";
+  out << "joint angles [rad or m] (* moved; the others keep robot.q):\n" << std::setprecision(12);
+  std::size_t width = 0;
+  for (const std::string& n : model.jointNames()) width = std::max(width, n.size());
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const bool moved = std::find(r.chain_joints.begin(), r.chain_joints.end(), static_cast<int>(j)) != r.chain_joints.end();
+    out << "  " << (moved ? "* " : "  ") << std::left << std::setw(static_cast<int>(width)) << model.jointNames()[j]
+        << std::right << "  " << std::setw(16) << r.q(j) << "\n";
+  }
+}
+
+}  // namespace kdl_space::cli
