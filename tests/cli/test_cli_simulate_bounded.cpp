@@ -128,9 +128,14 @@ TEST_F(SimulateBounded, CtrlCStopsTheRunWithinHalfASecondAndLeavesNothing) {
                               path("run.svg") + " --scene " + path("scene.svg"),
                           err);
   ASSERT_GT(pid, 0);
-  std::this_thread::sleep_for(std::chrono::seconds(1));
+  // Signalled once the run is under way (its CSV's temporary exists: the first sample is written),
+  // not after a fixed time: a loaded machine or a sanitizer build may still be loading at 1 s.
+  const std::string temporary = path(".run.csv.tmp" + std::to_string(pid));
+  for (int k = 0; k < 600 && !fs::exists(temporary); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(fs::exists(temporary)) << "the run did not start within 60 s";
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
   int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, WNOHANG), 0) << "the run is still going after 1 s";
+  ASSERT_EQ(waitpid(pid, &status, WNOHANG), 0) << "the run is still going";
   const auto signalled = Clock::now();
   ASSERT_EQ(kill(pid, SIGINT), 0);
   ASSERT_EQ(waitpid(pid, &status, 0), pid);

@@ -334,7 +334,14 @@ TEST(StudyParts, CtrlCStopsTheRunKeepsItsChunksAndTheRerunResumes) {
   fs::remove(table);
   fs::remove_all(table + ".parts");
   const pid_t pid = spawnTool("study " + kSlow + " --threads 2 --chunk-size 8 -o " + table, out, err);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  // Signalled once the run computes (a chunk is on disk), not after a fixed time: a loaded machine
+  // or a sanitizer build may still be loading the study at 1 s.
+  const auto chunks = [&] {
+    std::error_code ec;
+    return fs::is_directory(table + ".parts", ec) && !fs::is_empty(table + ".parts", ec);
+  };
+  for (int k = 0; k < 600 && !chunks(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(chunks()) << "no chunk written within 60 s";
   ASSERT_EQ(kill(pid, SIGINT), 0);
   const auto signalled = std::chrono::steady_clock::now();
   int status = 0;
