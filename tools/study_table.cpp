@@ -236,28 +236,48 @@ void StudyPartReader::checkEnd() {
   }
 }
 
+namespace {
+// The lock is written whole to a temporary, then linked to its name: link() fails when the name
+// exists, so the lock appears at once with its holder in it (a run killed while taking it leaves at
+// most a temporary of a dead PID, never an empty lock that would name no holder).
+std::string lockTemporary(const std::string& lock) {
+  const fs::path l(lock);
+  return (l.parent_path() / ("." + l.filename().string() + ".tmp" + std::to_string(getpid()))).string();
+}
+
+bool writeWhole(const std::string& path, const std::string& text) {
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) return false;
+  const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && fsync(fd) == 0;
+  return close(fd) == 0 && ok;
+}
+}  // namespace
+
 TableLock::TableLock(const std::string& table, std::ostream& notes) : path_(table + ".lock") {
   const std::string host = hostName();
+  char since_now[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(since_now, sizeof since_now, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const std::string text = "pid " + std::to_string(getpid()) + "\nhost " + host + "\nsince " + since_now + "\n";
+  const std::string tmp = lockTemporary(path_);
+  if (!writeWhole(tmp, text)) {
+    unlink(tmp.c_str());
+    throw InputError(table + ": cannot write its lock " + path_ + " (disk full, or the folder is not writable?)");
+  }
+  struct RemoveTemporary {
+    const std::string& path;
+    ~RemoveTemporary() { unlink(path.c_str()); }
+  } remove_temporary{tmp};
   for (int attempt = 0; attempt < 2; ++attempt) {
-    const int fd = open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd >= 0) {
-      char since[32];
-      const std::time_t now = std::time(nullptr);
-      std::strftime(since, sizeof since, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-      const std::string text = "pid " + std::to_string(getpid()) + "\nhost " + host + "\nsince " + since + "\n";
-      const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
-      close(fd);
-      if (!ok) {
-        unlink(path_.c_str());
-        throw InputError(table + ": cannot write its lock " + path_ + " (disk full?)");
-      }
-      return;
-    }
+    if (link(tmp.c_str(), path_.c_str()) == 0) return;
     if (errno != EEXIST) throw InputError(table + ": cannot create its lock " + path_ + ": " + std::strerror(errno));
     std::ifstream in(path_);
     long pid = 0;
     std::string key, holder_host, since;
     in >> key >> pid >> key >> holder_host >> key >> since;
+    if (pid <= 0)
+      throw InputError(table + " has a lock " + path_ + " that names no holder (not written by this version of " +
+                       "kdl_space?); remove it if no run is writing the table");
     if (attempt == 0 && holder_host == host && processGone(pid)) {
       notes << "kdl_space: " << path_ << ": removed a stale lock (PID " << pid << ", since " << since
             << ", is no longer running)\n";
@@ -286,10 +306,11 @@ void removeStaleTemporaries(const std::string& table, const std::string& parts) 
   const fs::path t(table);
   const fs::path folder = t.parent_path().empty() ? fs::path(".") : t.parent_path();
   // Beside the table: its own temporary, and the probe checkOutputFile creates and removes at once.
-  const std::string own = "." + t.filename().string() + ".tmp", probe = "." + t.filename().string() + ".probe";
+  const std::string own = "." + t.filename().string() + ".tmp", probe = "." + t.filename().string() + ".probe",
+                    lock = "." + t.filename().string() + ".lock.tmp";
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (stale(name, own) || stale(name, probe)) fs::remove(it->path(), ec);
+    if (stale(name, own) || stale(name, probe) || stale(name, lock)) fs::remove(it->path(), ec);
   }
   if (!fs::is_directory(parts, ec)) return;
   for (fs::directory_iterator it(parts, ec), end; !ec && it != end; it.increment(ec)) {

@@ -266,6 +266,12 @@ TEST(StudyParts, ALockOfALiveRunRefusesASecondRunAndAStaleOneIsRemoved) {
   EXPECT_NE(r.err.find(lock + ": removed a stale lock (PID " + std::to_string(dead)), std::string::npos) << r.err;
   EXPECT_EQ(slurp(table), slurp(shards().whole));
   EXPECT_FALSE(fs::exists(lock)) << "the run's own lock is removed at its end";
+  // A lock that names no holder (an empty file) is never taken for a run's: refused, and said so.
+  spit(lock, "");
+  r = kdlSpace("study " + kSmall + " -o " + table);
+  EXPECT_EQ(r.rc, 3);
+  EXPECT_NE(r.err.find(table + " has a lock " + lock + " that names no holder"), std::string::npos) << r.err;
+  fs::remove(lock);
 }
 
 TEST(StudyParts, TemporariesOfRunsThatAreGoneAreRemoved) {
@@ -274,12 +280,14 @@ TEST(StudyParts, TemporariesOfRunsThatAreGoneAreRemoved) {
   fs::create_directories(parts);
   const std::string dead = std::to_string(deadPid()), live = std::to_string(getpid());
   const std::string beside_dead = scratch(".temps.csv.tmp" + dead), beside_live = scratch(".temps.csv.tmp" + live),
-                    other = scratch(".other.csv.tmp" + dead), in_parts = parts + "/.rows-0-16.csv.tmp" + dead;
-  for (const std::string& p : {beside_dead, beside_live, other, in_parts}) spit(p, "half a table");
+                    other = scratch(".other.csv.tmp" + dead), in_parts = parts + "/.rows-0-16.csv.tmp" + dead,
+                    lock_dead = scratch(".temps.csv.lock.tmp" + dead);
+  for (const std::string& p : {beside_dead, beside_live, other, in_parts, lock_dead}) spit(p, "half a table");
   const ToolRun r = kdlSpace("study " + kSmall + " -o " + table);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_FALSE(fs::exists(beside_dead));
   EXPECT_FALSE(fs::exists(in_parts));
+  EXPECT_FALSE(fs::exists(lock_dead)) << "the lock's temporary of a run killed as it took the lock";
   EXPECT_TRUE(fs::exists(beside_live)) << "a live run's temporary is left alone";
   EXPECT_TRUE(fs::exists(other)) << "another table's temporary is left alone";
   // In the parts folder while it is still needed: a run stopped by Ctrl-C keeps its chunks, and
@@ -371,14 +379,18 @@ TEST(StudyParts, KilledAtRandomMomentsAndRunAgainTheTableIsAnUninterruptedRunsBy
                                   "samples: 3000\nseed: 11\ninputs:\n  target.tumble: {uniform: [0.05, 0.16]}\n"
                                   "  robot.self_motion: {uniform: [-1, 1]}\n");
   const std::string args = "study " + study + " --threads 2 --chunk-size 40 -o " + table;
+  // The kill moments are drawn within an eighth of an uninterrupted run, measured here: about
+  // sixteen kills on any machine, a fast one or a sanitizer build on a loaded one.
+  const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(kdlSpace("study " + study + " --threads 2 -o " + whole).rc, 0);
+  const int run_us = static_cast<int>(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
   fs::remove(table);
   fs::remove_all(table + ".parts");
   std::mt19937 random(20261126);
   int kills = 0, runs = 0, after_the_table = 0;
   for (bool ended = false; !ended && runs < 200; ++runs) {
     const pid_t pid = spawnTool(args, out, err);
-    std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(0, 400000)(random)));
+    std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(0, run_us / 8)(random)));
     kill(pid, SIGKILL);
     int status = 0;
     waitpid(pid, &status, 0);
