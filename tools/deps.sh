@@ -8,6 +8,7 @@ packages=(
   build-essential cmake pkg-config
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libexpat1-dev
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
+  libnlopt-cxx-dev                                                           # capture planning (kdl_space plan)
   gnuplot-nox
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
   python3-pykdl                                                              # its PyKDL interop tests
