@@ -222,11 +222,6 @@ std::uint64_t chunkSize(const StudyOptions& o, const Study& st) {
   return o.chunk_size ? o.chunk_size : defaultChunkSize(st.samples);
 }
 
-/// The chunks of the grid that meet [begin, end).
-std::uint64_t chunkCount(const StudyGrid& g) {
-  return g.end == g.begin ? 0 : (g.end + g.chunk_size - 1) / g.chunk_size - g.begin / g.chunk_size;
-}
-
 /// Rows [begin, end) computed in chunks kept in TABLE.parts/ (those already there, of an
 /// interrupted run, are used), then the table: the chunks concatenated in order, each checked.
 std::string computeTable(const std::shared_ptr<const Study>& study, const StudyOptions& o, const std::string& table,
@@ -242,13 +237,9 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
     fs::remove_all(parts, ec);
     return "the table was whole; the chunks a stopped run left in " + parts.string() + " removed";
   }
-  // The grid of chunks, generated as they are needed (nothing here grows with their number):
-  // chunk k holds rows [k c, (k + 1) c) cut to [begin, end).
+  // The grid of chunks, generated as they are needed (nothing here grows with their number).
   const StudyGrid grid{begin, end, chunkSize(o, st)};
-  const std::uint64_t first = begin / grid.chunk_size, count = chunkCount(grid);
-  const auto chunkAt = [&](std::uint64_t k) {
-    return StudyChunk{std::max(begin, (first + k) * grid.chunk_size), std::min(end, (first + k + 1) * grid.chunk_size)};
-  };
+  const std::uint64_t count = grid.count();
   const auto chunkFile = [&](const StudyChunk& c) {
     return (parts / ("rows-" + std::to_string(c.begin) + "-" + std::to_string(c.end) + ".csv")).string();
   };
@@ -277,7 +268,7 @@ std::string computeTable(const std::shared_ptr<const Study>& study, const StudyO
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   StudyTableWriter out(table, "--table", st, columns, begin, end);
   for (std::uint64_t k = 0; k < count; ++k) {
-    const StudyChunk c = chunkAt(k);
+    const StudyChunk c = grid.chunk(k);
     StudyPartReader part(chunkFile(c), st, columns);
     if (part.begin() != c.begin || part.end() != c.end)
       throw InputError(chunkFile(c) + ": holds rows " + std::to_string(part.begin()) + "-" + std::to_string(part.end()) +
@@ -364,9 +355,9 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
             (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
   const std::pair<const char*, std::string> outputs[] = {
       {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}, {"--groups", o.groups}};
-  if (o.merge.empty() && chunkCount(StudyGrid{begin, end, chunkSize(o, st)}) > kMaxChunks)
+  if (o.merge.empty() && StudyGrid{begin, end, chunkSize(o, st)}.count() > kMaxChunks)
     throw UsageError("--chunk-size " + std::to_string(chunkSize(o, st)) + ": " +
-                     std::to_string(chunkCount(StudyGrid{begin, end, chunkSize(o, st)})) + " chunk files for samples " +
+                     std::to_string(StudyGrid{begin, end, chunkSize(o, st)}.count()) + " chunk files for samples " +
                      std::to_string(begin) + "-" + std::to_string(end) + ", more than " + std::to_string(kMaxChunks) +
                      "; use --chunk-size " + std::to_string((end - begin + kMaxChunks - 2) / (kMaxChunks - 1)) + " or more");
   std::error_code ec;

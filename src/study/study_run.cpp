@@ -76,14 +76,7 @@ void runChunks(const std::shared_ptr<const Study>& study, std::uint64_t count,
 void runStudy(const std::shared_ptr<const Study>& study, const StudyGrid& grid, unsigned threads,
               const StudyChunkDone& done, const std::atomic<bool>* cancel,
               const std::function<bool(const StudyChunk&)>& skip) {
-  const std::uint64_t size = std::max<std::uint64_t>(grid.chunk_size, 1);
-  if (grid.end <= grid.begin) return;
-  const std::uint64_t first = grid.begin / size, count = (grid.end - 1) / size - first + 1;
-  const auto chunk = [&](std::uint64_t k) {
-    const std::uint64_t from = (first + k) * size;  // <= end - 1: no overflow
-    return StudyChunk{std::max(grid.begin, from), grid.end - from > size ? from + size : grid.end};
-  };
-  runChunks(study, count, chunk, threads, done, cancel, skip);
+  runChunks(study, grid.count(), [&](std::uint64_t k) { return grid.chunk(k); }, threads, done, cancel, skip);
 }
 
 void runStudy(const std::shared_ptr<const Study>& study, const std::vector<StudyChunk>& chunks, unsigned threads,

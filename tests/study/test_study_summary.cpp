@@ -257,6 +257,27 @@ TEST(StudyRun, AGridOfChunksSkipsWhatItIsToldAndEqualsTheListOfChunks) {
   EXPECT_EQ(chunks, 3);
 }
 
+TEST(StudyRun, AGridsChunksAreTheWholeRunsCutToItsRange) {
+  // Chunk k of the whole study holds rows [k c, (k + 1) c): a shard's chunks are cut from those.
+  const StudyGrid shard{5, 23, 8};
+  ASSERT_EQ(shard.count(), 3u);
+  const std::uint64_t expected[3][2] = {{5, 8}, {8, 16}, {16, 23}};
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(shard.chunk(k).begin, expected[k][0]) << k;
+    EXPECT_EQ(shard.chunk(k).end, expected[k][1]) << k;
+  }
+  EXPECT_EQ((StudyGrid{16, 32, 8}.count()), 2u) << "a range on chunk boundaries";
+  EXPECT_EQ((StudyGrid{7, 7, 8}.count()), 0u);
+  EXPECT_EQ((StudyGrid{0, 3, 0}.count()), 3u) << "a chunk size of 0 is taken as 1";
+  // A billion samples in chunks of 16, at the top of the 64-bit range: no overflow.
+  const std::uint64_t top = ~std::uint64_t{0};
+  const StudyGrid high{top - 40, top, 16};
+  const StudyChunk last = high.chunk(high.count() - 1);
+  EXPECT_EQ(last.end, top);
+  EXPECT_GT(last.end, last.begin);
+  EXPECT_EQ((StudyGrid{0, 1000000000, 16}.count()), 62500000u);
+}
+
 TEST(StudyRun, ACancelStopsAChunkWithinASample) {
   // One chunk of 2,000 samples, each a capture and half a second of motion after it (about 13 s
   // on one thread): cancelled after 100 ms.

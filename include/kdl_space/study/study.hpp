@@ -151,6 +151,18 @@ KDL_SPACE_EXPORT std::uint64_t defaultChunkSize(std::uint64_t samples);
 struct StudyGrid {
   std::uint64_t begin = 0, end = 0;
   std::uint64_t chunk_size = 1;  ///< 0 is taken as 1
+
+  /// The chunks that meet [begin, end): chunk k holds rows [k c, (k + 1) c) of the whole study, cut
+  /// to [begin, end) (so a shard's chunks are the whole run's, and their files the same).
+  std::uint64_t count() const { return end <= begin ? 0 : (end - 1) / size() - begin / size() + 1; }
+  /// The k-th chunk of count() (no overflow: its first row is below end).
+  StudyChunk chunk(std::uint64_t k) const {
+    const std::uint64_t from = (begin / size() + k) * size();
+    return StudyChunk{from > begin ? from : begin, end - from > size() ? from + size() : end};
+  }
+
+ private:
+  std::uint64_t size() const { return chunk_size ? chunk_size : 1; }
 };
 
 /// Called with each chunk finished: rows is chunk size x columns, row-major.
