@@ -20,11 +20,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
 
-std::string scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_motion_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
+std::string scratch(const std::string& name) { return scratchIn("kdl_space_motion", name); }
 
 /// A CSV as columns by header name.
 std::map<std::string, std::vector<double>> readCsv(const std::string& path) {

@@ -466,12 +466,7 @@ TEST(CommandLines, UnusableInputsExitWith3) {
 
 class OutputFiles : public HostileFiles {
  protected:
-  static std::string file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream bytes;
-    bytes << in.rdbuf();
-    return bytes.str();
-  }
+  static std::string file(const std::string& path) { return slurp(path); }
   /// Files in the scratch folder whose name is not in `expected` (temporaries left behind).
   std::vector<std::string> strays(const std::set<std::string>& expected) const {
     std::vector<std::string> found;

@@ -64,13 +64,6 @@ TEST(EquivalentBox, ThinAndPointBodies) {
 
 // --- the tool ------------------------------------------------------------------------------------
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
@@ -144,7 +137,7 @@ TEST_F(Scene, CaptureDrawsTheRobotAndARigidTarget) {
   EXPECT_NE(r.out.find("Scene: " + svg + "\n"), std::string::npos) << r.out;
   EXPECT_EQ(files(), std::vector<std::string>{"scene.svg"}) << "no temporary left behind";
   const Scenario sc = loadScenario(scenario);
-  const std::string text = readFile(svg);
+  const std::string text = slurp(svg);
   expectScene(text, *sc.capture.robot.model);
   EXPECT_GE(segments(text, "target (box of inertia)"), 12u);
   EXPECT_GE(segments(text, "target frame (x, y, z)"), 3u);
@@ -161,7 +154,7 @@ TEST_F(Scene, CaptureDrawsAFreeFloatingTargetAsAStickFigure) {
   const Scenario sc = loadScenario(scenario);
   const FloatingModel& robot = *sc.capture.robot.model;
   const FloatingModel& target = *std::get<FloatingSystem>(sc.capture.target).model;
-  const std::string text = readFile(svg);
+  const std::string text = slurp(svg);
   expectScene(text, robot);
   EXPECT_NE(text.find(">grasp point<"), std::string::npos);
   EXPECT_GE(segments(text, "target"), target.bodies().size() - 1);
@@ -175,7 +168,7 @@ TEST_F(Scene, SimulateDrawsTheStartTheContactAndTheEnd) {
                              " --csv " + csv + " --json");
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_EQ(files(), (std::vector<std::string>{"operation.csv", "operation.svg"})) << "no temporary left behind";
-  const std::string text = readFile(svg);
+  const std::string text = slurp(svg);
   const nlohmann::json j = nlohmann::json::parse(r.out);
   const double t_c = j.at("approach").at("t_contact").get<double>();
   for (const char* panel : {">start, t = 0 s<", ">end, t = "}) EXPECT_NE(text.find(panel), std::string::npos) << panel;
@@ -204,7 +197,7 @@ TEST_F(Scene, APngToo) {
   const ToolRun r = kdlSpace("capture " + kScenarios + "tumbling_box_capture.yaml --scene " + png);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_EQ(files(), std::vector<std::string>{"scene.png"});
-  EXPECT_EQ(readFile(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_EQ(slurp(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
 }
 
 TEST_F(Scene, AFileThatCannotBeWrittenIsRefusedByNameAndNothingIsLeft) {

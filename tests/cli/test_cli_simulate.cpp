@@ -14,11 +14,7 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml";
 
-std::string scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_sim_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
+std::string scratch(const std::string& name) { return scratchIn("kdl_space_sim", name); }
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> cells;

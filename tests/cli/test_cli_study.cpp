@@ -19,23 +19,14 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using kdl_space::test::kdlSpace;
 using kdl_space::test::ToolRun;
+using kdl_space::test::scratchIn;
+using kdl_space::test::slurp;
+using kdl_space::test::spit;
 
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
 const std::string kShippedStudy = kScenarios + "study_grasp_configuration.yaml";
 
-std::string scratch(const std::string& name) {
-  // One folder per process: ctest runs these tests in parallel processes, each writing its study.
-  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_cli_study_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string scratch(const std::string& name) { return scratchIn("kdl_space_cli_study", name); }
 
 std::string write(const std::string& name, const std::string& text) {
   const std::string path = scratch(name);

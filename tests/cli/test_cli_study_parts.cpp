@@ -30,23 +30,13 @@ namespace {
 namespace fs = std::filesystem;
 using kdl_space::test::kdlSpace;
 using kdl_space::test::ToolRun;
+using kdl_space::test::scratchIn;
+using kdl_space::test::slurp;
+using kdl_space::test::spit;
 
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
 
-std::string scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("kdl_space_cli_parts_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+std::string scratch(const std::string& name) { return scratchIn("kdl_space_cli_parts", name); }
 
 std::string write(const std::string& name, const std::string& text) {
   const std::string path = scratch(name);

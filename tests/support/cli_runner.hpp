@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -33,5 +34,24 @@ inline ToolRun kdlSpace(const std::string& args) {
   std::remove(err_file.c_str());
   return {WEXITSTATUS(status), out, err.str()};
 }
+
+/// A path `name` in a folder of this test process (ctest runs tests in parallel processes): the
+/// folder `tag`_PID under gtest's temporary folder, created.
+inline std::string scratchIn(const std::string& tag, const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / (tag + "_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+/// A file's bytes ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Writes `text` to `path` as it is (no newline conversion).
+inline void spit(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
 
 }  // namespace kdl_space::test
