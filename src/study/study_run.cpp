@@ -34,7 +34,7 @@ void runChunks(const std::shared_ptr<const Study>& study, std::uint64_t count,
   threads = static_cast<unsigned>(std::min<std::uint64_t>(threads, std::max<std::uint64_t>(count, 1)));
   std::atomic<std::uint64_t> next{0};
   std::atomic<bool> failed{false};
-  std::mutex report, skipping;
+  std::mutex report;
   std::exception_ptr error;
   // Seen between samples, not only between chunks: a chunk is up to 65,536 samples (seconds).
   const auto stop = [&] {
@@ -47,10 +47,7 @@ void runChunks(const std::shared_ptr<const Study>& study, std::uint64_t count,
       std::vector<double> rows;
       for (std::uint64_t k; !stop() && (k = next++) < count;) {
         const StudyChunk c = chunk(k);
-        if (skip) {
-          const std::lock_guard<std::mutex> lock(skipping);
-          if (skip(c)) continue;
-        }
+        if (skip && skip(c)) continue;  // on this thread, beside the others' (a resume reads chunks in parallel)
         rows.resize(static_cast<std::size_t>(c.end - c.begin) * m);
         std::uint64_t i = c.begin;
         for (; i < c.end && !stop(); ++i) evaluator.evaluate(i, rows.data() + static_cast<std::size_t>(i - c.begin) * m);

@@ -171,7 +171,7 @@ using StudyChunkDone = std::function<void(const StudyChunk&, const std::vector<d
 /// \brief Computes the chunks of `grid` on `threads` threads (0: all cores), each with its own
 /// evaluator; the threads take the chunks in order from a counter, so nothing proportional to the
 /// number of chunks is held (a study of 1e9 samples in chunks of 16 needs no list of chunks).
-/// `skip(chunk)` (may be empty; called from any thread, one call at a time) true leaves a chunk
+/// `skip(chunk)` (may be empty; called from the threads at once: it must be thread-safe) true leaves a chunk
 /// out (e.g. one already on disk). `done(chunk, rows)` is called for each chunk as it completes,
 /// one call at a time, in any order. `cancel` (may be null) set to true stops the run within a
 /// sample on every thread: a chunk cut short is not handed to `done`. An exception thrown by
