@@ -97,9 +97,19 @@ py::dict runOperation(const PyScenario& ps, py::object duration, py::object outp
     if (!observer.is_none()) observer(x.t, toString(x.phase), toNumpyVec(x.q), toNumpyVec(x.qd));
   };
   OperationResult r;
+  std::exception_ptr failed;
+  std::shared_ptr<const OperationResult> partial;
   {
     py::gil_scoped_release nogil;
-    r = runCaptureOperation(sc, o);
+    try {
+      r = runCaptureOperation(sc, o);
+    } catch (const OperationError& e) {
+      failed = std::current_exception(), partial = e.partial();
+    }
+  }
+  if (failed) {  // what the motion saw before it failed (a sampled controller's gains) warns too
+    if (partial) reportWarnings(partial->warnings);
+    std::rethrow_exception(failed);
   }
   const py::dict d = py::module_::import("json").attr("loads")(cli::operationJson(sc, r).dump());
   reportWarnings(r.warnings);  // the motion's warnings (also in d["warnings"]) as RuntimeWarnings

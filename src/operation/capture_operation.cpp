@@ -200,7 +200,10 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   if (const int src = sim.stiffness(start, r.record.stiffness))
     throw OperationError(sc.file + ": simulation: " + strError(src), src, std::make_shared<const OperationResult>(r));
   if (const std::string advice = stiffnessAdvice(r.record); !advice.empty())  // a warning, by the joint's name
-    r.warnings.push_back(Diagnostic{r.model->jointNames()[r.record.stiffness.fastest_joint], advice, "stiff"});
+    r.warnings.push_back(Diagnostic{r.model->jointNames()[r.record.stiffness.fastest_joint],
+                                    advice + " (its gains come from simulation.joints, where a pattern such as \"*\" "
+                                             "gives every joint it matches the same gains)",
+                                    "stiff"});
   if (rc == E_CANCELLED) {
     std::ostringstream why;
     why << std::setprecision(6) << sc.file << ": the simulation was cancelled at t = " << s.t << " s of "
@@ -211,6 +214,8 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     std::ostringstream why;
     why << sc.file << ": simulation failed at t = " << s.t << " s of " << r.duration << " s: "
         << simulationFailure(rc ? rc : observer_rc, sc.simulation, r.record, s);
+    for (const Diagnostic& d : r.warnings)  // what was seen before it ran: the likely cause
+      if (d.kind == "sampled_gain_unstable") why << "; " << d.message;
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(r));
   }
   if (!r.joined)
