@@ -3,6 +3,7 @@
 // `kdl_space simulate --json` prints (the same writer: tools/operation_report), plus the samples
 // as NumPy arrays, with an optional controller at a control rate and an observer per sample.
 #include <cmath>
+#include <exception>
 
 #include "capture_types.hpp"
 #include "conversions.hpp"

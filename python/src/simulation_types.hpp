@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "conversions.hpp"
+#include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
 namespace kdl_space::python {

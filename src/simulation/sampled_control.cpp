@@ -42,7 +42,7 @@ int sampledGainWarnings(Simulator& sim, const SimulationState& s, const SampledC
   const auto torque = [&](Eigen::VectorXd& tau) {
     tau.setZero();
     controller(x, tau);
-    if (tau.size() != n) return E_SIZE_MISMATCH;
+    if (tau.size() != static_cast<Eigen::Index>(n)) return E_SIZE_MISMATCH;
     return tau.allFinite() ? E_NOERROR : E_NOT_FINITE;
   };
   for (unsigned int j = 0; j < n; ++j) {
@@ -64,7 +64,7 @@ int sampledGainWarnings(Simulator& sim, const SimulationState& s, const SampledC
     const std::string& name = sim.model().jointNames()[j];
     std::ostringstream why;
     why.precision(3);
-    why << "the controller sampled at " << control_rate << " Hz feeds joint '" << name << "''s rate back with kd = "
+    why << "the controller sampled at " << control_rate << " Hz feeds back the rate of joint '" << name << "' with kd = "
         << kd << " N m s/rad (or N s/m) against its apparent inertia " << m << " kg m^2 (or kg): kd dt / m = " << b
         << (b >= 2.0 ? ", above 2: unstable under a zero-order hold" : ", above 1: it rings at the control rate")
         << "; sample at " << kd / (m * kSampledGainMargin) << " Hz or more, or lower kd to "

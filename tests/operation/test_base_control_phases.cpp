@@ -107,7 +107,7 @@ TEST(BaseControlPhases, UnknownOrNoPhaseIsRefusedByName) {
     return std::string("accepted");
   };
   EXPECT_NE(refusal("phase_unknown", "[approach, sideways]")
-                .find("simulation.base_control.phases[1]: \"sideways\" is not one of approach, after"),
+                .find("simulation.base_control.phases[1]: 'sideways' is not one of approach, after"),
             std::string::npos)
       << refusal("phase_unknown", "[approach, sideways]");
   EXPECT_NE(refusal("phase_empty", "[]").find("simulation.base_control.phases: is empty"), std::string::npos)

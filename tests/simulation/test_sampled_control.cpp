@@ -111,15 +111,21 @@ TEST_F(SampledControl, RateGainBeyondTheHoldsBoundIsWarnedAndDoesDiverge) {
       ++calls;
       tau = -kd.cwiseProduct(x.velocity.qdot.data);
     };
-    Simulator sim(model);
+    SimulationOptions unlimited;
+    unlimited.effort_limits = false;  // a saturated torque would turn the divergence into a bounded ringing
+    Simulator sim(model, unlimited);
     std::vector<Diagnostic> warnings;
     ASSERT_EQ(sampledGainWarnings(sim, start, damper, rate, warnings), 0);
     EXPECT_EQ(calls, 4);  // two a joint
     SimulationState s = start;
-    const int rc = runSampled(sim, s, 2.0, 0.1, damper, rate, nullptr);
+    double fastest = 0.0;  // the largest joint rate over the run
+    const int rc = runSampled(sim, s, 1.0, 0.01, damper, rate, [&](const SimulationState& x) {
+      if (x.velocity.qdot.data.allFinite()) fastest = std::max(fastest, x.velocity.qdot.data.norm());
+    });
     if (b < 1.0) {
       EXPECT_TRUE(warnings.empty()) << warnings.front().message;
       ASSERT_EQ(rc, 0);
+      EXPECT_LE(fastest, start.velocity.qdot.data.norm());                             // never grew
       EXPECT_LT(s.velocity.qdot.data.norm(), 0.1 * start.velocity.qdot.data.norm());  // damped out
     } else {
       ASSERT_EQ(warnings.size(), 2u);
@@ -128,8 +134,9 @@ TEST_F(SampledControl, RateGainBeyondTheHoldsBoundIsWarnedAndDoesDiverge) {
         EXPECT_EQ(warnings[j].element, model->jointNames()[j]);
         EXPECT_NE(warnings[j].message.find("above 2: unstable"), std::string::npos) << warnings[j].message;
       }
-      EXPECT_TRUE(rc != 0 || s.velocity.qdot.data.norm() > 100.0 * start.velocity.qdot.data.norm())
-          << "rc " << rc << ", |qdot| " << s.velocity.qdot.data.norm();  // grew by (b - 1)^k
+      // |1 - b| = 1.5 a period: a hundredfold within some 12 periods (then the arm's nonlinear
+      // dynamics at such rates take over, or the run fails)
+      EXPECT_TRUE(rc != 0 || fastest > 100.0 * start.velocity.qdot.data.norm()) << "rc " << rc << ", max |qdot| " << fastest;
     }
   }
   // A continuous controller (no rate) has no hold: nothing to check, not even a call.
