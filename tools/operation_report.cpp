@@ -92,6 +92,17 @@ Json targetMotionJson(const OperationResult& r) {
               {"max_angular_momentum_change", r.target_motion->dL}};
 }
 
+/// Where the scenario's base control acts (`base_control.phases`) and where it did in this run:
+/// null without one.
+Json baseControlPhasesJson(const Scenario& sc, const OperationResult& r) {
+  const BaseControl& c = sc.simulation.base_control;
+  if (!c.on()) return nullptr;
+  Json phases = Json::array();
+  if (c.in_approach) phases.push_back("approach");
+  if (c.after_capture) phases.push_back("after");
+  return Json{{"phases", phases}, {"acted_in", r.base_control_phases}};
+}
+
 }  // namespace
 
 Json operationJson(const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
@@ -103,7 +114,11 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
   j["target_motion"] = targetMotionJson(r);
   // The robot's configuration at the capture (the contact instant of an approach).
-  j["warnings"] = warningsJson(r.capture ? captureWarnings(r.at_contact) : std::vector<Diagnostic>{});
+  // and what the motion found (a sampled controller's gains, a stiff servo).
+  std::vector<Diagnostic> warnings = r.capture ? captureWarnings(r.at_contact) : std::vector<Diagnostic>{};
+  warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());
+  j["warnings"] = warningsJson(warnings);
+  j["base_control"] = baseControlPhasesJson(sc, r);
   if (record.samples == 0) {  // stopped at the capture (OperationOptions::motion false)
     j["simulation"] = nullptr;
     return j;
@@ -155,6 +170,14 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   if (r.capture) {
     printCaptureSummary(out, sc, *r.capture);
     printWarnings(out, captureWarnings(r.at_contact));
+  }
+  if (sc.simulation.base_control.on()) {
+    const BaseControl& c = sc.simulation.base_control;
+    out << "Base control acts " << (c.in_approach && c.after_capture ? "in the approach and after the capture"
+                                    : c.in_approach                  ? "in the approach only"
+                                                                     : "after the capture only")
+        << " (base_control.phases); in this run: "
+        << (r.base_control_phases.empty() ? std::string("none") : detail::listNames(r.base_control_phases)) << "\n";
   }
   if (record.samples == 0) return;  // stopped at the capture
   if (r.capture) {

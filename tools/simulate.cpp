@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <memory>
@@ -180,6 +181,11 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);
+  // What the motion found (a sampled controller's gains, a stiff servo): on stderr too, whatever
+  // the format of stdout.
+  for (const Diagnostic& d : r.warnings)
+    std::cerr << "kdl_space: warning: " << d.kind << ": " << (d.element.empty() ? "" : d.element + ": ") << d.message
+              << "\n";
   const OperationFiles files{o.csv, o.plot};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

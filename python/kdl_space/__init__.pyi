@@ -202,7 +202,7 @@ def run_operation(scenario: Scenario, *, duration: Optional[float] = None, outpu
                   approach: bool = True, motion: bool = True,
                   observer: Optional[Callable[[float, str, Array, Array], None]] = None,
                   controller: Optional["Controller"] = None, control_rate: Optional[float] = None,
-                  max_output_rows: int = 10_000_000) -> dict[str, Any]: ...
+                  max_output_rows: int = 10_000_000, check_gains: bool = True) -> dict[str, Any]: ...
 def solve_capture(scenario_or_problem: Union[Scenario, CaptureProblem]) -> CaptureResult: ...
 @overload
 def inverse_kinematics(state: State, contact: Contact, goal: Union[ArrayLike, Tuple[ArrayLike, ArrayLike]], *,
@@ -280,6 +280,7 @@ class SimulationResult:
     momentum: Array
     energy: Array
     work: dict[str, Array]
+    warnings: list[dict[str, str]]  # a sampled controller's gains: {kind, element, message}
     impulse: Array
     final_state: State
     final_t: float
@@ -315,7 +316,7 @@ class Simulator:
     def apparent_inertia(self, state: State, joint: Union[str, int]) -> float: ...
     def run(self, state: State, t_end: float, output_dt: float, *, controller: Optional[Controller] = None,
             control_rate: Optional[float] = None, t0: float = 0.0,
-            max_output_rows: int = 10_000_000) -> SimulationResult: ...
+            max_output_rows: int = 10_000_000, check_gains: bool = True) -> SimulationResult: ...
 
 class Study:
     file: str

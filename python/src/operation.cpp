@@ -3,6 +3,7 @@
 // `kdl_space simulate --json` prints (the same writer: tools/operation_report), plus the samples
 // as NumPy arrays, with an optional controller at a control rate and an observer per sample.
 #include <cmath>
+#include <exception>
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
@@ -52,7 +53,7 @@ py::dict samplesDict(const OperationResult& r) {
 
 py::dict runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
                       py::object observer, py::object controller, py::object control_rate,
-                      std::uint64_t max_output_rows) {
+                      std::uint64_t max_output_rows, bool check_gains) {
   const Scenario& sc = ps.scenario;
   OperationOptions o;
   if (!duration.is_none()) {
@@ -66,6 +67,7 @@ py::dict runOperation(const PyScenario& ps, py::object duration, py::object outp
       throw py::value_error("output_step: expected a finite step > 0 s, got " + std::to_string(*o.output_step));
   }
   o.approach = approach, o.motion = motion;
+  o.check_sampled_gains = check_gains;
   // Every sample is kept (the result's arrays): their count is checked before the run.
   checkOutputRows("run_operation", estimatedOutputRows(sc, o), max_output_rows, "output_step (simulation.output_step)");
   o.cancelled = SignalPoll();  // Ctrl-C between the samples too
@@ -96,11 +98,22 @@ py::dict runOperation(const PyScenario& ps, py::object duration, py::object outp
     if (!observer.is_none()) observer(x.t, toString(x.phase), toNumpyVec(x.q), toNumpyVec(x.qd));
   };
   OperationResult r;
+  std::exception_ptr failed;
+  std::shared_ptr<const OperationResult> partial;
   {
     py::gil_scoped_release nogil;
-    r = runCaptureOperation(sc, o);
+    try {
+      r = runCaptureOperation(sc, o);
+    } catch (const OperationError& e) {
+      failed = std::current_exception(), partial = e.partial();
+    }
+  }
+  if (failed) {  // what the motion saw before it failed (a sampled controller's gains) warns too
+    if (partial) reportWarnings(partial->warnings);
+    std::rethrow_exception(failed);
   }
   const py::dict d = py::module_::import("json").attr("loads")(cli::operationJson(sc, r).dump());
+  reportWarnings(r.warnings);  // the motion's warnings (also in d["warnings"]) as RuntimeWarnings
   d["samples"] = samplesDict(r);
   return d;
 }
@@ -111,7 +124,7 @@ void bindOperation(py::module_& m) {
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
         py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,
         py::arg("observer") = py::none(), py::arg("controller") = py::none(), py::arg("control_rate") = py::none(),
-        py::arg("max_output_rows") = std::uint64_t{10'000'000},
+        py::arg("max_output_rows") = std::uint64_t{10'000'000}, py::arg("check_gains") = true,
         "The scenario's capture operation as `kdl_space simulate` runs it: the approach (if any), the capture at "
         "the contact instant, the system after it and `duration` s of its motion (None: the scenario's). Returns "
         "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
@@ -119,7 +132,11 @@ void bindOperation(py::module_& m) {
         "base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, work, impulse, grasp_distance; "
         "joint_names). `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
-        "`observer(t, phase, q, qdot)` sees every sample. InputError naming the scenario's file for what cannot "
+        "`observer(t, phase, q, qdot)` sees every sample. With control_rate and check_gains the controller is "
+        "first probed at the start of the motion (2 calls a joint, its rate perturbed): a rate gain kd above "
+        "control_rate x the joint's apparent inertia gets a warning (kind 'sampled_gain_unstable'), as a servo that "
+        "forces tiny steps does ('stiff'), in 'warnings' and as a RuntimeWarning; 'base_control' says in which "
+        "phases the scenario's base control acts ('phases') and acted ('acted_in'). InputError naming the scenario's file for what cannot "
         "be run or failed. The samples are kept in memory: a run that could give more than max_output_rows "
         "(approach.max_duration and duration over the output step) is refused (ValueError) before it starts. "
         "Ctrl-C raises KeyboardInterrupt within about 0.1 s.");

@@ -80,7 +80,7 @@ struct PySimulator {
 }
 
 PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, py::object controller,
-          py::object control_rate, double t0, std::uint64_t max_output_rows) {
+          py::object control_rate, double t0, std::uint64_t max_output_rows, bool check_gains) {
   w.notFromController();
   const FloatingModel& model = *w.model.ptr;
   SimulationState s = w.stateOf(start, "state");
@@ -125,7 +125,8 @@ PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, 
     py::gil_scoped_acquire gil;  // Ctrl-C ends the run at the next output sample (a KeyboardInterrupt)
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   };
-  int rc;
+  int rc = E_NOERROR;
+  std::vector<Diagnostic> gain_warnings;
   {
     py::gil_scoped_release nogil;
     std::lock_guard<std::mutex> lock(w.mutex);
@@ -138,9 +139,12 @@ PyRun run(PySimulator& w, const PyState& start, double t_end, double output_dt, 
     } guard{w};
     w.runner = std::this_thread::get_id();
     w.sim->setCancelPoll(SignalPoll());  // and between the samples, however rare
-    rc = runSampled(*w.sim, s, t_end, output_dt, sampled, rate, observer);
+    // A sampled controller's rate gains, probed at the start (2 calls a joint), before it runs.
+    if (check_gains) rc = sampledGainWarnings(*w.sim, s, sampled, rate, gain_warnings);
+    if (rc == E_NOERROR) rc = runSampled(*w.sim, s, t_end, output_dt, sampled, rate, observer);
   }
   PyRun result(samples, PyState{w.model.ptr, s.state, s.velocity}, PyStats{w.sim->stats(), model.jointNames()});
+  result.warnings = reportWarnings(gain_warnings);
   if (rc || sample_rc) raiseRunError(rc ? rc : sample_rc, s, t0, t_end, py::cast(result));
   return result;
 }
@@ -180,7 +184,7 @@ std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model
         w->sim->setJointControl(in(j), brake);
     for (const auto& [j, control] : spec.joints) w->sim->setJointControl(in(j), control);
     for (const auto& [j, mode] : spec.limits) w->sim->setLimitMode(in(j), mode);
-    w->sim->setBaseControl(spec.base_control);
+    if (spec.base_control.after_capture) w->sim->setBaseControl(spec.base_control);  // its phases: this motion is `after`
     for (ScheduledWrench x : spec.wrenches) {
       const int b = model.ptr->bodyIndex(robot.model->bodies()[x.body].name);
       if (b < 0)
@@ -357,12 +361,13 @@ void bindSimulation(py::module_& m) {
       }, "Each joint's Coulomb regularisation v_s of the last run (nj,).")
       .def("run", &run, py::arg("state"), py::arg("t_end"), py::arg("output_dt"), py::kw_only(),
            py::arg("controller") = py::none(), py::arg("control_rate") = py::none(), py::arg("t0") = 0.0,
-           py::arg("max_output_rows") = std::uint64_t{10'000'000},
+           py::arg("max_output_rows") = std::uint64_t{10'000'000}, py::arg("check_gains") = true,
            "Integrates from `state` at time t0 to t_end; samples at t0, every output_dt and t_end "
            "(SimulationResult). controller(t, q, qdot, base_pose (4, 4), base_twist (6,)) -> tau (nj,) (or a dict "
            "by joint name), added to the joint controls' torques: with control_rate [Hz], called at t0 + k / "
            "control_rate with the state there and held constant until the next (zero-order hold; output_dt and "
-           "the period must be commensurate); without, called at every derivative evaluation. The GIL is released "
+           "the period must be commensurate; check_gains: probed first, 2 calls a joint, kd / (rate m_j) > 1 warns "
+           "in result.warnings and as RuntimeWarning); else called at every evaluation. The GIL is released "
            "while integrating; an exception in the controller ends the run and propagates; a nonzero return "
            "code raises ComputeError with .code, .t (how far the run got) and .result (the samples so far). "
            "Every sample is kept in memory: a run of more than max_output_rows samples is refused (ValueError) "

@@ -16,6 +16,16 @@ py::array_t<double> rows(const std::vector<double>& v, long k, long cols) {
 
 }  // namespace
 
+py::list reportWarnings(const std::vector<Diagnostic>& warnings) {
+  py::list l;
+  for (const Diagnostic& w : warnings) {
+    l.append(py::dict(py::arg("kind") = w.kind, py::arg("element") = w.element, py::arg("message") = w.message));
+    const std::string text = w.kind + ": " + (w.element.empty() ? "" : w.element + ": ") + w.message;
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+  }
+  return l;
+}
+
 PyRun::PyRun(const Samples& x, const PyState& final, const PyStats& st)
   : joint_names(st.joint_names), final_state(final), stats(st) {
   const long n = static_cast<long>(joint_names.size());
@@ -88,6 +98,10 @@ void bindSimulationResults(py::module_& m) {
       .def_readonly("base_position", &PyRun::base_position, "(k, 3) [m]")
       .def_readonly("base_quaternion", &PyRun::base_quaternion, "(k, 4), (x, y, z, w) of world_R_base.")
       .def_readonly("base_twist", &PyRun::base_twist, "(k, 6): (v of the base origin; w).")
+      .def_readonly("warnings", &PyRun::warnings,
+                    "[{kind, element, message}]: a controller sampled at control_rate whose rate gain on a joint "
+                    "(element) exceeds what its zero-order hold keeps stable (kind 'sampled_gain_unstable'); each "
+                    "also issued as a RuntimeWarning.")
       .def_readonly("q", &PyRun::q, "(k, nj)")
       .def_readonly("qdot", &PyRun::qdot, "(k, nj)")
       .def_readonly("tau", &PyRun::tau, "(k, nj): joint torques applied (controls, limited, plus friction).")

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "conversions.hpp"
+#include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
 namespace kdl_space::python {
@@ -88,6 +89,7 @@ struct PyRun {
   py::dict work;
   PyState final_state;
   PyStats stats;
+  py::list warnings;  ///< {kind, element, message}: a sampled controller's gains (sampledGainWarnings)
   PyRun(const Samples& x, const PyState& final, const PyStats& st);
 };
 
@@ -97,6 +99,10 @@ unsigned int jointArgument(const FloatingModel& model, py::handle obj, const cha
 unsigned int bodyArgument(const FloatingModel& model, py::handle obj, const char* name);
 /// None (no joint), joint names or indices, or nj booleans.
 std::vector<bool> lockedJoints(const FloatingModel& model, py::handle obj);
+
+/// The warnings of a run as a list of {kind, element, message}, each also issued as a Python
+/// RuntimeWarning (on stderr unless the caller filters it; an error if warnings are errors).
+py::list reportWarnings(const std::vector<Diagnostic>& warnings);
 
 /// Integrator, JointRecord, SimulationStats, Stiffness, SimulationResult (simulation_result.cpp).
 void bindSimulationResults(py::module_& m);

@@ -47,6 +47,13 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
     # Keys added after the golden files were written (JSON keys are only ever added): the
     # configuration's warnings at the capture (issue 26; their values: test_poses.py).
     assert isinstance(now.pop("warnings"), list)
+    # Where the scenario's base control acts and acted (issue 26): null without one; after the
+    # capture (the default) in the one shipped scenario that has one, which has no approach.
+    phases = now.pop("base_control")
+    if before["simulation"]["base_control"] is None:
+        assert phases is None
+    else:
+        assert phases == {"phases": ["after"], "acted_in": ["after"]}
     # The same build type on the same kind of machine: the same floating-point code, so the same
     # numbers but for the last bits of a long adaptive run.
     assert_same(before, now, rel=1e-9, abs_tol=1e-12)
@@ -98,7 +105,7 @@ def test_controller_observer_and_options():
         assert pose.shape == (4, 4) and q.shape == (7,)
         return np.zeros(7)
 
-    r = kdl_space.run_operation(scenario, duration=0.5, controller=zero, control_rate=10.0,
+    r = kdl_space.run_operation(scenario, duration=0.5, controller=zero, control_rate=10.0, check_gains=False,
                                 observer=lambda t, phase, q, qdot: seen.append((t, phase)))
     np.testing.assert_allclose(r["simulation"]["final"]["q"], plain["simulation"]["final"]["q"], rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(calls, np.arange(6) * 0.1, atol=1e-12)  # t = 0, 0.1, ..., 0.5: held between
@@ -149,3 +156,21 @@ def test_ctrl_c_ends_run_operation_within_half_a_second_however_rare_its_samples
         timer.cancel()
         timer.join()
     assert sent and time.monotonic() - sent[0] < 0.5
+
+
+def test_sampled_controller_beyond_its_hold_and_a_stiff_servo_are_warned():
+    """A PD at 200 Hz with the scenario's continuous gains after the capture: the joints whose kd
+    dt / m exceeds 1 are named in 'warnings' (kind sampled_gain_unstable) and as RuntimeWarnings, and
+    in the error if the motion then blows up."""
+    scenario = kdl_space.load_scenario(str(SCENARIOS["stiff_wrist_servo"]))
+
+    def servo(t, q, qdot, pose, twist):
+        return -300.0 * qdot
+
+    with pytest.warns(RuntimeWarning, match="sampled_gain_unstable: joint7: .*200 Hz"):
+        try:
+            r = kdl_space.run_operation(scenario, duration=0.2, controller=servo, control_rate=200.0)
+            warned = [w for w in r["warnings"] if w["kind"] == "sampled_gain_unstable"]
+            assert "joint7" in [w["element"] for w in warned]
+        except kdl_space.InputError as e:
+            assert "sampled at 200 Hz" in str(e)

@@ -243,7 +243,7 @@ def test_controller_at_a_control_rate_is_a_zero_order_hold(arm):
     calls = []
     rate, t0, t_end = 100.0, 0.25, 0.75
     run = sim.run(moving(arm), t_end=t_end, output_dt=0.0025, controller=pd(kp, kd, target, calls),
-                  control_rate=rate, t0=t0)
+                  control_rate=rate, t0=t0, check_gains=False)  # the run's calls alone, not the gains' probe
     # called at t0 + k / rate exactly, with the state there (the samples at those instants)
     times = np.array([c[0] for c in calls])
     assert np.allclose(times, t0 + np.arange(51) / rate, rtol=0, atol=1e-12)
@@ -461,3 +461,36 @@ def test_a_run_that_would_keep_more_samples_than_max_output_rows_is_refused(arm)
     # The default (10 million) refuses 1e5 s at 1e-4 s before any step.
     with pytest.raises(ValueError, match=r"up to 1000000001 samples in memory, more than max_output_rows = 10000000"):
         sim.run(state, t_end=1e5, output_dt=1e-4)
+
+
+def test_sampled_pd_with_a_continuous_servos_gains_is_warned(arm):
+    """A PD at 200 Hz with the gains of a continuous servo (kd / m of the wrist some 10^3 1/s) once
+    diverged without a word: each joint where kd / (rate m) exceeds 1 (m = 1 / (H*^-1)_jj, from
+    NumPy here) is warned about by name before the run, in result.warnings and as a
+    RuntimeWarning; at a rate fast enough, nothing; check_gains=False: no probe."""
+    sim = kdl_space.Simulator(arm, joint_friction=False, effort_limits=False)
+    start = moving(arm)
+    solver = kdl_space.FreeFloatingSolver(arm)
+    solver.compute(start)
+    m = 1.0 / np.diag(np.linalg.inv(solver.H_star))
+    kp, kd, rate = 400.0, 300.0, 200.0  # stiff_wrist_servo.yaml's servo gains
+    expected = [name for name, mj in zip(arm.joint_names, m) if kd / (rate * mj) > 1.0]
+    assert 0 < len(expected) < arm.nj and max(kd / m) > 2000.0  # the wrist: kd / m in the thousands
+    target = np.zeros(arm.nj)
+    with pytest.warns(RuntimeWarning, match="sampled_gain_unstable") as caught:
+        try:
+            run = sim.run(start, 0.2, 0.05, controller=pd(kp, kd, target), control_rate=rate)
+            warned = run.warnings
+        except kdl_space.ComputeError as e:  # it blows up: the warnings came before
+            warned = e.result.warnings
+    assert [w["element"] for w in warned] == expected
+    assert all(w["kind"] == "sampled_gain_unstable" and "200 Hz" in w["message"] for w in warned)
+    assert sorted(str(w.message).split(": ")[1] for w in caught if "sampled_gain_unstable" in str(w.message)) == sorted(expected)
+    # Fast enough for every joint: quiet, and the probe leaves the motion as it was.
+    fast = 1000.0 * np.ceil(max(kd / m) / 1000.0)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        checked = sim.run(start, 0.02, 0.005, controller=pd(kp, kd, target), control_rate=fast)
+    unchecked = sim.run(start, 0.02, 0.005, controller=pd(kp, kd, target), control_rate=fast, check_gains=False)
+    assert checked.warnings == [] and np.array_equal(checked.q, unchecked.q)

@@ -174,6 +174,13 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   setModesAfter(sc, problem, r, o.hold_servos, sim);
   checkStart(sc, sim, s);
   const SimulationState start = s;
+  // A sampled controller's rate gains against what its hold keeps stable, before it runs.
+  if (o.check_sampled_gains)
+    if (const int grc = sampledGainWarnings(sim, s, o.controller, o.control_rate, r.warnings))
+      throw OperationError(sc.file + ": the controller's gains could not be checked at the start of the motion: " +
+                               strError(grc),
+                           grc, std::make_shared<const OperationResult>(r));
+  if (sim.baseControl().on()) r.base_control_phases.push_back("after");
   int observer_rc = E_NOERROR;
   const Phase phase = sc.impact ? Phase::Post : Phase::Motion;
   const bool spherical = r.joined && r.joined->grasp == GraspJoint::Spherical;
@@ -192,6 +199,11 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, r.record.stiffness))
     throw OperationError(sc.file + ": simulation: " + strError(src), src, std::make_shared<const OperationResult>(r));
+  if (const std::string advice = stiffnessAdvice(r.record); !advice.empty())  // a warning, by the joint's name
+    r.warnings.push_back(Diagnostic{r.model->jointNames()[r.record.stiffness.fastest_joint],
+                                    advice + " (its gains come from simulation.joints, where a pattern such as \"*\" "
+                                             "gives every joint it matches the same gains)",
+                                    "stiff"});
   if (rc == E_CANCELLED) {
     std::ostringstream why;
     why << std::setprecision(6) << sc.file << ": the simulation was cancelled at t = " << s.t << " s of "
@@ -202,6 +214,8 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     std::ostringstream why;
     why << sc.file << ": simulation failed at t = " << s.t << " s of " << r.duration << " s: "
         << simulationFailure(rc ? rc : observer_rc, sc.simulation, r.record, s);
+    for (const Diagnostic& d : r.warnings)  // what was seen before it ran: the likely cause
+      if (d.kind == "sampled_gain_unstable") why << "; " << d.message;
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(r));
   }
   if (!r.joined)
@@ -227,7 +241,11 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
   if (o.motion) checkStepBudget(sc, r.duration, r.output_step);
   r.at_contact = sc.capture;
   SimulationState s;
-  if (sc.approach && o.approach) operation::approach(sc, r.output_step, o.cancelled, r, s);
+  if (sc.approach && o.approach) {
+    if (sc.simulation.base_control.on() && sc.simulation.base_control.in_approach)
+      r.base_control_phases.push_back("approach");
+    operation::approach(sc, r.output_step, o.cancelled, r, s);
+  }
   std::optional<CaptureResult> capture;
   if (sc.impact) capture = inScenario(sc, [&] { return solveCapture(r.at_contact); });
   const CaptureProblem at_contact = r.at_contact;

@@ -1,5 +1,6 @@
 #include "kdl_space/simulation/sampled_control.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -28,6 +29,49 @@ ControlGrid controlGrid(double output_dt, double period) {
   why << "output_dt: " << output_dt << " s and the control period 1 / control_rate = " << period
       << " s are not commensurate (their ratio is no fraction a / b with b <= 1000)";
   throw InputError(why.str());
+}
+
+int sampledGainWarnings(Simulator& sim, const SimulationState& s, const SampledController& controller,
+                        double control_rate, std::vector<Diagnostic>& warnings) {
+  const unsigned int n = sim.model().nj();
+  if (!controller || !(control_rate > 0.0) || !std::isfinite(control_rate)) return E_NOERROR;  // not sampled
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  const double dt = 1.0 / control_rate;
+  SimulationState x = s;
+  Eigen::VectorXd up(n), down(n);
+  const auto torque = [&](Eigen::VectorXd& tau) {
+    tau.setZero();
+    controller(x, tau);
+    if (tau.size() != static_cast<Eigen::Index>(n)) return E_SIZE_MISMATCH;
+    return tau.allFinite() ? E_NOERROR : E_NOT_FINITE;
+  };
+  for (unsigned int j = 0; j < n; ++j) {
+    if (sim.jointControls()[j].mode == JointControl::Mode::Locked) continue;  // braked: its rate is held
+    // A central difference: exact for a controller linear in the rate; delta small beside the rates
+    // a manipulator reaches, large beside the round-off of its torque.
+    const double qdot = s.velocity.qdot(j), delta = 1e-4 * std::max(1.0, std::abs(qdot));
+    x.velocity.qdot(j) = qdot + delta;
+    if (const int rc = torque(up)) return rc;
+    x.velocity.qdot(j) = qdot - delta;
+    if (const int rc = torque(down)) return rc;
+    x.velocity.qdot(j) = qdot;
+    const double kd = -(up(j) - down(j)) / (2.0 * delta);
+    if (!(kd > 0.0)) continue;  // no damping fed back (or positive feedback: not this check's)
+    double m = 0.0;
+    if (const int rc = sim.apparentInertia(s, j, m)) return rc;
+    const double b = kd * dt / m;  // the bound's derivation: sampled_control.hpp
+    if (b <= kSampledGainMargin) continue;
+    const std::string& name = sim.model().jointNames()[j];
+    std::ostringstream why;
+    why.precision(3);
+    why << "the controller sampled at " << control_rate << " Hz feeds back the rate of joint '" << name << "' with kd = "
+        << kd << " N m s/rad (or N s/m) against its apparent inertia " << m << " kg m^2 (or kg): kd dt / m = " << b
+        << (b >= 2.0 ? ", above 2: unstable under a zero-order hold" : ", above 1: it rings at the control rate")
+        << "; sample at " << kd / (m * kSampledGainMargin) << " Hz or more, or lower kd to "
+        << kSampledGainMargin * m * control_rate << " or less";
+    warnings.push_back(Diagnostic{name, why.str(), "sampled_gain_unstable"});
+  }
+  return E_NOERROR;
 }
 
 int runSampled(Simulator& sim, SimulationState& s, double t_end, double output_dt, const SampledController& controller,

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "kdl_space/simulation/sampled_control.hpp"
 #include "test_util.hpp"
@@ -93,6 +94,60 @@ TEST_F(SampledControl, FastHoldApproachesTheContinuousController) {
     previous = error;
   }
   EXPECT_LT(previous, 2e-3);
+}
+
+TEST_F(SampledControl, RateGainBeyondTheHoldsBoundIsWarnedAndDoesDiverge) {
+  // Each joint's rate gain set to b m_j / dt, m_j = 1 / (H*^-1)_jj from the free-floating solver
+  // (the check reads the simulator's dynamics instead): b = 0.5 is stable and quiet, b = 2.5 is
+  // past the zero-order hold's bound kd dt / m < 2 on every joint and diverges.
+  FreeFloatingSolver solver(model);
+  ASSERT_EQ(solver.compute(start.state), 0);
+  const Eigen::VectorXd m = solver.H_star().data.inverse().diagonal().cwiseInverse();
+  const double rate = 100.0, dt = 1.0 / rate;
+  for (double b : {0.5, 2.5}) {
+    const Eigen::VectorXd kd = b * m / dt;
+    int calls = 0;
+    const SampledController damper = [&](const SimulationState& x, Eigen::VectorXd& tau) {
+      ++calls;
+      tau = -kd.cwiseProduct(x.velocity.qdot.data);
+    };
+    SimulationOptions unlimited;
+    unlimited.effort_limits = false;  // a saturated torque would turn the divergence into a bounded ringing
+    Simulator sim(model, unlimited);
+    std::vector<Diagnostic> warnings;
+    ASSERT_EQ(sampledGainWarnings(sim, start, damper, rate, warnings), 0);
+    EXPECT_EQ(calls, 4);  // two a joint
+    SimulationState s = start;
+    double fastest = 0.0;  // the largest joint rate over the run
+    const int rc = runSampled(sim, s, 1.0, 0.01, damper, rate, [&](const SimulationState& x) {
+      if (x.velocity.qdot.data.allFinite()) fastest = std::max(fastest, x.velocity.qdot.data.norm());
+    });
+    if (b < 1.0) {
+      EXPECT_TRUE(warnings.empty()) << warnings.front().message;
+      ASSERT_EQ(rc, 0);
+      EXPECT_LE(fastest, start.velocity.qdot.data.norm());                             // never grew
+      EXPECT_LT(s.velocity.qdot.data.norm(), 0.1 * start.velocity.qdot.data.norm());  // damped out
+    } else {
+      ASSERT_EQ(warnings.size(), 2u);
+      for (unsigned int j = 0; j < 2; ++j) {
+        EXPECT_EQ(warnings[j].kind, "sampled_gain_unstable");
+        EXPECT_EQ(warnings[j].element, model->jointNames()[j]);
+        EXPECT_NE(warnings[j].message.find("above 2: unstable"), std::string::npos) << warnings[j].message;
+      }
+      // |1 - b| = 1.5 a period: a hundredfold within some 12 periods (then the arm's nonlinear
+      // dynamics at such rates take over, or the run fails)
+      EXPECT_TRUE(rc != 0 || fastest > 100.0 * start.velocity.qdot.data.norm()) << "rc " << rc << ", max |qdot| " << fastest;
+    }
+  }
+  // A continuous controller (no rate) has no hold: nothing to check, not even a call.
+  int calls = 0;
+  std::vector<Diagnostic> none;
+  Simulator sim(model);
+  ASSERT_EQ(sampledGainWarnings(sim, start, [&](const SimulationState&, Eigen::VectorXd& tau) { ++calls, tau.setZero(); },
+                                0.0, none),
+            0);
+  EXPECT_EQ(calls, 0);
+  EXPECT_TRUE(none.empty());
 }
 
 TEST_F(SampledControl, WithoutAControllerTheRateIsNotUsedAndTheRunIsPlain) {

@@ -37,9 +37,11 @@ struct OperationOptions {
   std::function<void(const OperationResult& so_far, const MotionSample& sample)> observer;
   bool keep_samples = true;  ///< keep the samples in the result (false: the observer and the record only)
   /// A controller of the motion after the capture (its torques add to the scenario's joint modes),
-  /// called at control_rate [Hz] with a zero-order hold, or at every evaluation when 0.
+  /// called at control_rate [Hz] with a zero-order hold, or at every evaluation when 0. A sampled
+  /// one is probed first at the start of the motion (sampledGainWarnings: 2 nj extra calls).
   SampledController controller;
   double control_rate = 0.0;
+  bool check_sampled_gains = true;  ///< false: no probe (a controller whose calls change its state)
   /// Polled before every step of every phase (Simulator::setCancelPoll): once it returns true the
   /// run stops with an OperationError of code E_CANCELLED (at t = how far it got); it may throw
   /// instead (the exception propagates). Empty: never cancelled.
@@ -84,6 +86,13 @@ struct KDL_SPACE_EXPORT OperationResult {
   SimulationState end;            ///< the state at the end of the motion
   std::optional<TargetMotion> target_motion;  ///< a free-floating target that separated
   double min_chart_margin = 1.0;  ///< a ball joint's least distance from its chart's singularity
+  /// What the motion after the capture found that a user should see (kind, element: the joint):
+  /// `sampled_gain_unstable` (sampledGainWarnings: options.controller's rate feedback beyond what
+  /// its zero-order hold keeps stable) and `stiff` (a servo whose stiffness held an explicit
+  /// integrator's steps far below the output step: stiffnessAdvice).
+  std::vector<Diagnostic> warnings;
+  /// The phases the scenario's base control acted in, of those that ran: "approach", "after".
+  std::vector<std::string> base_control_phases;
 };
 
 /// \brief A failed operation: the scenario's terms (what grew, when, what to try), the code of the

@@ -68,6 +68,12 @@ struct BaseControl {
   };
   Attitude attitude;
   Position position;
+  /// The phases of a capture operation in which it acts (a scenario's `base_control.phases`):
+  /// the approach (`in_approach`), and the motion after the capture, or a plain motion without
+  /// one (`after_capture`). By default after the capture only: an approach opts in. A Simulator
+  /// alone does not read them: it applies the control it is given whenever that is on().
+  bool in_approach = false;
+  bool after_capture = true;
   bool on() const { return attitude.on || position.on; }
 };
 

@@ -57,8 +57,19 @@ void gains(const Field& f, const char* limit_key, double& kp, double& kd, Vector
 }
 
 BaseControl baseControl(const Field& f) {
-  f.onlyKeys({"attitude", "position"});
+  f.onlyKeys({"attitude", "position", "phases"});
   BaseControl c;
+  if (f.has("phases")) {  // where it acts: said, not implied (the approach only when asked)
+    const Field ph = f.at("phases");
+    c.after_capture = false;
+    for (const Field& name : ph.items("phases [approach, after]")) {
+      if (name.text() == "approach") c.in_approach = true;
+      else if (name.text() == "after") c.after_capture = true;
+      else name.fail(echo(name.text()) + " is not one of approach, after");
+    }
+    if (!c.in_approach && !c.after_capture)
+      ph.fail("is empty: give approach, after or both (the default is [after]), or leave out base_control");
+  }
   if (f.has("attitude")) {
     const Field a = f.at("attitude");
     a.onlyKeys({"kp", "kd", "set_point", "torque_limit"});

@@ -33,7 +33,8 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
   if (!approach)
     for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(joint), control);
   for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(joint), mode);
-  sim->setBaseControl(spec.base_control);
+  // The base control acts in the phases the scenario names (base_control.phases; default: after).
+  if (approach ? spec.base_control.in_approach : spec.base_control.after_capture) sim->setBaseControl(spec.base_control);
   for (ScheduledWrench w : spec.wrenches) {
     w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
     sim->addWrench(w);

@@ -86,7 +86,8 @@ KDL_SPACE_EXPORT StepEstimate fewestSteps(const SimulationSpec& spec, double dur
 /// captured payload, or a joined system: the robot's joints are found by name). The robot's mode
 /// holds through the motion (a grounded base stays grounded, braked joints stay braked) unless the
 /// simulation section changes it. For an approach (`approach`) the joints are left free for its
-/// velocity servo (the section's joint controls act after the capture).
+/// velocity servo (the section's joint controls act after the capture). The base control is set
+/// in the phases its `phases` name (BaseControl::in_approach, after_capture).
 /// \throws ModelError as the Simulator's set-up calls.
 KDL_SPACE_EXPORT std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                                           bool approach);
