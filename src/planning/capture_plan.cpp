@@ -135,7 +135,7 @@ void polish(Search& s, const std::vector<double>& start, unsigned int N, unsigne
 CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
   PlanEvaluator evaluator(scenario, options);  // or InputError: the options, nothing to plan
   const PlanOptions& o = evaluator.options();
-  Search s{evaluator, {}, {}};
+  Search s{evaluator, {}, {}, 0, false, {}, {}, false};
   const PlanRange ranges[3] = {*o.self_motion, o.wrist_roll, o.timing};
   for (int k = 0; k < 3; ++k) {
     if (ranges[k].searched()) {
