@@ -40,7 +40,7 @@ PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& option
       throw InputError("objective: the weight of " + name + " must be finite and > 0, got " + detail::number(weight));
   }
   if (!scenario.impact)
-    throw InputError("plan: " + scenario.file + " has no target and no law: there is no capture to plan");
+    throw InputError("plan: the scenario has no target and no law: there is no capture to plan");
   const FloatingSystem& robot = scenario.capture.robot;
   const auto* rigid = std::get_if<RigidTarget>(&scenario.capture.target);
   // A redundant arm: its self-motion exists at the scenario's state (SelfMotion refuses otherwise).
@@ -93,8 +93,9 @@ bool PlanEvaluator::handPlaced(const PlanPoint& x, std::string& why) {
     }
   }
   if (x.wrist_roll != 0.0 || x.timing != 0.0) {
-    IkOptions o;
+    IkOptions o;  // the scenario's branch: from its state, no restarts elsewhere (capture_plan.hpp)
     o.preferred = robot.state.q;
+    o.restarts = 0;
     try {
       placed_.q = solveInverseKinematics(*robot.model, robot.state, robot.contact, grasp * KDL::Frame(KDL::Rotation::RotZ(x.wrist_roll)), o).q;
     } catch (const InputError& e) {  // IkUnreachable: out of reach within the limits

@@ -17,27 +17,27 @@ namespace {
 const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml";
 const std::string kArm6 = dataDir() + "/scenarios/arm6_reach_capture.json";
 
-/// scenarios/tumbling_box_capture.yaml's capture (robot, target, law; no approach, no motion)
-/// with the joints at `q`, as a file.
+/// scenarios/tumbling_box_capture.yaml's capture (its robot, target and law; the motion section
+/// dropped) with the joints at `q`, as a file: its `q:` line replaced, its URDF path made absolute.
 std::string captureScenario(const nlohmann::json& q_by_name) {
   std::ostringstream q;
   q.precision(17);
   for (auto it = q_by_name.begin(); it != q_by_name.end(); ++it)
     q << (it == q_by_name.begin() ? "" : ", ") << it.key() << ": " << it.value().get<double>();
   const std::string path = ::testing::TempDir() + "kdl_space_planned_" + std::to_string(getpid()) + ".yaml";
+  std::ifstream in(kScenario);
   std::ofstream f(path);
-  f << "robot:\n"
-    << "  urdf: " << urdfDir() << "/space_arm7.urdf\n"
-    << "  contact: {link: end_effector, offset: [0, 0, 0.05]}\n"
-    << "  base: {position: [0, 0, 0], rpy: [0, 0, 0], twist: [0.001, 0, 0, 0, 0, 0.001]}\n"
-    << "  q: {" << q.str() << "}\n"
-    << "target:\n"
-    << "  mass: 50\n"
-    << "  inertia: [[2.1, 0, 0], [0, 2.6, 0], [0, 0, 3.0]]\n"
-    << "  pose: {position: [-0.92, -2.03, 0.62], rpy: [0.3, -0.2, 0.5]}\n"
-    << "  twist: [0.003, -0.002, 0.001, 0.02, 0.03, -0.02]\n"
-    << "law:\n"
-    << "  type: capture\n";
+  int replaced = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("simulation:", 0) == 0) break;
+    if (line.rfind("  q: {", 0) == 0) {
+      line = "  q: {" + q.str() + "}";
+      ++replaced;
+    }
+    if (line.rfind("  urdf: ../urdf/", 0) == 0) line = "  urdf: " + urdfDir() + "/" + line.substr(16);
+    f << line << "\n";
+  }
+  EXPECT_EQ(replaced, 1);
   return path;
 }
 

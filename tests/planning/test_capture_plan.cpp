@@ -47,6 +47,7 @@ bool configure(const Scenario& sc, double s, double psi, double t, Configuration
   if (psi != 0.0 || t != 0.0) {
     IkOptions o;
     o.preferred = robot.state.q;
+    o.restarts = 0;
     try {
       moved.capture.robot.state.q = solveInverseKinematics(*robot.model, robot.state, robot.contact, c.goal, o).q;
     } catch (const InputError&) {

@@ -9,9 +9,11 @@
 //              G(t) = T(t) T(0)^-1 H0, H0 the contact frame at the scenario's state;
 //   wrist_roll the hand rotated by psi [rad] about the contact frame's own z axis (the approach
 //              axis of the shipped tools, along which their contact offset points): the goal
-//              G(t) Rot_z(psi); the arm's joints then come from solveInverseKinematics (seed and
-//              preferred posture: the scenario's state), unless the goal is H0 itself (t = 0 and
-//              psi = 0): the scenario's q, as written;
+//              G(t) Rot_z(psi); the arm's joints then come from solveInverseKinematics with the
+//              scenario's state as seed and preferred posture and no restarts (IkOptions
+//              restarts = 0: the branch of the scenario's configuration, not another one found
+//              from elsewhere), unless the goal is H0 itself (t = 0 and psi = 0): the scenario's
+//              q, as written;
 //   self_motion s [rad] along a redundant arm's self-motion from there (selfMotionJoints of the
 //              scenario with that q): the hand's pose held. Absent for a non-redundant arm.
 // The capture of each configuration is the scenario's (solveCapture: the same base pose and
