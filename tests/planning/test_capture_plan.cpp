@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/impact/capture.hpp"
@@ -38,8 +40,11 @@ bool configure(const Scenario& sc, double s, double psi, double t, Configuration
   c.target = target0;
   KDL::Frame grasp = H0;
   if (t > 0.0) {
-    FreeRigidMotion tumble(target0);
-    EXPECT_EQ(tumble.at(t, c.target), 0);
+    // One motion per target: at(t) is a function of t alone (and extends its grid as asked).
+    static std::map<std::string, std::unique_ptr<FreeRigidMotion>> tumbles;  // by scenario file
+    std::unique_ptr<FreeRigidMotion>& tumble = tumbles[sc.file];
+    if (!tumble) tumble = std::make_unique<FreeRigidMotion>(target0);
+    EXPECT_EQ(tumble->at(t, c.target), 0);
     grasp = c.target.pose * target0.pose.Inverse() * H0;
   }
   c.goal = grasp * KDL::Frame(KDL::Rotation::RotZ(psi));
@@ -136,12 +141,16 @@ void expectReproduced(const Scenario& sc, const CapturePlan& plan) {
 
 TEST(CapturePlan, DefaultArmNoWorseThanA41x41GridOfSelfMotionAndWristRoll) {
   const Scenario sc = loadScenario(kDefault);
+  // A box whose optimum lies inside it (in the default box it is a corner, which a scan holds).
+  PlanOptions o;
+  o.self_motion = PlanRange{-2.0, 2.0};
+  o.wrist_roll = PlanRange{-2 * kHalfPi, 2 * kHalfPi};
   const auto start = std::chrono::steady_clock::now();
-  const CapturePlan plan = planCapture(sc);
+  const CapturePlan plan = planCapture(sc, o);
   const double planning = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(plan.optimum.feasible);
   ASSERT_EQ(plan.searched, (std::vector<std::string>{"self_motion", "wrist_roll"}));
-  const GridBest best = grid(sc, PlanRange{-1.0, 1.0}, PlanRange{-kHalfPi, kHalfPi}, [&](double s, double psi, Configuration& c) {
+  const GridBest best = grid(sc, *o.self_motion, o.wrist_roll, [&](double s, double psi, Configuration& c) {
     return configure(sc, s, psi, 0.0, c);
   });
   ASSERT_GT(best.feasible, 100);
