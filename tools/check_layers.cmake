@@ -1,7 +1,8 @@
 # Checks that the library's include graph goes one way, down the layers of docs/ARCHITECTURE.md.
 # A layer is a folder, the same under include/kdl_space/ and src/:
 #   0 spatial (and src/detail/)   1 multibody   2 algorithm   3 impact   4 simulation
-#   5 parsers (urdf/, scenario/)  6 operation   7 study       (tools/, python/: anything)
+#   5 parsers (urdf/, scenario/)  6 operation   7 study       8 planning
+#   (tools/, python/: anything)
 # A file of the library may include only files of its own folder's layer or lower ones, named by
 # their folder ("kdl_space/impact/capture.hpp", "multibody/model_rules.hpp", "detail/lanes.hpp");
 # the flat paths include/kdl_space/<name>.hpp are forwarding headers for downstream code (one
@@ -10,8 +11,8 @@
 # Run: cmake -DSOURCE_DIR=<repo> -P tools/check_layers.cmake (ctest: layers).
 cmake_minimum_required(VERSION 3.16)
 
-set(kdl_space_layers spatial detail multibody algorithm impact simulation parsers operation study)
-set(kdl_space_ranks 0 0 1 2 3 4 5 6 7)
+set(kdl_space_layers spatial detail multibody algorithm impact simulation parsers operation study planning)
+set(kdl_space_ranks 0 0 1 2 3 4 5 6 7 8)
 
 # The rank of a folder name (the first component of a path below include/kdl_space/ or src/).
 function(rank_of folder out)

@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "ik.hpp"
 #include "inspect.hpp"
+#include "plan.hpp"
 #include "simulate.hpp"
 #include "study.hpp"
 
@@ -27,6 +28,8 @@ int main(int argc, char** argv) {
   CLI::App* study = addStudy(app, study_options);
   IkCliOptions ik_options;
   CLI::App* ik = addIk(app, ik_options);
+  PlanCliOptions plan_options;
+  CLI::App* plan = addPlan(app, plan_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -52,6 +55,7 @@ int main(int argc, char** argv) {
     if (simulate->parsed()) runSimulate(simulate_options, std::cout);
     if (study->parsed()) runStudyCommand(study_options, std::cout);
     if (ik->parsed()) runIk(ik_options, std::cout);
+    if (plan->parsed()) runPlan(plan_options, std::cout);
     const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
     if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
       std::cerr << "kdl_space: cannot write the output to stdout\n";

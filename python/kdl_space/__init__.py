@@ -26,6 +26,7 @@ expected).
 
 from ._kdl_space import (  # noqa: F401  (re-exported)
     CaptureProblem,
+    CapturePlan,
     CaptureResult,
     ComputeError,
     Contact,
@@ -62,6 +63,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     load_scenario,
     load_study,
     load_urdf,
+    plan_capture,
     run_operation,
     self_motion,
     solve_capture,
@@ -85,13 +87,13 @@ from .study import StudyResult, study  # noqa: F401  (the engines: threads, Dask
 ik = inverse_kinematics  # the short name (as the command `kdl_space ik`)
 
 __all__ = [
-    "CaptureProblem", "CaptureResult", "ComputeError", "Contact", "DenseForwardDynamicsSolver",
+    "CaptureProblem", "CapturePlan", "CaptureResult", "ComputeError", "Contact", "DenseForwardDynamicsSolver",
     "Diagnostic", "ElementType", "Error", "Finding", "ForwardDynamicsSolver", "FreeFloatingSolver",
     "ImpactLaw", "Impulse", "InputError", "Integrator", "JointRecord", "Model", "ModelError",
     "RecursiveExIITSolver", "RigidTarget", "Scenario", "Severity", "SideResult", "SimulationResult",
     "SimulationStats", "Simulator", "State", "Stiffness", "Study", "StudyResult", "attach_target",
     "check_urdf", "codes", "ik", "inverse_kinematics",
-    "load_scenario", "load_study", "load_urdf", "run_operation", "self_motion", "solve_capture", "solve_impact",
+    "load_scenario", "load_study", "load_urdf", "plan_capture", "run_operation", "self_motion", "solve_capture", "solve_impact",
     "str_error", "study", "virtual_mass",
     "E_NOERROR", "E_SIZE_MISMATCH", "E_NOT_COMPUTED", "E_NOT_FINITE", "E_NOT_POSITIVE_DEFINITE",
     "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW", "E_CANCELLED",

@@ -215,6 +215,29 @@ def inverse_kinematics(scenario: Scenario, goal: Union[ArrayLike, Tuple[ArrayLik
                        position_tolerance: float = 1e-10, orientation_tolerance: float = 1e-10,
                        restarts: int = 16, max_iterations: int = 500) -> dict[str, Any]: ...
 ik = inverse_kinematics
+
+class CapturePlan:
+    scenario: str
+    joint_names: list[str]
+    q: Array
+    q_by_name: dict[str, float]
+    qdot_after: Array
+    parameters: dict[str, float]
+    searched: list[str]
+    objective: float
+    optimum: dict[str, Any]
+    nominal_objective: float
+    nominal: dict[str, Any]
+    nominal_q_by_name: dict[str, float]
+    evaluations: int
+@overload
+def plan_capture(scenario: Scenario, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
+                 self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
+                 timing: Optional[Tuple[float, float]] = None, scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
+@overload
+def plan_capture(scenario: str, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
+                 self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
+                 timing: Optional[Tuple[float, float]] = None, scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
 @overload
 def attach_target(scenario_or_problem: Scenario, result: CaptureResult) -> Model: ...
 @overload

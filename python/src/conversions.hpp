@@ -102,5 +102,6 @@ void bindStudy(py::module_& m);
 void bindOperation(py::module_& m);
 void bindPoses(py::module_& m);
 void bindInverseKinematics(py::module_& m);
+void bindPlanning(py::module_& m);
 
 }  // namespace kdl_space::python

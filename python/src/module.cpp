@@ -19,4 +19,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindStudy(m);
   bindOperation(m);
   bindInverseKinematics(m);
+  bindPlanning(m);
 }

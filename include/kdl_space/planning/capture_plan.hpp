@@ -1,0 +1,104 @@
+// Capture planning: of the arm configurations that grasp the target at the scenario's grasp, the
+// one whose capture disturbs the servicer least (reaction-null-space planning after Yoshida and
+// Nenchev, by search). What `kdl_space plan` and kdl_space.plan_capture() run.
+//
+// The configurations are a chart of up to three parameters, each a documented function of the
+// public API, so that a caller can rebuild any of them (the tests do):
+//   timing t   the capture t [s] later: the rigid target moved on along its torque-free tumble
+//              (FreeRigidMotion::at), the grasp frame riding with it:
+//              G(t) = T(t) T(0)^-1 H0, H0 the contact frame at the scenario's state;
+//   wrist_roll the hand rotated by psi [rad] about the contact frame's own z axis (the approach
+//              axis of the shipped tools, along which their contact offset points): the goal
+//              G(t) Rot_z(psi); the arm's joints then come from solveInverseKinematics with the
+//              scenario's state as seed and preferred posture and no restarts (IkOptions
+//              restarts = 0: the branch of the scenario's configuration, not another one found
+//              from elsewhere), unless the goal is H0 itself (t = 0 and psi = 0): the scenario's
+//              q, as written;
+//   self_motion s [rad] along a redundant arm's self-motion from there (selfMotionJoints of the
+//              scenario with that q): the hand's pose held. Absent for a non-redundant arm.
+// The capture of each configuration is the scenario's (solveCapture: the same base pose and
+// twist, joint rates, target and law; the target at its pose and twist at t).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+
+namespace kdl_space {
+
+/// One planned parameter's range; lower == upper fixes it there (not searched).
+struct PlanRange {
+  double lower = 0.0, upper = 0.0;
+  bool searched() const { return upper > lower; }
+};
+
+/// What planCapture searches and minimises.
+struct PlanOptions {
+  /// The objective: the weighted sum of the named terms (each weight > 0):
+  ///   "base_rate"        |w| of the base after the capture [rad/s]
+  ///   "impulse"          |f|, the linear part of the impulse on the robot [N s]
+  ///   "joint_rate_jump"  max_j |qdot_j after - qdot_j before| [rad/s or m/s]
+  std::vector<std::pair<std::string, double>> weights{{"base_rate", 1.0}};
+  /// The self-motion's range [rad of joint-space arc length]. Unset: [-1, 1] for an arm with a
+  /// one-parameter self-motion (7 joints on the path to the contact), fixed at 0 otherwise.
+  std::optional<PlanRange> self_motion;
+  PlanRange wrist_roll{-1.5707963267948966, 1.5707963267948966};  ///< [rad]
+  PlanRange timing{0.0, 0.0};  ///< [s], >= 0; a rigid target only
+  /// Points per searched parameter of the first scan (a grid over the box), >= 2.
+  unsigned int scan = 21;
+  /// Local polishes (NLopt LN_BOBYQA, or LN_COBYLA in one dimension) from the scan's best local
+  /// minima, at most this many.
+  unsigned int polish_starts = 5;
+  unsigned int polish_evaluations = 300;  ///< per polish
+  /// Polled between configurations (may be empty): true stops the search; the plan then has
+  /// `cancelled` set and holds the best found so far (if any).
+  std::function<bool()> cancelled;
+};
+
+/// The terms at one configuration.
+struct PlanTerms {
+  double base_rate = 0.0, impulse = 0.0, joint_rate_jump = 0.0;
+  double objective = 0.0;  ///< the weighted sum
+  /// Inside every joint's position limits and, after the capture, its URDF velocity limit.
+  bool feasible = false;
+  /// How far outside: the sum over the joints of the position and rate excesses (0: feasible).
+  double violation = 0.0;
+  std::string infeasible;  ///< why not (the first joint and limit), or what could not be computed
+};
+
+/// A planned capture.
+struct CapturePlan {
+  std::vector<std::string> joint_names;  ///< model order
+  std::vector<double> q;                 ///< the optimum's joint angles [rad or m]
+  std::vector<double> qdot_after;        ///< the joint rates after its capture
+  /// The parameters, in the order self_motion, wrist_roll, timing (present ones only), their values.
+  std::vector<std::pair<std::string, double>> parameters;
+  std::vector<std::string> searched;     ///< the names of those that were searched
+  PlanTerms optimum;                     ///< at the optimum (always feasible)
+  PlanTerms nominal;                     ///< the scenario as written (may be infeasible)
+  std::vector<double> nominal_q;
+  unsigned int evaluations = 0;          ///< configurations computed, scan and polishes
+  bool cancelled = false;                ///< PlanOptions::cancelled stopped the search
+};
+
+/// \brief The configuration that minimises the objective over the box of `options` under the
+/// joints' position and rate limits (the chart above). Deterministic: a scan on a fixed grid,
+/// then NLopt local polishes from its best local minima. The limits are hard constraints: a
+/// configuration outside them (or one that cannot be reached or computed) scores a penalty
+/// (1e6 + the violation) the optimiser sees, and the reported optimum is the best feasible
+/// configuration evaluated.
+/// \throws InputError "plan: ..." for a scenario with nothing to plan (no rigid-target capture,
+/// no searched parameter), an unknown term or a weight <= 0 ("objective: ..."), a range that
+/// cannot be used ("self_motion: ...", "wrist_roll: ...", "timing: ..."), or no feasible
+/// configuration in the box.
+KDL_SPACE_EXPORT CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options = {});
+
+/// The names of the objective's terms, in the order of the documentation.
+KDL_SPACE_EXPORT const std::vector<std::string>& planObjectiveTerms();
+
+}  // namespace kdl_space

@@ -1,0 +1,123 @@
+// kdl_space.plan_capture: the library's planCapture on a scenario (a path or a Scenario), a
+// CapturePlan object with the fields of `kdl_space plan --json`.
+#include <csignal>
+
+#include "capture_types.hpp"
+#include "conversions.hpp"
+#include "kdl_space/planning/capture_plan.hpp"
+
+namespace kdl_space::python {
+namespace {
+
+struct PyPlan {
+  CapturePlan plan;
+  std::string scenario;
+};
+
+py::dict termsDict(const PlanTerms& t) {
+  py::dict d;
+  d["objective"] = t.objective;
+  d["base_rate"] = t.base_rate;
+  d["impulse"] = t.impulse;
+  d["joint_rate_jump"] = t.joint_rate_jump;
+  d["feasible"] = t.feasible;
+  d["violation"] = t.violation;
+  if (!t.feasible) d["infeasible"] = t.infeasible;
+  return d;
+}
+
+std::optional<PlanRange> rangeOf(py::handle r, const char* name) {
+  if (r.is_none()) return std::nullopt;
+  const auto ab = r.cast<std::pair<double, double>>();
+  if (ab.first > ab.second) throw py::value_error(std::string(name) + ": the range's lower end must not exceed its upper end");
+  return PlanRange{ab.first, ab.second};
+}
+
+PyPlan plan(const Scenario& sc, const std::string& objective, py::handle weights, py::handle self_motion,
+            py::handle wrist_roll, py::handle timing, unsigned int scan, unsigned int polish_starts) {
+  PlanOptions o;
+  if (!weights.is_none()) {
+    o.weights.clear();
+    for (const auto& [key, value] : weights.cast<py::dict>()) o.weights.emplace_back(py::str(key), value.cast<double>());
+  } else {
+    o.weights = {{objective, 1.0}};
+  }
+  o.self_motion = rangeOf(self_motion, "self_motion");
+  if (const auto r = rangeOf(wrist_roll, "wrist_roll")) o.wrist_roll = *r;
+  if (const auto r = rangeOf(timing, "timing")) o.timing = *r;
+  o.scan = scan;
+  o.polish_starts = polish_starts;
+  PyPlan result{{}, sc.file};
+  {
+    py::gil_scoped_release nogil;
+    result.plan = planCapture(sc, o);  // InputError: the options, nothing to plan
+  }
+  return result;
+}
+
+template <typename T>
+py::dict byName(const std::vector<std::string>& names, const std::vector<T>& values) {
+  py::dict d;
+  for (std::size_t j = 0; j < names.size(); ++j) d[py::str(names[j])] = values[j];
+  return d;
+}
+
+}  // namespace
+
+void bindPlanning(py::module_& m) {
+  py::class_<PyPlan>(m, "CapturePlan", "A planned capture (plan_capture): the fields of `kdl_space plan --json`.")
+      .def_property_readonly("scenario", [](const PyPlan& p) { return p.scenario; }, "The scenario's path.")
+      .def_property_readonly("joint_names", [](const PyPlan& p) { return p.plan.joint_names; }, "Model order.")
+      .def_property_readonly("q", [](const PyPlan& p) { return toNumpyVec(Eigen::Map<const Eigen::VectorXd>(p.plan.q.data(), static_cast<Eigen::Index>(p.plan.q.size()))); },
+                             "The optimum's joint angles (nj,) [rad or m].")
+      .def_property_readonly("q_by_name", [](const PyPlan& p) { return byName(p.plan.joint_names, p.plan.q); }, "Name -> angle.")
+      .def_property_readonly("qdot_after", [](const PyPlan& p) { return toNumpyVec(Eigen::Map<const Eigen::VectorXd>(p.plan.qdot_after.data(), static_cast<Eigen::Index>(p.plan.qdot_after.size()))); },
+                             "The joint rates after its capture (nj,).")
+      .def_property_readonly("parameters", [](const PyPlan& p) {
+        py::dict d;
+        for (const auto& [name, value] : p.plan.parameters) d[py::str(name)] = value;
+        return d;
+      }, "self_motion [rad], wrist_roll [rad], timing [s] at the optimum (those that apply).")
+      .def_property_readonly("searched", [](const PyPlan& p) { return p.plan.searched; }, "The parameters searched.")
+      .def_property_readonly("objective", [](const PyPlan& p) { return p.plan.optimum.objective; }, "At the optimum.")
+      .def_property_readonly("optimum", [](const PyPlan& p) { return termsDict(p.plan.optimum); },
+                             "objective, base_rate, impulse, joint_rate_jump, feasible, violation at the optimum.")
+      .def_property_readonly("nominal_objective", [](const PyPlan& p) { return p.plan.nominal.objective; },
+                             "At the scenario as written.")
+      .def_property_readonly("nominal", [](const PyPlan& p) { return termsDict(p.plan.nominal); }, "The nominal's terms.")
+      .def_property_readonly("nominal_q_by_name", [](const PyPlan& p) { return byName(p.plan.joint_names, p.plan.nominal_q); },
+                             "The scenario's joint angles.")
+      .def_property_readonly("evaluations", [](const PyPlan& p) { return p.plan.evaluations; }, "Captures computed.")
+      .def("__repr__", [](const PyPlan& p) {
+        return "<kdl_space.CapturePlan objective " + std::to_string(p.plan.optimum.objective) + " (nominal " +
+               std::to_string(p.plan.nominal.objective) + ")>";
+      });
+  const char* doc =
+      "Capture planning (as `kdl_space plan`): over a redundant arm's self-motion, the wrist roll about the contact "
+      "frame's z and optionally the capture instant, the configuration whose capture minimises `objective` "
+      "(base_rate, impulse or joint_rate_jump) or the weighted sum `weights` ({name: weight}), inside the joints' "
+      "position and velocity limits. Ranges are (lower, upper) pairs; None: the default (self_motion (-1, 1) for a "
+      "redundant arm, wrist_roll (-pi/2, pi/2), timing (0, 0)); (a, a) fixes one. Returns a CapturePlan; InputError "
+      "for nothing to plan, an unknown term or a bad weight.";
+  m.def(
+      "plan_capture",
+      [=](const PyScenario& s, const std::string& objective, py::object weights, py::object self_motion, py::object wrist_roll,
+          py::object timing, unsigned int scan, unsigned int polish_starts) {
+        return plan(s.scenario, objective, weights, self_motion, wrist_roll, timing, scan, polish_starts);
+      },
+      py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
+      py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),
+      py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
+  m.def(
+      "plan_capture",
+      [=](const std::string& path, const std::string& objective, py::object weights, py::object self_motion,
+          py::object wrist_roll, py::object timing, unsigned int scan, unsigned int polish_starts) {
+        const Scenario sc = loadScenario(path);
+        return plan(sc, objective, weights, self_motion, wrist_roll, timing, scan, polish_starts);
+      },
+      py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
+      py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),
+      py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
+}
+
+}  // namespace kdl_space::python

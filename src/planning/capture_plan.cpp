@@ -1,0 +1,176 @@
+// planCapture: a scan of the searched parameters' box on a fixed grid, then NLopt local polishes
+// (derivative-free: the objective comes through inverse kinematics and a capture) from the scan's
+// best local minima. Everything is deterministic: the grid, the starts, the algorithms (BOBYQA and
+// COBYLA draw no random numbers).
+#include "kdl_space/planning/capture_plan.hpp"
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "planning/plan_evaluator.hpp"
+
+namespace kdl_space {
+namespace {
+
+/// The searched parameters: their ranges, in the order self_motion, wrist_roll, timing.
+struct Box {
+  std::vector<int> which;  ///< 0 self_motion, 1 wrist_roll, 2 timing
+  std::vector<PlanRange> range;
+};
+
+/// The search: the chart's evaluator, the box, and the best feasible configuration seen.
+struct Search {
+  PlanEvaluator& evaluator;
+  Box box;
+  PlanPoint fixed;  ///< the values of the parameters not searched
+  unsigned int evaluations = 0;
+  bool found = false;
+  PlanPoint best;
+  PlanTerms best_terms;
+  bool cancelled = false;
+
+  bool stopped() {
+    if (!cancelled && evaluator.options().cancelled) cancelled = evaluator.options().cancelled();
+    return cancelled;
+  }
+
+  PlanPoint point(const std::vector<double>& x) const {
+    PlanPoint p = fixed;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      const double v = std::clamp(x[k], box.range[k].lower, box.range[k].upper);
+      (box.which[k] == 0 ? p.self_motion : box.which[k] == 1 ? p.wrist_roll : p.timing) = v;
+    }
+    return p;
+  }
+  double score(const std::vector<double>& x) {
+    if (stopped()) return PlanEvaluator::score(PlanTerms{});
+    const PlanPoint p = point(x);
+    const PlanTerms t = evaluator.evaluate(p);
+    ++evaluations;
+    if (t.feasible && (!found || t.objective < best_terms.objective)) {
+      found = true;
+      best = p;
+      best_terms = t;
+    }
+    return PlanEvaluator::score(t);
+  }
+};
+
+double nloptScore(const std::vector<double>& x, std::vector<double>& /*grad*/, void* data) {
+  return static_cast<Search*>(data)->score(x);
+}
+
+/// The scan: N points per searched parameter, the self-motion varying fastest (the inverse
+/// kinematics of a (wrist_roll, timing) pair is computed once for its row). Returns the scores.
+std::vector<double> scan(Search& s, unsigned int N, std::vector<std::vector<double>>& points) {
+  const std::size_t d = s.box.which.size();
+  std::size_t total = 1;
+  for (std::size_t k = 0; k < d; ++k) total *= N;
+  std::vector<double> scores(total);
+  points.assign(total, std::vector<double>(d));
+  for (std::size_t i = 0; i < total; ++i) {
+    std::size_t rest = i;
+    for (std::size_t k = 0; k < d; ++k) {
+      const std::size_t digit = rest % N;
+      rest /= N;
+      const PlanRange& r = s.box.range[k];
+      points[i][k] = digit + 1 == N ? r.upper : r.lower + (r.upper - r.lower) * static_cast<double>(digit) / (N - 1);
+    }
+    scores[i] = s.score(points[i]);
+  }
+  return scores;
+}
+
+/// The scan's local minima (no axis neighbour scores lower), best first, ties by index.
+std::vector<std::size_t> localMinima(const std::vector<double>& scores, unsigned int N, std::size_t d) {
+  std::vector<std::size_t> minima;
+  for (std::size_t i = 0; i < scores.size(); ++i) {
+    bool lowest = scores[i] < 1e6;  // a feasible point (the penalties start at 1e6)
+    std::size_t stride = 1;
+    for (std::size_t k = 0; k < d && lowest; ++k, stride *= N) {
+      const std::size_t digit = (i / stride) % N;
+      if (digit > 0 && scores[i - stride] < scores[i]) lowest = false;
+      if (digit + 1 < N && scores[i + stride] < scores[i]) lowest = false;
+    }
+    if (lowest) minima.push_back(i);
+  }
+  std::stable_sort(minima.begin(), minima.end(), [&](std::size_t a, std::size_t b) { return scores[a] < scores[b]; });
+  return minima;
+}
+
+void polish(Search& s, const std::vector<double>& start, unsigned int N, unsigned int evaluations) {
+  const std::size_t d = start.size();
+  nlopt::opt opt(d == 1 ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, static_cast<unsigned>(d));
+  std::vector<double> lower(d), upper(d), step(d), tol(d);
+  for (std::size_t k = 0; k < d; ++k) {
+    const PlanRange& r = s.box.range[k];
+    lower[k] = r.lower;
+    upper[k] = r.upper;
+    step[k] = (r.upper - r.lower) / (N - 1);  // one scan cell: the basin the start stands for
+    tol[k] = 1e-9 * (r.upper - r.lower);
+  }
+  opt.set_lower_bounds(lower);
+  opt.set_upper_bounds(upper);
+  opt.set_initial_step(step);
+  opt.set_xtol_abs(tol);
+  opt.set_ftol_rel(1e-12);
+  opt.set_maxeval(static_cast<int>(evaluations));
+  opt.set_min_objective(nloptScore, &s);
+  if (s.cancelled) return;
+  std::vector<double> x = start;
+  double f = 0.0;
+  try {
+    opt.optimize(x, f);
+    if (s.cancelled) return;
+  } catch (const std::exception&) {
+    // NLopt's roundoff_limited or forced stops: the best point seen is kept by the search anyway
+  }
+}
+
+}  // namespace
+
+CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
+  PlanEvaluator evaluator(scenario, options);  // or InputError: the options, nothing to plan
+  const PlanOptions& o = evaluator.options();
+  Search s{evaluator, {}, {}, 0, false, {}, {}, false};
+  const PlanRange ranges[3] = {*o.self_motion, o.wrist_roll, o.timing};
+  for (int k = 0; k < 3; ++k) {
+    if (ranges[k].searched()) {
+      s.box.which.push_back(k);
+      s.box.range.push_back(ranges[k]);
+    }
+  }
+  s.fixed = PlanPoint{ranges[0].lower, ranges[1].lower, ranges[2].lower};
+  std::vector<std::vector<double>> points;
+  const std::vector<double> scores = scan(s, o.scan, points);
+  const std::vector<std::size_t> minima = localMinima(scores, o.scan, s.box.which.size());
+  for (std::size_t m = 0; m < minima.size() && m < o.polish_starts; ++m) polish(s, points[minima[m]], o.scan, o.polish_evaluations);
+  CapturePlan plan;
+  plan.cancelled = s.cancelled;
+  if (s.cancelled && !s.found) return plan;
+  if (!s.found)
+    throw InputError("plan: no configuration in the box keeps the joints inside their position and velocity limits "
+                     "(widen or move the ranges, or check the scenario's robot.q)");
+
+  const FloatingModel& model = *scenario.capture.robot.model;
+  plan.joint_names = model.jointNames();
+  plan.optimum = evaluator.evaluate(s.best, &plan.q, &plan.qdot_after);
+  const char* names[3] = {"self_motion", "wrist_roll", "timing"};
+  const double values[3] = {s.best.self_motion, s.best.wrist_roll, s.best.timing};
+  for (int k = 0; k < 3; ++k) {
+    if (k == 0 && !evaluator.redundant()) continue;
+    if (k == 2 && !ranges[2].searched() && ranges[2].lower == 0.0) continue;
+    plan.parameters.emplace_back(names[k], values[k]);
+    if (ranges[k].searched()) plan.searched.emplace_back(names[k]);
+  }
+  plan.nominal = evaluator.evaluate(PlanPoint{});
+  plan.nominal_q.resize(model.nj());
+  for (unsigned int j = 0; j < model.nj(); ++j) plan.nominal_q[j] = scenario.capture.robot.state.q(j);
+  plan.evaluations = s.evaluations + 2;
+  return plan;
+}
+
+}  // namespace kdl_space

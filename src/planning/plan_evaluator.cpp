@@ -1,0 +1,182 @@
+// The capture plan's chart, one configuration at a time: the target at the capture instant, the
+// hand's goal rolled about the contact frame's z, the inverse kinematics, the self-motion, the
+// capture (CaptureSolver, the study's solver), its terms and the limits.
+#include "planning/plan_evaluator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "detail/text.hpp"
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
+
+namespace kdl_space {
+namespace {
+
+constexpr double kPenalty = 1e6;
+
+void checkRange(const PlanRange& r, const char* name, double lowest) {
+  if (!std::isfinite(r.lower) || !std::isfinite(r.upper) || r.lower > r.upper)
+    throw InputError(std::string(name) + ": the range [" + detail::number(r.lower) + ", " + detail::number(r.upper) +
+                     "] is not finite lower <= upper");
+  if (r.lower < lowest)
+    throw InputError(std::string(name) + ": must be >= " + detail::number(lowest) + ", got " + detail::number(r.lower));
+}
+
+}  // namespace
+
+const std::vector<std::string>& planObjectiveTerms() {
+  static const std::vector<std::string> terms{"base_rate", "impulse", "joint_rate_jump"};
+  return terms;
+}
+
+PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& options)
+    : scenario_(scenario), options_(options) {
+  const std::vector<std::string>& terms = planObjectiveTerms();
+  if (options_.weights.empty()) throw InputError("objective: no term given (" + detail::listNames(terms) + ")");
+  for (const auto& [name, weight] : options_.weights) {
+    if (std::find(terms.begin(), terms.end(), name) == terms.end())
+      throw InputError("objective: unknown term '" + name + "' (terms: " + detail::listNames(terms) + ")");
+    if (!(weight > 0.0) || !std::isfinite(weight))
+      throw InputError("objective: the weight of " + name + " must be finite and > 0, got " + detail::number(weight));
+  }
+  if (!scenario.impact)
+    throw InputError("plan: the scenario has no target and no law: there is no capture to plan");
+  const FloatingSystem& robot = scenario.capture.robot;
+  const auto* rigid = std::get_if<RigidTarget>(&scenario.capture.target);
+  // A redundant arm: its self-motion exists at the scenario's state (SelfMotion refuses otherwise).
+  try {
+    SelfMotion probe(robot.model, robot.contact, robot.state);
+    redundant_ = true;
+  } catch (const InputError& e) {
+    if (options_.self_motion && options_.self_motion->searched())
+      throw InputError(std::string("self_motion: cannot be searched: ") + e.what());
+  }
+  if (!options_.self_motion) options_.self_motion = redundant_ ? PlanRange{-1.0, 1.0} : PlanRange{};
+  checkRange(*options_.self_motion, "self_motion", -1e300);
+  if (!redundant_ && (options_.self_motion->lower != 0.0 || options_.self_motion->upper != 0.0))
+    throw InputError("self_motion: the arm has no one-parameter self-motion: leave its range at 0");
+  checkRange(options_.wrist_roll, "wrist_roll", -1e300);
+  checkRange(options_.timing, "timing", 0.0);
+  if (options_.timing.upper > 0.0 && !rigid)
+    throw InputError("timing: only a rigid target's tumble can be followed (the target is free-floating)");
+  if (!options_.self_motion->searched() && !options_.wrist_roll.searched() && !options_.timing.searched())
+    throw InputError("plan: nothing to plan: no parameter has a range (self_motion, wrist_roll, timing)");
+  if (options_.scan < 2) throw InputError("scan: at least 2 points per parameter, got " + std::to_string(options_.scan));
+  hand0_ = contactFrame(*robot.model, robot.state, robot.contact);
+  if (rigid && options_.timing.upper > 0.0) tumble_.emplace(*rigid);  // or ModelError "FreeRigidMotion: ..."
+  problem_ = scenario.capture;
+  if (rigid) target_at_ = *rigid;
+}
+
+bool PlanEvaluator::handPlaced(const PlanPoint& x, std::string& why) {
+  const std::pair<double, double> key{x.wrist_roll, x.timing};
+  if (placed_key_ && *placed_key_ == key) {
+    why = placed_why_;
+    return placed_ok_;
+  }
+  placed_key_ = key;
+  placed_ok_ = false;
+  placed_why_.clear();
+  self_motion_.reset();
+  const FloatingSystem& robot = scenario_.capture.robot;
+  placed_ = robot.state;
+  KDL::Frame grasp = hand0_;  // G(t): the grasp frame riding with the target
+  if (const auto* rigid = std::get_if<RigidTarget>(&scenario_.capture.target)) {
+    target_at_ = *rigid;
+    if (x.timing > 0.0) {
+      if (tumble_->at(x.timing, target_at_) != E_NOERROR) {
+        placed_why_ = "timing: the target's tumble cannot be followed to " + detail::number(x.timing) + " s";
+        why = placed_why_;
+        return false;
+      }
+      grasp = target_at_.pose * rigid->pose.Inverse() * hand0_;
+    }
+  }
+  if (x.wrist_roll != 0.0 || x.timing != 0.0) {
+    IkOptions o;  // the scenario's branch: from its state, no restarts elsewhere (capture_plan.hpp)
+    o.preferred = robot.state.q;
+    o.restarts = 0;
+    try {
+      placed_.q = solveInverseKinematics(*robot.model, robot.state, robot.contact, grasp * KDL::Frame(KDL::Rotation::RotZ(x.wrist_roll)), o).q;
+    } catch (const InputError& e) {  // IkUnreachable: out of reach within the limits
+      placed_why_ = std::string("the hand cannot reach the grasp: ") + e.what();
+      why = placed_why_;
+      return false;
+    }
+  }
+  placed_ok_ = true;
+  return true;
+}
+
+double PlanEvaluator::violation(const std::vector<double>& q, const KDL::JntArray& qdot_after, std::string& why) const {
+  const FloatingModel& model = *scenario_.capture.robot.model;
+  double v = 0.0;
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const JointProperties& p = model.jointProperties()[j];
+    const double outside = std::max(p.lower - q[j], q[j] - p.upper);
+    const double over = std::abs(qdot_after(j)) - p.velocity;
+    if (outside > 0.0 && why.empty())
+      why = "joint " + model.jointNames()[j] + " at " + detail::number(q[j]) + ", outside its limits [" +
+            detail::number(p.lower) + ", " + detail::number(p.upper) + "]";
+    if (over > 0.0 && why.empty())
+      why = "joint " + model.jointNames()[j] + ": rate " + detail::number(qdot_after(j)) +
+            " after the capture, over its velocity limit " + detail::number(p.velocity);
+    v += std::max(outside, 0.0) + std::max(over, 0.0);
+  }
+  return v;
+}
+
+PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, std::vector<double>* q_out, std::vector<double>* qdot_out) {
+  PlanTerms t;
+  t.objective = std::numeric_limits<double>::quiet_NaN();
+  if (!handPlaced(x, t.infeasible)) return t;
+  FloatingSystem& robot = problem_.robot;
+  robot.state = placed_;
+  if (x.self_motion != 0.0 && !self_motion_) {  // built at the placed joints (selfMotionJoints' start)
+    try {
+      self_motion_ = std::make_unique<SelfMotion>(robot.model, robot.contact, placed_);
+    } catch (const InputError& e) {
+      t.infeasible = e.what();
+      return t;
+    }
+  }
+  if (x.self_motion != 0.0)
+    if (const int rc = self_motion_->move(robot.state, x.self_motion)) {
+      t.infeasible = "self_motion: the arm cannot move " + detail::number(x.self_motion) + " rad along its self-motion (" +
+                     strError(rc) + ")";
+      return t;
+    }
+  if (std::holds_alternative<RigidTarget>(problem_.target)) problem_.target = target_at_;
+  const CaptureResult* r = nullptr;
+  try {
+    r = &capture_.solve(problem_);
+  } catch (const Error& e) {
+    t.infeasible = std::string("the capture cannot be computed: ") + e.what();
+    return t;
+  }
+  const unsigned int n = robot.model->nj();
+  std::vector<double> q(n);
+  for (unsigned int j = 0; j < n; ++j) {
+    q[j] = robot.state.q(j);
+    t.joint_rate_jump = std::max(t.joint_rate_jump, std::abs(r->robot.after.qdot(j) - r->robot.before.qdot(j)));
+  }
+  t.base_rate = toEigen(r->robot.after.base_twist).tail<3>().norm();
+  t.impulse = r->impulse.F.head<3>().norm();
+  t.objective = 0.0;
+  for (const auto& [name, weight] : options_.weights)
+    t.objective += weight * (name == "base_rate" ? t.base_rate : name == "impulse" ? t.impulse : t.joint_rate_jump);
+  t.violation = violation(q, r->robot.after.qdot, t.infeasible);
+  t.feasible = t.violation == 0.0 && std::isfinite(t.objective);
+  if (q_out) *q_out = q;
+  if (qdot_out) *qdot_out = std::vector<double>(r->robot.after.qdot.data.data(), r->robot.after.qdot.data.data() + n);
+  return t;
+}
+
+double PlanEvaluator::score(const PlanTerms& t) {
+  if (t.feasible) return t.objective;
+  // Outside the limits: the penalty grows with the excess, which leads the optimiser back inside;
+  // a configuration that cannot be reached or computed scores above every computed one.
+  return std::isfinite(t.objective) ? kPenalty + t.violation : 2.0 * kPenalty;
+}
+
+}  // namespace kdl_space

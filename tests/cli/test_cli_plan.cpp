@@ -1,0 +1,103 @@
+// `kdl_space plan` end to end: the JSON's keys and joint angles by name; the planned joint angles,
+// written into a scenario and run through `kdl_space capture`, give the base rate the plan
+// reports; the text names the joints; usage mistakes exit 2 naming the option, a scenario
+// without a capture exits 3.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "test_util.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml";
+const std::string kArm6 = dataDir() + "/scenarios/arm6_reach_capture.json";
+
+/// scenarios/tumbling_box_capture.yaml's capture (its robot, target and law; the motion section
+/// dropped) with the joints at `q`, as a file: its `q:` line replaced, its URDF path made absolute.
+std::string captureScenario(const nlohmann::json& q_by_name) {
+  std::ostringstream q;
+  q.precision(17);
+  for (auto it = q_by_name.begin(); it != q_by_name.end(); ++it)
+    q << (it == q_by_name.begin() ? "" : ", ") << it.key() << ": " << it.value().get<double>();
+  const std::string path = ::testing::TempDir() + "kdl_space_planned_" + std::to_string(getpid()) + ".yaml";
+  std::ifstream in(kScenario);
+  std::ofstream f(path);
+  int replaced = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("simulation:", 0) == 0) break;
+    if (line.rfind("  q: {", 0) == 0) {
+      line = "  q: {" + q.str() + "}";
+      ++replaced;
+    }
+    if (line.rfind("  urdf: ../urdf/", 0) == 0) line = "  urdf: " + urdfDir() + "/" + line.substr(16);
+    f << line << "\n";
+  }
+  EXPECT_EQ(replaced, 1);
+  return path;
+}
+
+double baseRateOf(const nlohmann::json& capture) {
+  const auto w = capture.at("robot").at("base_twist_after");
+  return std::sqrt(std::pow(w[3].get<double>(), 2) + std::pow(w[4].get<double>(), 2) + std::pow(w[5].get<double>(), 2));
+}
+
+TEST(PlanTool, ThePlannedJointsReproduceTheObjectiveThroughCapture) {
+  const ToolRun run = kdlSpace("plan " + kScenario + " --scan 11 --json");
+  ASSERT_EQ(run.rc, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  for (const char* key : {"scenario", "weights", "joint_names", "q", "q_by_name", "qdot_after", "parameters", "searched",
+                          "objective", "optimum", "nominal_objective", "nominal", "nominal_q_by_name", "evaluations"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j.at("q_by_name").size(), 7u);
+  EXPECT_TRUE(j.at("parameters").contains("self_motion"));
+  EXPECT_TRUE(j.at("parameters").contains("wrist_roll"));
+  const double planned = j.at("objective").get<double>();
+  EXPECT_LT(planned, j.at("nominal_objective").get<double>());
+
+  const std::string path = captureScenario(j.at("q_by_name"));
+  const ToolRun capture = kdlSpace("capture " + path + " --json");
+  std::remove(path.c_str());
+  ASSERT_EQ(capture.rc, 0) << capture.err;
+  // 17 significant digits each way: the same joints, the same capture, to round-off.
+  EXPECT_NEAR(baseRateOf(nlohmann::json::parse(capture.out)), planned, 1e-9 * planned);
+
+  // The nominal (the scenario's own q) through capture too.
+  const std::string nominal = captureScenario(j.at("nominal_q_by_name"));
+  const ToolRun as_written = kdlSpace("capture " + nominal + " --json");
+  std::remove(nominal.c_str());
+  ASSERT_EQ(as_written.rc, 0) << as_written.err;
+  EXPECT_NEAR(baseRateOf(nlohmann::json::parse(as_written.out)), j.at("nominal_objective").get<double>(),
+              1e-9 * j.at("nominal_objective").get<double>());
+}
+
+TEST(PlanTool, PrintsTheJointAnglesByNameAndBothObjectives) {
+  const ToolRun run = kdlSpace("plan " + kArm6 + " --scan 9 --objective joint_rate_jump");
+  ASSERT_EQ(run.rc, 0) << run.err;
+  for (const char* text : {"optimum", "nominal", "wrist_roll", "shoulder_yaw_joint", "wrist_roll_joint", "joint_rate_jump"})
+    EXPECT_NE(run.out.find(text), std::string::npos) << text << "\n" << run.out;
+}
+
+TEST(PlanTool, UsageMistakesExit2NamingTheOption) {
+  const auto expect = [](const std::string& args, int rc, const std::string& words) {
+    const ToolRun run = kdlSpace("plan " + args);
+    EXPECT_EQ(run.rc, rc) << args << "\n" << run.err;
+    EXPECT_NE(run.err.find(words), std::string::npos) << args << "\n" << run.err;
+    EXPECT_EQ(run.out, "");
+  };
+  expect(kArm6 + " --objective base_spin", 2, "--objective: unknown objective 'base_spin'");
+  expect(kArm6 + " --weights base_rate=1,impulse=-2", 2, "--weights");
+  expect(kArm6 + " --weights base_rate=1,spin=2", 2, "--weights: unknown objective 'spin'");
+  expect(kArm6 + " --weights base_rate", 2, "--weights");
+  expect(kArm6 + " --wrist-roll 0,0", 2, "nothing to plan");
+  expect(kArm6 + " --self-motion -1,1", 2, "--self-motion");
+  expect(kArm6 + " --wrist-roll 1,-1", 2, "--wrist-roll");
+  expect(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/base_attitude_control.yaml", 3, "no capture to plan");
+}
+
+}  // namespace
+}  // namespace kdl_space::test

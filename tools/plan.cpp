@@ -1,0 +1,173 @@
+#include "plan.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+
+#include "capture.hpp"  // inScenario
+
+namespace kdl_space::cli {
+namespace {
+
+PlanRange rangeOf(const std::vector<double>& ab, const std::string& option) {
+  if (ab[0] > ab[1]) throw UsageError(option + ": the range's lower end must not exceed its upper end");
+  return PlanRange{ab[0], ab[1]};
+}
+
+std::string termList() {
+  std::string list;
+  for (const std::string& t : planObjectiveTerms()) list += (list.empty() ? "" : ", ") + t;
+  return list;
+}
+
+void checkTerm(const std::string& name, const std::string& option) {
+  const std::vector<std::string>& terms = planObjectiveTerms();
+  if (std::find(terms.begin(), terms.end(), name) == terms.end())
+    throw UsageError(option + ": unknown objective '" + name + "' (choose from " + termList() + ")");
+}
+
+/// The library refuses a range or finds nothing to plan: a usage mistake, the option named (exit 2).
+void usageOrInput(const InputError& e) {
+  const std::string what = e.what();
+  for (const auto& [field, option] : {std::pair<std::string, std::string>{"self_motion: ", "--self-motion: "},
+                                      {"wrist_roll: ", "--wrist-roll: "}, {"timing: ", "--timing: "},
+                                      {"objective: ", "--weights: "}, {"scan: ", "--scan: "}})
+    if (what.rfind(field, 0) == 0) throw UsageError(option + what.substr(field.size()));
+  if (what.rfind("plan: nothing to plan", 0) == 0)
+    throw UsageError(what + "; give a range with --self-motion (a redundant arm), --wrist-roll or --timing");
+}
+
+void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
+  out << "  " << std::left << std::setw(9) << label << std::right << std::setprecision(6) << "objective "
+      << std::setw(12) << t.objective << "   base_rate " << t.base_rate << " rad/s, impulse " << t.impulse
+      << " N s, largest joint-rate jump " << t.joint_rate_jump << "\n";
+  if (!t.feasible) out << "           not within the limits: " << t.infeasible << "\n";
+}
+
+Json termsJson(const PlanTerms& t) {
+  Json j;
+  j["objective"] = t.objective;
+  j["base_rate"] = t.base_rate;
+  j["impulse"] = t.impulse;
+  j["joint_rate_jump"] = t.joint_rate_jump;
+  j["feasible"] = t.feasible;
+  j["violation"] = t.violation;
+  if (!t.feasible) j["infeasible"] = t.infeasible;
+  return j;
+}
+
+}  // namespace
+
+CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "Capture planning: over the self-motion, the wrist roll and the capture instant, the arm configuration "
+              "whose capture disturbs the servicer least, within the joints' position and velocity limits");
+  cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON) with a capture: robot, target, law")->required();
+  cmd->add_option("--objective", o.objective, "What to minimise: base_rate (|w| of the base after), impulse (|f| of "
+                                              "the impulse) or joint_rate_jump (largest |dqdot|); default base_rate");
+  cmd->add_option("--weights", o.weights, "A weighted sum instead: NAME=W,... (e.g. base_rate=1,impulse=0.01)");
+  cmd->add_option("--self-motion", o.self_motion, "A redundant arm's self-motion range A,B [rad] (default -1,1)")
+      ->expected(2)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--wrist-roll", o.wrist_roll, "The hand's roll about the contact frame's z: range A,B [rad] "
+                                                "(default -pi/2,pi/2; 0,0 keeps the scenario's)")
+      ->expected(2)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--timing", o.timing, "The capture instant's range A,B [s] later along the target's tumble "
+                                        "(default 0,0: now)")
+      ->expected(2)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--scan", o.scan, "Points per searched parameter of the first scan")->check(CLI::Range(2u, 201u));
+  cmd->add_option("--polish-starts", o.polish_starts, "Local polishes from the scan's best local minima")
+      ->check(CLI::Range(0u, 100u));
+  cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
+  return cmd;
+}
+
+PlanOptions planOptions(const PlanCliOptions& o) {
+  PlanOptions p;
+  if (o.weights.empty()) {
+    checkTerm(o.objective, "--objective");
+    p.weights = {{o.objective, 1.0}};
+  } else {
+    p.weights.clear();
+    std::stringstream list(o.weights);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      const auto [name, weight] = parseAssignment(item, "--weights");
+      checkTerm(name, "--weights");
+      if (!(weight > 0.0)) throw UsageError("--weights " + item + ": a weight must be > 0");
+      for (const auto& [seen, w] : p.weights)
+        if (seen == name) throw UsageError("--weights: " + name + " is given twice");
+      p.weights.emplace_back(name, weight);
+    }
+    if (p.weights.empty()) throw UsageError("--weights: give NAME=W,... (terms: " + termList() + ")");
+  }
+  if (!o.self_motion.empty()) p.self_motion = rangeOf(o.self_motion, "--self-motion");
+  if (!o.wrist_roll.empty()) p.wrist_roll = rangeOf(o.wrist_roll, "--wrist-roll");
+  if (!o.timing.empty()) p.timing = rangeOf(o.timing, "--timing");
+  p.scan = o.scan;
+  p.polish_starts = o.polish_starts;
+  p.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
+  return p;
+}
+
+Json planJson(const Scenario& sc, const PlanOptions& options, const CapturePlan& plan) {
+  Json by_name = Json::object(), nominal_by_name = Json::object(), params = Json::object(), weights = Json::object();
+  for (std::size_t j = 0; j < plan.joint_names.size(); ++j) {
+    by_name[plan.joint_names[j]] = plan.q[j];
+    nominal_by_name[plan.joint_names[j]] = plan.nominal_q[j];
+  }
+  for (const auto& [name, value] : plan.parameters) params[name] = value;
+  for (const auto& [name, w] : options.weights) weights[name] = w;
+  Json j;
+  j["scenario"] = sc.file;
+  j["weights"] = weights;
+  j["joint_names"] = plan.joint_names;
+  j["q"] = plan.q;
+  j["q_by_name"] = by_name;
+  j["qdot_after"] = plan.qdot_after;
+  j["parameters"] = params;
+  j["searched"] = plan.searched;
+  j["objective"] = plan.optimum.objective;
+  j["optimum"] = termsJson(plan.optimum);
+  j["nominal_objective"] = plan.nominal.objective;
+  j["nominal"] = termsJson(plan.nominal);
+  j["nominal_q_by_name"] = nominal_by_name;
+  j["evaluations"] = plan.evaluations;
+  return j;
+}
+
+void runPlan(const PlanCliOptions& o, std::ostream& out) {
+  const PlanOptions options = planOptions(o);  // or UsageError, before the scenario is read
+  const Scenario sc = loadScenario(o.scenario);
+  CapturePlan plan;
+  try {
+    plan = planCapture(sc, options);
+  } catch (const InputError& e) {
+    usageOrInput(e);  // the options' names (exit 2), else the scenario's problem (exit 3)
+    e.rethrowWithContext(sc.file + ": ");
+  } catch (const Error& e) {
+    e.rethrowWithContext(sc.file + ": ");
+  }
+  if (plan.cancelled) throw Interrupted("plan: stopped during the search; nothing written");
+  if (o.json) {
+    out << planJson(sc, options, plan).dump(2) << "\n";
+    return;
+  }
+  out << "kdl_space plan " << sc.file << ": minimising";
+  for (std::size_t k = 0; k < options.weights.size(); ++k)
+    out << (k ? " +" : "") << " " << options.weights[k].second << " " << options.weights[k].first;
+  out << " over";
+  for (const std::string& s : plan.searched) out << " " << s;
+  out << " (" << plan.evaluations << " captures computed)\n";
+  printTerms(out, "optimum", plan.optimum);
+  printTerms(out, "nominal", plan.nominal);
+  out << "parameters:";
+  for (const auto& [name, value] : plan.parameters) out << " " << name << " = " << std::setprecision(9) << value;
+  out << (plan.parameters.empty() ? " none" : "") << "\njoint angles at the optimum [rad or m] (nominal in brackets):\n";
+  std::size_t width = 0;
+  for (const std::string& n : plan.joint_names) width = std::max(width, n.size());
+  for (std::size_t j = 0; j < plan.joint_names.size(); ++j)
+    out << "  " << std::left << std::setw(static_cast<int>(width)) << plan.joint_names[j] << std::right << "  "
+        << std::setprecision(12) << std::setw(18) << plan.q[j] << "  (" << plan.nominal_q[j] << ")\n";
+}
+
+}  // namespace kdl_space::cli

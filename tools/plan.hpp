@@ -1,0 +1,40 @@
+// `kdl_space plan SCENARIO [--objective NAME | --weights NAME=W,...] [--self-motion A,B]
+// [--wrist-roll A,B] [--timing A,B] [--scan N] [--json]`: the arm configuration whose capture
+// disturbs the servicer least (the library's planCapture, printed): the joint angles by name, the
+// parameters, the objective at the optimum and at the scenario as written. Exit 2 for a usage
+// mistake (an unknown objective, bad weights, nothing to plan), 3 for a scenario it cannot plan.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "kdl_space/planning/capture_plan.hpp"
+
+namespace kdl_space::cli {
+
+struct PlanCliOptions {
+  std::string scenario;
+  std::string objective = "base_rate";
+  std::string weights;                 ///< NAME=W,NAME=W (overrides --objective)
+  std::vector<double> self_motion;     ///< A B [rad]; empty: the library's default
+  std::vector<double> wrist_roll;      ///< A B [rad]
+  std::vector<double> timing;          ///< A B [s]
+  unsigned int scan = 21;
+  unsigned int polish_starts = 5;
+  bool json = false;
+};
+
+CLI::App* addPlan(CLI::App& app, PlanCliOptions& options);
+
+/// The JSON object of a plan (keys are a contract: see the README).
+Json planJson(const Scenario& scenario, const PlanOptions& options, const CapturePlan& plan);
+
+/// \brief The library's options from the command line's. \throws UsageError naming the option.
+PlanOptions planOptions(const PlanCliOptions& options);
+
+void runPlan(const PlanCliOptions& options, std::ostream& out);
+
+}  // namespace kdl_space::cli
