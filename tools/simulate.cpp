@@ -170,6 +170,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
       streams.add(o, sc, so_far.model->jointNames(), x);
     };
+  // Before the run: a start pose near a singularity otherwise shows only as a failed approach.
+  if (options.approach) warnOnStderr(approachStartWarnings(sc));
   OperationResult r;
   try {
     r = runCaptureOperation(sc, options);
@@ -180,6 +182,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);
+  if (r.capture) warnOnStderr(captureWarnings(r.at_contact));
   const OperationFiles files{o.csv, o.plot};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

@@ -308,6 +308,10 @@ Scenario loadScenario(const std::string& path) {
     if (std::holds_alternative<FloatingSystem>(s.capture.target))
       approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
     s.approach = sections::approach(approach, *s.capture.robot.model);
+    if (robot.has("place"))
+      robot.at("place").fail("puts the hand at the grasp before anything moves, so the approach would have nothing to "
+                             "reach: remove robot.place and robot.grasp (the approach starts from robot.q and reaches "
+                             "approach.grasp), or the approach section");
   }
   if (top.has("simulation")) {
     const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);
