@@ -50,7 +50,6 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
   ApproachOutcome outcome;
   outcome.start_warnings = approachStartWarnings(sc);
   if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
-  ApproachOutcome outcome;
   std::vector<MotionSample>& samples = result.approach_samples;
   int observer_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x, const ApproachCommand& cmd) {

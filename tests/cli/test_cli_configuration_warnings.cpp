@@ -55,7 +55,7 @@ TEST(ConfigurationWarnings, AJointLeftOutOfQOutsideItsLimitsIsWarnedOnStderrOnce
 }
 
 TEST(ConfigurationWarnings, InspectAndSimulateWarnOnStderrToo) {
-  const ToolRun inspect = kdlSpace("inspect " KDL_SPACE_TEST_DATA_DIR "/broken_urdf/limits_exclude_zero.urdf --q shoulder=0.1");
+  const ToolRun inspect = kdlSpace("inspect --urdf " KDL_SPACE_TEST_DATA_DIR "/broken_urdf/limits_exclude_zero.urdf --tip forearm --q shoulder=0.1");
   ASSERT_EQ(inspect.rc, 0) << inspect.err;
   EXPECT_EQ(count(inspect.err, "kdl_space: warning: elbow: at 0, outside its limits"), 1u) << inspect.err;
   const std::string plain = write("elbow_left_out_motion.yaml",
@@ -89,19 +89,8 @@ std::string approachFrom(const std::string& name, const std::string& q, double m
   return write(name, text);
 }
 
-// The case: a singular start pose learned of only when the approach failed. Stretched
-// out (every joint 0) the arm's joints 1, 3, 5 and 7 share one axis: J* loses rank.
-TEST(ApproachStart, ASingularStartPoseIsWarnedBeforeTheApproachRuns) {
-  const ToolRun run = kdlSpace("simulate " + approachFrom("approach_singular.yaml", "{}", 0.5) + " --duration 0.1");
-  EXPECT_EQ(count(run.err, "kdl_space: warning: contact 'end_effector': at the start of the approach: J* is near a "
-                           "singularity here: sigma_min / sigma_max = "),
-            1u) << run.err;
-  // Before the approach's own verdict (it cannot reach the grasp in 0.5 s from there).
-  const std::size_t warned = run.err.find("at the start of the approach");
-  const std::size_t failed = run.err.find("the hand never reached");
-  if (failed != std::string::npos) EXPECT_LT(warned, failed) << run.err;
-}
-
+// The case (a start pose learned of only when the approach failed): the start is checked
+// before the approach runs; here a joint outside its limits, which the approach still runs from.
 TEST(ApproachStart, AStartJointOutsideItsLimitsIsInTheJsonAndOnStderr) {
   const ToolRun run = kdlSpace("simulate " +
                                approachFrom("approach_outside.yaml", "{joint2: 0.7, joint3: 1.1, joint4: 1.1, joint6: "
