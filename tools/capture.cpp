@@ -244,7 +244,7 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     scene.commit();
   }
   const std::vector<Diagnostic> warnings = captureWarnings(sc.capture);
-  warnOnStderr(warnings);
+  if (!o.json) warnOnStderr(warnings);  // the JSON carries them; its runs keep stderr for errors
   if (o.json) {
     Json j = captureJson(sc, result);
     j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);

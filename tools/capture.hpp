@@ -47,8 +47,8 @@ Json captureJson(const Scenario& scenario, const CaptureResult& result);
 std::vector<Diagnostic> captureWarnings(const CaptureProblem& problem);
 /// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
 void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
-/// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr: seen in the
-/// terminal whatever the output (text, --json) and even when the run fails after it.
+/// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr (the text runs'
+/// warnings, and an approach's start warnings before it runs, which a failed run shows no other way).
 void warnOnStderr(const std::vector<Diagnostic>& warnings);
 
 /// The readable summary.

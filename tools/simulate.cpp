@@ -170,7 +170,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
       streams.add(o, sc, so_far.model->jointNames(), x);
     };
-  // Before the run: a start pose near a singularity otherwise shows only as a failed approach.
+  // Before the run, --json too: a start pose near a singularity otherwise shows only as a failed
+  // approach, which prints no JSON.
   if (options.approach) warnOnStderr(approachStartWarnings(sc));
   OperationResult r;
   try {
@@ -182,7 +183,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);
-  if (r.capture) warnOnStderr(captureWarnings(r.at_contact));
+  if (r.capture && !o.json) warnOnStderr(captureWarnings(r.at_contact));
   const OperationFiles files{o.csv, o.plot};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

@@ -47,7 +47,7 @@ TEST(ConfigurationWarnings, AJointLeftOutOfQOutsideItsLimitsIsWarnedOnStderrOnce
   EXPECT_NE(run.err.find("a joint left out of q is at 0"), std::string::npos) << run.err;
   const ToolRun json = kdlSpace("capture " + elbowLeftOut() + " --json");
   ASSERT_EQ(json.rc, 0) << json.err;
-  EXPECT_EQ(count(json.err, "kdl_space: warning: elbow:"), 1u) << json.err;
+  EXPECT_EQ(json.err, "");  // a --json run: the warnings are in the JSON
   const nlohmann::json j = nlohmann::json::parse(json.out);
   ASSERT_EQ(j.at("warnings").size(), 1u);
   EXPECT_EQ(j.at("warnings")[0].at("kind"), "joint_outside_limits");
