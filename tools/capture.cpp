@@ -3,7 +3,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
+#include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.hpp"
@@ -43,6 +45,22 @@ std::string row(const Eigen::VectorXd& v) {
 }
 
 }  // namespace
+
+std::optional<Vector3d> pointInTargetFrame(const CaptureProblem& p, const Vector3d& point) {
+  if (const auto* rigid = std::get_if<RigidTarget>(&p.target)) return toEigen(rigid->pose.Inverse() * toKDL(point));
+  if (const auto* other = std::get_if<FloatingSystem>(&p.target))
+    return toEigen(other->state.world_T_base.Inverse() * toKDL(point));
+  return std::nullopt;
+}
+
+Json graspJson(const Scenario& sc) {
+  if (!sc.grasp_solution) return nullptr;
+  const IkResult& g = *sc.grasp_solution;
+  return Json{{"residual_position", g.position_residual},
+              {"residual_rotation", g.orientation_residual},
+              {"iterations", g.iterations},
+              {"attempts", g.attempts}};
+}
 
 CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
   CLI::App* cmd = app.add_subcommand("capture", "Solve the impact or capture of a scenario (YAML or JSON)");
@@ -90,6 +108,12 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
   j["energy_lost"] = r.energyLost();
   // null without a normal, and where the robot cannot move its contact point along it (infinite)
   j["virtual_mass"] = r.virtual_mass ? Json(*r.virtual_mass) : Json(nullptr);
+  // Where the hand holds the target, in the target's frame (a rigid target's `pose` frame, a
+  // free-floating target's base frame), at the scenario's states.
+  const std::optional<Vector3d> in_target = pointInTargetFrame(p, r.contact_point);
+  j["contact_point"] = toJson(r.contact_point);
+  j["contact_point_in_target"] = in_target ? toJson(*in_target) : Json(nullptr);
+  j["grasp"] = graspJson(sc);  // robot.place: grasp: how well the solved arm holds the grasp frame
   j["G_star"] = toJson(r.G_robot);
   j["G_B"] = toJson(r.G_target);
   return j;
@@ -108,6 +132,11 @@ void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings) {
     out << "Warning: " << (d.element.empty() ? "" : d.element + ": ") << d.message << "\n";
 }
 
+void warnOnStderr(const std::vector<Diagnostic>& warnings) {
+  for (const Diagnostic& d : warnings)
+    std::cerr << "kdl_space: warning: " << (d.element.empty() ? "" : d.element + ": ") << d.message << "\n";
+}
+
 void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureResult& r) {
   const CaptureProblem& p = sc.capture;
   const ImpactLaw& law = p.law;
@@ -124,7 +153,15 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
   if (law.kind == ImpactKind::FrictionalImpact && !r.impulse.separating)
     out << (r.impulse.sticking ? "Contact sticks at the end of the impact.\n" : "Contact slides at the end of the impact.\n");
   out << "Contact point " << row(r.contact_point) << " m on link '"
-      << p.robot.model->bodies()[p.robot.contact.body].name << "'\n";
+      << p.robot.model->bodies()[p.robot.contact.body].name << "'";
+  if (const std::optional<Vector3d> in_target = pointInTargetFrame(p, r.contact_point))
+    out << ", " << row(*in_target) << " m in the target's frame";
+  out << "\n";
+  if (sc.grasp_solution)
+    out << "Grasp (robot.place: grasp): the contact frame holds robot.grasp.target_frame to "
+        << sc.grasp_solution->position_residual << " m, " << sc.grasp_solution->orientation_residual << " rad ("
+        << sc.grasp_solution->iterations << " iterations, " << sc.grasp_solution->attempts
+        << (sc.grasp_solution->attempts == 1 ? " start)\n" : " starts)\n");
   const std::vector<std::string> braked = lockedNames(p.robot);
   if (!braked.empty()) {
     out << "Braked joints (locked at the impact, rates stay 0):";
@@ -207,6 +244,7 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     scene.commit();
   }
   const std::vector<Diagnostic> warnings = captureWarnings(sc.capture);
+  if (!o.json) warnOnStderr(warnings);  // the JSON carries them; its runs keep stderr for errors
   if (o.json) {
     Json j = captureJson(sc, result);
     j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -34,6 +35,11 @@ auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
 /// The files a scenario makes a run read: the scenario, the robot's URDF, the target's URDF.
 std::vector<InputFile> scenarioInputs(const Scenario& scenario);
 
+/// \brief `point` (world) in the frame of `problem`'s target: a rigid target's `pose` frame, a
+/// free-floating target's base frame, at the problem's states.
+std::optional<Vector3d> pointInTargetFrame(const CaptureProblem& problem, const Vector3d& point);
+/// The `grasp` object of the capture JSON: robot.place: grasp's residuals; null without it.
+Json graspJson(const Scenario& scenario);
 /// The capture JSON object (the keys are a contract: see the README).
 Json captureJson(const Scenario& scenario, const CaptureResult& result);
 /// \brief The warnings about the robot's configuration at the capture (`problem`'s state and
@@ -41,6 +47,9 @@ Json captureJson(const Scenario& scenario, const CaptureResult& result);
 std::vector<Diagnostic> captureWarnings(const CaptureProblem& problem);
 /// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
 void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
+/// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr (the text runs'
+/// warnings, and an approach's start warnings before it runs, which a failed run shows no other way).
+void warnOnStderr(const std::vector<Diagnostic>& warnings);
 
 /// The readable summary.
 void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);

@@ -1,5 +1,7 @@
 #include "ik.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <iomanip>
 
 #include "capture.hpp"  // inScenario
@@ -21,7 +23,9 @@ CLI::App* addIk(CLI::App& app, IkCliOptions& o) {
   cmd->add_option("--rpy", o.rpy, "Its roll pitch yaw about fixed world axes (or R,P,Y) [rad]; default 0 0 0")
       ->expected(3)->delimiter(',')->check(finiteNumber());
   cmd->add_option("--prefer", o.prefer,
-                  "A redundant arm's preferred posture NAME=VALUE [rad or m] (default: robot.q; unnamed joints as there)")
+                  "Which solution a redundant arm takes: 'posture' (default: the one closest to robot.q), NAME=VALUE "
+                  "[rad or m] ... (closest to that posture; unnamed joints as in robot.q), or 'reaction' (the one from "
+                  "which a unit hand motion turns the base least: the least reaction_measure)")
       ->expected(1, -1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--position-tolerance", o.position_tolerance, "Largest accepted position residual [m]")
       ->check(positiveNumber());
@@ -54,6 +58,7 @@ Json ikJson(const Scenario& sc, const KDL::Frame& goal, const IkResult& r) {
   j["iterations"] = r.iterations;
   j["attempts"] = r.attempts;
   j["preference_gradient"] = r.preference_gradient;
+  j["reaction_measure"] = std::isfinite(r.reaction_measure) ? Json(r.reaction_measure) : Json(nullptr);
   return j;
 }
 
@@ -67,9 +72,14 @@ void runIk(const IkCliOptions& o, std::ostream& out) {
   options.position_tolerance = o.position_tolerance;
   options.orientation_tolerance = o.orientation_tolerance;
   options.restarts = o.restarts;
-  if (!o.prefer.empty()) {
+  const bool reaction = std::find(o.prefer.begin(), o.prefer.end(), "reaction") != o.prefer.end();
+  if (reaction && o.prefer.size() > 1)
+    throw UsageError("--prefer reaction: takes no posture (NAME=VALUE) and no second preference; give one of them");
+  if (reaction) options.prefer = IkPreference::Reaction;
+  if (!reaction && !o.prefer.empty()) {
     KDL::JntArray preferred = robot.state.q;
     for (const std::string& text : o.prefer) {
+      if (text == "posture") continue;  // the default: robot.q, or the NAME=VALUE given with it
       const auto [name, value] = parseAssignment(text, "--prefer");
       const int j = robot.model->jointIndex(name);
       if (j < 0) throw UsageError("--prefer " + text + ": the robot has no movable joint '" + name + "'");
@@ -86,9 +96,12 @@ void runIk(const IkCliOptions& o, std::ostream& out) {
   const FloatingModel& model = *robot.model;
   out << "kdl_space ik " << sc.file << ": the contact frame of link '" << linkName(sc) << "' at position ["
       << o.position[0] << ", " << o.position[1] << ", " << o.position[2] << "] m, rpy [" << o.rpy[0] << ", " << o.rpy[1]
-      << ", " << o.rpy[2] << "] rad (world), the base as the scenario puts it\n";
+      << ", " << o.rpy[2] << "] rad (world), the base as the scenario puts it; preferring "
+      << (reaction ? "the least reaction of the base" : "the posture") << "\n";
   out << std::setprecision(3) << "reached: residual " << r.position_residual << " m, " << r.orientation_residual
       << " rad; " << r.iterations << " iterations, " << r.attempts << (r.attempts == 1 ? " start" : " starts") << "\n";
+  if (std::isfinite(r.reaction_measure))
+    out << "reaction measure (base angular rate per unit hand twist, ||W J_h^+||_F): " << r.reaction_measure << "\n";
   out << "joint angles [rad or m] (* moved; the others keep robot.q):\n" << std::setprecision(12);
   std::size_t width = 0;
   for (const std::string& n : model.jointNames()) width = std::max(width, n.size());

@@ -5,6 +5,7 @@
 #include <memory>
 #include <sstream>
 
+#include "capture.hpp"  // warnOnStderr
 #include "cli_common.hpp"
 #include "detail/text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
@@ -307,6 +308,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
     throw InputError("--tip: G* over all contact points cannot be computed: " + std::string(strError(rc)));
 
   for (const Diagnostic& d : warnings) diagnostics.push_back("warning: " + describe(d));
+  if (!o.json) warnOnStderr(warnings);
   if (o.json) {
     out << std::setprecision(17) << inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings).dump(2)
         << "\n";

@@ -111,11 +111,18 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   const bool grounded = record.options.grounded;
   Json j;
   j["capture"] = r.capture ? captureJson(sc, *r.capture) : Json(nullptr);
+  if (r.capture) {  // the target where it was at the contact instant (an approach moved it)
+    const std::optional<Vector3d> in_target = pointInTargetFrame(r.at_contact, r.capture->contact_point);
+    j["capture"]["contact_point_in_target"] = in_target ? toJson(*in_target) : Json(nullptr);
+  }
   j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
   j["target_motion"] = targetMotionJson(r);
   // The robot's configuration at the capture (the contact instant of an approach).
-  // and what the motion found (a sampled controller's gains, a stiff servo).
-  std::vector<Diagnostic> warnings = r.capture ? captureWarnings(r.at_contact) : std::vector<Diagnostic>{};
+  // The pose an approach started from first, then the configuration at the capture, then what the
+  // motion found (a sampled controller's gains, a stiff servo).
+  std::vector<Diagnostic> warnings = r.approach ? r.approach->start_warnings : std::vector<Diagnostic>{};
+  if (r.capture)
+    for (Diagnostic& d : captureWarnings(r.at_contact)) warnings.push_back(std::move(d));
   warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());
   j["warnings"] = warningsJson(warnings);
   j["base_control"] = baseControlPhasesJson(sc, r);
@@ -166,7 +173,10 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
 void printOperation(std::ostream& out, const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
   const MotionRecord& record = r.record;
   const std::vector<std::string>& joints = r.model->jointNames();
-  if (r.approach) printApproach(out, sc, *r.approach);
+  if (r.approach) {
+    printApproach(out, sc, *r.approach);
+    printWarnings(out, r.approach->start_warnings);
+  }
   if (r.capture) {
     printCaptureSummary(out, sc, *r.capture);
     printWarnings(out, captureWarnings(r.at_contact));

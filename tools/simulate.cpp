@@ -171,6 +171,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
       streams.add(o, sc, so_far.model->jointNames(), x);
     };
+  // Before the run, --json too: a start pose near a singularity otherwise shows only as a failed
+  // approach, which prints no JSON.
+  if (options.approach) warnOnStderr(approachStartWarnings(sc));
   OperationResult r;
   try {
     r = runCaptureOperation(sc, options);
@@ -181,11 +184,10 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);
-  // What the motion found (a sampled controller's gains, a stiff servo): on stderr too, whatever
-  // the format of stdout.
-  for (const Diagnostic& d : r.warnings)
-    std::cerr << "kdl_space: warning: " << d.kind << ": " << (d.element.empty() ? "" : d.element + ": ") << d.message
-              << "\n";
+  if (r.capture && !o.json) warnOnStderr(captureWarnings(r.at_contact));
+  // What the motion found (a sampled controller's gains, a stiff servo): on stderr whatever the
+  // format of stdout (they may explain a motion that then went wrong).
+  warnOnStderr(r.warnings);
   const OperationFiles files{o.csv, o.plot};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

@@ -22,20 +22,26 @@ py::dict solutionDict(const FloatingModel& model, const IkResult& r) {
   d["iterations"] = r.iterations;
   d["attempts"] = r.attempts;
   d["preference_gradient"] = r.preference_gradient;
+  d["reaction_measure"] = r.reaction_measure;
   return d;
 }
 
 /// Solves, the GIL released; an unreachable pose raises kdl_space.InputError carrying the best
 /// attempt (position_residual, orientation_residual, q, q_by_name).
 py::dict solve(const std::shared_ptr<const FloatingModel>& model, const State& seed, const Contact& contact, py::handle goal,
-               py::handle preferred, double position_tolerance, double orientation_tolerance, unsigned int restarts,
-               unsigned int max_iterations) {
+               py::handle preferred, const std::string& prefer, double position_tolerance, double orientation_tolerance,
+               unsigned int restarts, unsigned int max_iterations) {
   const KDL::Frame world_T_goal = frameFromPython(goal, "goal");
   IkOptions o;
   o.position_tolerance = position_tolerance;
   o.orientation_tolerance = orientation_tolerance;
   o.restarts = restarts;
   o.max_iterations = max_iterations;
+  if (prefer != "posture" && prefer != "reaction")
+    throw py::value_error("prefer: '" + prefer + "' is neither 'posture' nor 'reaction'");
+  o.prefer = prefer == "reaction" ? IkPreference::Reaction : IkPreference::Posture;
+  if (!preferred.is_none() && o.prefer == IkPreference::Reaction)
+    throw py::value_error("preferred: a posture is for prefer='posture'; prefer='reaction' minimises the base's reaction");
   if (!preferred.is_none()) {
     // A dict names only some joints: the others keep the seed's angle (not 0).
     KDL::JntArray p = seed.q;
@@ -75,31 +81,32 @@ void bindInverseKinematics(py::module_& m) {
       "The joint angles that put the contact frame (the contact link's axes, origin at its offset) at the world pose "
       "`goal` (a 4x4 matrix, or (position, rpy)), the base where the state (or the scenario's robot) puts it, every joint "
       "inside its limits. preferred: a redundant arm's posture to stay closest to (array (nj,) or dict name -> value; "
-      "default the state's q). Returns a dict: q (nj,), q_by_name, joint_names, moved_joints, position_residual [m], "
-      "orientation_residual [rad], iterations, attempts, preference_gradient. Raises InputError when the pose is out of "
+      "default the state's q). prefer: 'posture' (that) or 'reaction' (the self-motion solution from which a unit hand "
+      "motion turns the base least: the least reaction_measure, || W J_h^+ ||_F, W the base's angular rows of J*). Returns a dict: q (nj,), q_by_name, joint_names, moved_joints, position_residual [m], "
+      "orientation_residual [rad], iterations, attempts, preference_gradient, reaction_measure. Raises InputError when the pose is out of "
       "reach: its message says how far the best attempt came; the error's position_residual, orientation_residual, q, "
       "q_by_name and attempts are that attempt's.";
   m.def(
       "inverse_kinematics",
-      [](const PyState& state, const PyContact& contact, py::object goal, py::object preferred, double position_tolerance,
-         double orientation_tolerance, unsigned int restarts, unsigned int max_iterations) {
+      [](const PyState& state, const PyContact& contact, py::object goal, py::object preferred, const std::string& prefer,
+         double position_tolerance, double orientation_tolerance, unsigned int restarts, unsigned int max_iterations) {
         checkContact(*state.model, contact);
-        return solve(state.model, state.state, contact.contact, goal, preferred, position_tolerance, orientation_tolerance,
+        return solve(state.model, state.state, contact.contact, goal, preferred, prefer, position_tolerance, orientation_tolerance,
                      restarts, max_iterations);
       },
       py::arg("state"), py::arg("contact"), py::arg("goal"), py::kw_only(), py::arg("preferred") = py::none(),
-      py::arg("position_tolerance") = 1e-10, py::arg("orientation_tolerance") = 1e-10, py::arg("restarts") = 16,
+      py::arg("prefer") = "posture", py::arg("position_tolerance") = 1e-10, py::arg("orientation_tolerance") = 1e-10, py::arg("restarts") = 16,
       py::arg("max_iterations") = 500, doc);
   m.def(
       "inverse_kinematics",
-      [](const PyScenario& s, py::object goal, py::object preferred, double position_tolerance,
-         double orientation_tolerance, unsigned int restarts, unsigned int max_iterations) {
+      [](const PyScenario& s, py::object goal, py::object preferred, const std::string& prefer,
+         double position_tolerance, double orientation_tolerance, unsigned int restarts, unsigned int max_iterations) {
         const FloatingSystem& robot = s.scenario.capture.robot;
-        return solve(robot.model, robot.state, robot.contact, goal, preferred, position_tolerance, orientation_tolerance,
+        return solve(robot.model, robot.state, robot.contact, goal, preferred, prefer, position_tolerance, orientation_tolerance,
                      restarts, max_iterations);
       },
       py::arg("scenario"), py::arg("goal"), py::kw_only(), py::arg("preferred") = py::none(),
-      py::arg("position_tolerance") = 1e-10, py::arg("orientation_tolerance") = 1e-10, py::arg("restarts") = 16,
+      py::arg("prefer") = "posture", py::arg("position_tolerance") = 1e-10, py::arg("orientation_tolerance") = 1e-10, py::arg("restarts") = 16,
       py::arg("max_iterations") = 500, doc);
 }
 

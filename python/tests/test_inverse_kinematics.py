@@ -126,3 +126,25 @@ def test_out_of_reach_raises_with_the_remaining_distance():
     assert 45.0 <= e.value.position_residual <= 50.0
     assert e.value.attempts == 3
     assert set(e.value.q_by_name) >= {"joint1", "joint7"}
+
+
+def test_prefer_reaction_turns_the_base_no_more_than_the_posture():
+    """prefer='reaction': the goal (by NumPy's forward kinematics) reached to 1e-9, with a reaction
+    measure no larger than the posture solution's; a wrong preference, or a posture with it, is a
+    ValueError. (The measure is checked against an independent recomputation and a scan of the
+    self-motion in tests/study/test_ik_reaction.cpp.)"""
+    scenario = kdl_space.load_scenario(str(SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"))
+    truth = {"joint1": -0.2, "joint2": 0.9, "joint3": 0.4, "joint4": 1.2, "joint5": 0.3, "joint6": -0.8, "joint7": 0.5}
+    goal = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector", truth, np.eye(4)) @ homogeneous(
+        np.eye(3), [0, 0, 0.05])
+    posture = kdl_space.ik(scenario, goal, preferred=truth)
+    reaction = kdl_space.ik(scenario, goal, prefer="reaction")
+    assert reaction["position_residual"] <= 1e-9 and reaction["orientation_residual"] <= 1e-9
+    assert reaction["reaction_measure"] <= posture["reaction_measure"]
+    reached = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector", reaction["q_by_name"], np.eye(4)) @ \
+        homogeneous(np.eye(3), [0, 0, 0.05])
+    assert np.abs(reached - goal).max() <= 1e-9
+    with pytest.raises(ValueError, match="prefer"):
+        kdl_space.ik(scenario, goal, prefer="least_effort")
+    with pytest.raises(ValueError, match="preferred"):
+        kdl_space.ik(scenario, goal, prefer="reaction", preferred=truth)

@@ -54,6 +54,11 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
         assert phases is None
     else:
         assert phases == {"phases": ["after"], "acted_in": ["after"]}
+    # ... and the capture's contact point, world and in the target's frame, and robot.place: grasp's
+    # solve (null without it; their values: tests/cli/test_cli_configuration_warnings.cpp).
+    if now.get("capture"):
+        for key in ("contact_point", "contact_point_in_target", "grasp"):
+            now["capture"].pop(key)
     # The same build type on the same kind of machine: the same floating-point code, so the same
     # numbers but for the last bits of a long adaptive run.
     assert_same(before, now, rel=1e-9, abs_tol=1e-12)

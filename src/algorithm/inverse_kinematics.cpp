@@ -9,9 +9,12 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <sstream>
 
 #include "detail/text.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 
 namespace kdl_space {
@@ -136,15 +139,80 @@ class Search {
     return length(e.vel) + length(e.rot);
   }
 
-  /// N (preferred - q): the part of the way to the preferred posture that does not move the tip.
-  Eigen::VectorXd preferenceGradient(const KDL::JntArray& q) {
+  /// An orthonormal basis of the self-motion at q (the null space of the chain's Jacobian).
+  Eigen::MatrixXd nullBasis(const KDL::JntArray& q) {
     KDL::Jacobian J(q.rows());
     jac_.JntToJac(q, J);
-    const Eigen::MatrixXd& Jd = J.data;
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jd, Eigen::ComputeFullV);
-    const Eigen::Index rank = svd.rank();
-    const Eigen::MatrixXd Vn = svd.matrixV().rightCols(Jd.cols() - rank);  // null-space basis
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J.data, Eigen::ComputeFullV);
+    return svd.matrixV().rightCols(J.data.cols() - svd.rank());
+  }
+
+  /// N (preferred - q): the part of the way to the preferred posture that does not move the tip.
+  Eigen::VectorXd preferenceGradient(const KDL::JntArray& q) {
+    const Eigen::MatrixXd Vn = nullBasis(q);
     return Vn * (Vn.transpose() * (preferred_.data - q.data));
+  }
+
+  /// The measure a Reaction preference minimises, of chain angles (empty: Posture).
+  void setMeasure(std::function<double(const KDL::JntArray&)> m) { measure_ = std::move(m); }
+  bool minimisesMeasure() const { return static_cast<bool>(measure_); }
+
+  /// N grad measure by central differences (step 1e-6 rad: the measure is smooth away from
+  /// singularities, the error ~1e-12 relative).
+  Eigen::VectorXd measureGradient(const KDL::JntArray& q) {
+    Eigen::VectorXd g(q.rows());
+    for (unsigned int j = 0; j < q.rows(); ++j) {
+      KDL::JntArray a = q, b = q;
+      a(j) += 1e-6;
+      b(j) -= 1e-6;
+      g(j) = (measure_(a) - measure_(b)) / 2e-6;
+    }
+    const Eigen::MatrixXd Vn = nullBasis(q);
+    return Vn * (Vn.transpose() * g);
+  }
+
+  /// \brief The least measure over the self-motion through q: for a one-dimensional self-motion
+  /// a scan along it both ways (steps of 0.05 rad, each projected back onto the pose, until a
+  /// limit, a failed projection or the loop closes) for the best start, then steps down
+  /// N grad measure (a line search: shorter on failure, longer on success) from there.
+  void minimiseMeasure(KDL::JntArray& q, unsigned int& iterations) {
+    if (q.rows() <= 6) return;
+    KDL::JntArray best = q;
+    double best_f = measure_(q);
+    if (nullBasis(q).cols() == 1) {
+      for (const double way : {1.0, -1.0}) {
+        KDL::JntArray x = q;
+        Eigen::VectorXd t = way * nullBasis(q).col(0);
+        for (int k = 0; k < 600; ++k) {
+          Eigen::VectorXd t_new = nullBasis(x).col(0);
+          if (t_new.dot(t) < 0) t_new = -t_new;  // keep going the same way
+          t = t_new;
+          KDL::JntArray trial(x.rows());
+          for (unsigned int j = 0; j < x.rows(); ++j) trial(j) = clampTo(x(j) + 0.05 * t(j), c_.lower(j), c_.upper(j));
+          if (!refine(trial, iterations) || (trial.data - x.data).norm() < 1e-3) break;  // a limit, a singularity
+          x = trial;
+          const double f = measure_(x);
+          if (f < best_f) best_f = f, best = x;
+          if (k > 10 && (x.data - q.data).norm() < 0.04) break;  // back where it started: the loop is closed
+        }
+      }
+    }
+    q = best;
+    double step = 0.05;
+    for (int k = 0; k < 300 && step > 1e-9; ++k) {
+      const Eigen::VectorXd g = measureGradient(q);
+      if (g.norm() < 1e-12) return;
+      KDL::JntArray trial(q.rows());
+      for (unsigned int j = 0; j < q.rows(); ++j) trial(j) = clampTo(q(j) - step * g(j) / g.norm(), c_.lower(j), c_.upper(j));
+      double f = 0;
+      if (refine(trial, iterations) && (f = measure_(trial)) < best_f) {
+        q = trial;
+        best_f = f;
+        step = std::min(2.0 * step, 0.2);
+      } else {
+        step *= 0.5;
+      }
+    }
   }
 
   /// Null-space steps towards the preferred posture, each projected back onto the pose.
@@ -179,6 +247,7 @@ class Search {
   KDL::ChainJntToJacSolver jac_;
   KDL::ChainIkSolverVel_pinv vel_;
   KDL::ChainIkSolverPos_LMA lma_;
+  std::function<double(const KDL::JntArray&)> measure_;
 };
 
 /// The a-th deterministic start (a >= 1): a low-discrepancy point (fractional parts of multiples
@@ -209,14 +278,29 @@ void measure(const FloatingModel& model, const State& seed, const Contact& conta
 
 }  // namespace
 
-KDL::Frame contactFrame(const FloatingModel& model, const State& state, const Contact& contact) {
-  if (contact.body < 0 || static_cast<std::size_t>(contact.body) >= model.bodies().size())
-    throw ModelError("contact frame: body index " + std::to_string(contact.body) + " is outside the model's " +
-                     std::to_string(model.bodies().size()) + " bodies");
-  Kinematics kin(model);
-  const int code = forwardKinematics(model, state, kin);
-  if (code) throw ModelError(std::string("contact frame: forward kinematics failed: ") + strError(code));
-  return kin.pose(contact.body) * KDL::Frame(contact.offset);
+double reactionMeasure(const FloatingModel& model, const State& state, const Contact& contact,
+                       const std::vector<int>& joints) {
+  // Not owned: the solver lives only for this call, within the caller's model's lifetime.
+  const std::shared_ptr<const FloatingModel> shared(&model, [](const FloatingModel*) {});
+  FreeFloatingSolver solver(shared);
+  KDL::Jacobian J_h(model.nj()), J_base(model.nj());
+  int rc = solver.compute(state);
+  if (rc == E_NOERROR) rc = solver.J_star(contact, J_h);
+  if (rc == E_NOERROR) rc = solver.J_star(Contact{0, KDL::Vector::Zero()}, J_base);
+  if (rc != E_NOERROR) throw ModelError(std::string("reaction measure: ") + strError(rc));
+  const Eigen::Index k = static_cast<Eigen::Index>(joints.size());
+  Eigen::MatrixXd A(6, k), W(3, k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    A.col(i) = J_h.data.col(joints[i]);
+    W.col(i) = J_base.data.col(joints[i]).tail<3>();
+  }
+  if (k == 0) return 0.0;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(sv.size());
+  for (Eigen::Index i = 0; i < sv.size(); ++i)
+    if (sv(i) > 1e-12 * sv(0)) inv(i) = 1.0 / sv(i);
+  return (W * svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose()).norm();
 }
 
 IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, const Contact& contact,
@@ -246,6 +330,20 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
     for (unsigned int k = 0; k < n; ++k) q(c.joints[k]) = qc(k);
     return q;
   };
+  // The reaction measure of chain angles, the base where the seed puts it.
+  const auto reaction = [&](const KDL::JntArray& qc) {
+    State st = seed;
+    st.q = toModel(qc);
+    return reactionMeasure(model, st, contact, c.joints);
+  };
+  const auto measureOr = [&](const KDL::JntArray& qc) {
+    try {
+      return reaction(qc);
+    } catch (const ModelError&) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+  };
+  if (options.prefer == IkPreference::Reaction && n > 6) search.setMeasure(reaction);
   IkResult best;
   best.chain_joints = c.joints;
   double best_score = std::numeric_limits<double>::infinity();
@@ -253,14 +351,19 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
   for (unsigned int a = 0; a <= options.restarts; ++a) {
     KDL::JntArray qc = a == 0 ? q0 : start(c, q0, a);
     const bool ok = n > 0 && search.attempt(qc, iterations);
-    if (ok) search.preferPosture(qc, iterations);
+    if (ok && search.minimisesMeasure())
+      search.minimiseMeasure(qc, iterations);
+    else if (ok)
+      search.preferPosture(qc, iterations);
     IkResult r;
     r.q = toModel(qc);
     r.chain_joints = c.joints;
     r.attempts = a + 1;
     measure(model, seed, contact, world_T_goal, r);
     r.iterations = iterations;
-    if (ok && n > 6) r.preference_gradient = search.preferenceGradient(qc).norm();
+    if (ok && n > 6)
+      r.preference_gradient = (search.minimisesMeasure() ? search.measureGradient(qc) : search.preferenceGradient(qc)).norm();
+    r.reaction_measure = measureOr(qc);
     if (ok && search.withinLimits(qc) && r.position_residual <= options.position_tolerance &&
         r.orientation_residual <= options.orientation_tolerance)
       return r;

@@ -1,5 +1,9 @@
 #include "kdl_space/multibody/poses.hpp"
 
+#include <string>
+
+#include "kdl_space/spatial/errors.hpp"
+
 namespace kdl_space {
 
 PoseFigures poseFigures(const KDL::Frame& world_T_frame) {
@@ -14,6 +18,16 @@ PoseFigures poseFigures(const KDL::Frame& world_T_frame) {
   f.quaternion = Eigen::Vector4d(s * x, s * y, s * z, s * w);
   world_T_frame.M.GetRPY(f.rpy(0), f.rpy(1), f.rpy(2));
   return f;
+}
+
+KDL::Frame contactFrame(const FloatingModel& model, const State& state, const Contact& contact) {
+  if (contact.body < 0 || static_cast<std::size_t>(contact.body) >= model.bodies().size())
+    throw ModelError("contact frame: body index " + std::to_string(contact.body) + " is outside the model's " +
+                     std::to_string(model.bodies().size()) + " bodies");
+  Kinematics kin(model);
+  if (const int code = forwardKinematics(model, state, kin))
+    throw ModelError(std::string("contact frame: forward kinematics failed: ") + strError(code));
+  return contactFrame(kin, contact);
 }
 
 int linkPose(const FloatingModel& model, const State& state, int body, KDL::Frame& world_T_link) {

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "detail/text.hpp"
+#include "kdl_space/algorithm/conditioning.hpp"
 
 namespace kdl_space::operation {
 
@@ -46,8 +47,9 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
   });
   s.state = robot.state;
   s.velocity = robot.velocity;
-  if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
   ApproachOutcome outcome;
+  outcome.start_warnings = approachStartWarnings(sc);
+  if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
   std::vector<MotionSample>& samples = result.approach_samples;
   int observer_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x, const ApproachCommand& cmd) {
@@ -139,6 +141,17 @@ std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CapturePro
 }  // namespace kdl_space::operation
 
 namespace kdl_space {
+
+std::vector<Diagnostic> approachStartWarnings(const Scenario& sc) {
+  if (!sc.approach) return {};
+  const FloatingSystem& robot = sc.capture.robot;
+  Conditioning c;
+  std::vector<Diagnostic> warnings;
+  // A state the solver refuses fails the approach itself; the limit warnings stand alone then.
+  checkConfiguration(robot.model, robot.state, robot.contact, c, warnings);
+  for (Diagnostic& d : warnings) d.message = "at the start of the approach: " + d.message;
+  return warnings;
+}
 
 std::optional<JoinedSystem> joinedAfterCapture(const CaptureProblem& problem, const CaptureResult& capture) {
   const ImpactKind kind = problem.law.kind;

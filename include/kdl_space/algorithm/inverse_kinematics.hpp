@@ -14,10 +14,26 @@
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/multibody/model.hpp"
+#include "kdl_space/multibody/poses.hpp"  // contactFrame: the contact frame solved for
 #include "kdl_space/multibody/state.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {
+
+/// \brief Which of a redundant arm's solutions (more than six joints on the contact's chain: a
+/// self-motion that keeps the contact frame's pose) solveInverseKinematics returns.
+enum class IkPreference {
+  /// The one closest to IkOptions::preferred (the first-order condition: q - preferred has no
+  /// component in the self-motion).
+  Posture,
+  /// \brief The reaction-minimising one: the least reactionMeasure (the base's angular rate a
+  /// unit hand motion produces), after the reaction null space of Yoshida and Nenchev (Nenchev,
+  /// Yoshida, Umetani, "Reaction null-space control of flexible structure mounted manipulator
+  /// systems", IEEE T-RA 15(6), 1999) and the disturbance map of Dubowsky and Torres ("Path
+  /// planning for space manipulators to minimize spacecraft attitude disturbances", ICRA 1991):
+  /// from it the hand moves with the least turning of the base.
+  Reaction,
+};
 
 /// How solveInverseKinematics searches.
 struct IkOptions {
@@ -30,6 +46,8 @@ struct IkOptions {
   /// where q - preferred has no component in the self-motion (null space of the contact frame's
   /// Jacobian), the first-order condition of the closest one. Unset: the seed's q.
   std::optional<KDL::JntArray> preferred;
+  /// Which self-motion solution a redundant arm returns (`preferred` is unused for Reaction).
+  IkPreference prefer = IkPreference::Posture;
 };
 
 /// A solution.
@@ -40,9 +58,23 @@ struct IkResult {
   unsigned int iterations = 0;     ///< Newton-Raphson iterations, every attempt counted
   unsigned int attempts = 0;       ///< starts tried (1: the seed sufficed)
   std::vector<int> chain_joints;   ///< the joints that move the contact frame (model indices, base to tip)
-  /// Null-space norm |N (preferred - q)| at the solution (0 for a non-redundant arm) [rad or m]
+  /// The preference's first-order residual at the solution (0 for a non-redundant arm): Posture
+  /// |N (preferred - q)| [rad or m]; Reaction |N grad reactionMeasure| [1/rad].
   double preference_gradient = 0;
+  /// reactionMeasure at the solution (whichever preference; NaN where J* cannot be computed).
+  double reaction_measure = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// \brief The reaction measure of a configuration: || W J_h^+ ||_F, the Frobenius norm of the map
+/// from the contact frame's twist (v; w) to the base's angular velocity when the hand moves by the
+/// least-norm rates of `joints` (the others still) with zero momentum. J_h (6 x k) is J* of
+/// `contact` and W (3 x k) the angular rows of J* of the base's frame, both over the columns of
+/// `joints` (model indices); + is the Moore-Penrose inverse (singular values below 1e-12 of the
+/// largest dropped). Its square is the sum, over the six unit hand twists, of the squared base
+/// angular rate [rad/s per m/s or rad/s]: near a singularity of J_h it grows without bound.
+/// \throws ModelError for a state or contact the free-floating solver refuses.
+KDL_SPACE_EXPORT double reactionMeasure(const FloatingModel& model, const State& state, const Contact& contact,
+                                        const std::vector<int>& joints);
 
 /// \brief The pose was not reached within the tolerances after every restart (out of reach, or
 /// only outside the joints' limits). Carries how far the best attempt came and its joint angles.
@@ -72,16 +104,13 @@ class KDL_SPACE_EXPORT IkUnreachable : public InputError {
 /// ChainIkSolverPos_LMA (Levenberg-Marquardt, clamped into the limits) finished by the same steps;
 /// then from the next of `restarts` deterministic starts. For a redundant chain (more than six
 /// joints) null-space steps q += N (preferred - q), each projected back onto the pose, until
-/// N (preferred - q) vanishes. The residuals are measured by the
+/// N (preferred - q) vanishes (Posture), or (Reaction) a scan along a one-dimensional
+/// self-motion, then steps down N grad reactionMeasure, each projected back onto the pose. The residuals are measured by the
 /// model's own forwardKinematics, not by the chain's.
 /// \throws ModelError for a model with mimic joints, a contact body outside the model, a seed of
 /// the wrong size or a non-finite goal; IkUnreachable (an InputError) when no attempt reaches
 /// the tolerances: its message gives the remaining distance [m] and angle [rad].
 KDL_SPACE_EXPORT IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, const Contact& contact,
                                                  const KDL::Frame& world_T_goal, const IkOptions& options = {});
-
-/// World pose of the contact frame of `contact` at `state` (the link's axes, origin at the offset).
-/// \throws ModelError for a state of the wrong size or a contact body outside the model.
-KDL_SPACE_EXPORT KDL::Frame contactFrame(const FloatingModel& model, const State& state, const Contact& contact);
 
 }  // namespace kdl_space

@@ -26,10 +26,16 @@ KDL_SPACE_EXPORT PoseFigures poseFigures(const KDL::Frame& world_T_frame);
 
 /// \brief The contact frame of `h`: its origin at the contact point, its axes the link's
 /// (world_T_link * Frame(offset)). `kin` must hold a successful forwardKinematics and h.body
-/// must be one of its bodies (contactCode checks both).
+/// must be one of its bodies (contactCode checks both). The one definition of a contact frame:
+/// the overload below, inverse kinematics and the tools all come here.
 inline KDL::Frame contactFrame(const Kinematics& kin, const Contact& h) {
   return kin.pose(h.body) * KDL::Frame(h.offset);
 }
+
+/// \brief The contact frame of `contact` at `state` (the base where the state puts it): the
+/// overload above on a Kinematics of its own (it allocates: for a loop over states keep one).
+/// \throws ModelError for a state of the wrong size or a contact body outside the model.
+KDL_SPACE_EXPORT KDL::Frame contactFrame(const FloatingModel& model, const State& state, const Contact& contact);
 
 /// \brief The world pose of link `body` (index into model.bodies()) at `state`, the base where
 /// the state puts it: forwardKinematics into a Kinematics of its own (it allocates: for a loop

@@ -13,6 +13,7 @@
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/impact/joined_system.hpp"
+#include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/operation/motion_record.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/simulation/sampled_control.hpp"
@@ -58,7 +59,17 @@ KDL_SPACE_EXPORT double estimatedOutputRows(const Scenario& scenario, const Oper
 struct ApproachOutcome {
   ApproachRecord record;
   RigidTarget target_at_contact;  ///< the target at the end of the approach
+  /// The warnings about the pose it started from (approachStartWarnings), found before it ran.
+  std::vector<Diagnostic> start_warnings = {};
 };
+
+/// \brief The warnings about the pose an approach starts from (the scenario's robot state and
+/// contact, checkConfiguration): a joint outside its limits (named), J* near a singularity
+/// (sigma_min / sigma_max below kNearSingularRatio, with the singular values), each message
+/// beginning "at the start of the approach: ". Known before the approach runs: a near-singular
+/// start otherwise shows only as an approach that never reaches its grasp. None without an
+/// approach. Builds a solver of its own (a set-up call).
+KDL_SPACE_EXPORT std::vector<Diagnostic> approachStartWarnings(const Scenario& scenario);
 
 /// A free-floating target that separated after a point impact, moved on by itself.
 struct TargetMotion {

@@ -271,6 +271,10 @@ Scenario loadScenario(const std::string& path) {
   const Field robot = top.at("robot");
   if (robot.has("grasp") && !robot.has("place"))
     robot.at("grasp").fail("is the grasp frame that robot.place: grasp solves the arm for: add robot.place: grasp");
+  if (robot.has("place") && top.has("approach"))  // before the solve: it need not be reachable to be refused
+    robot.at("place").fail("puts the hand at the grasp before anything moves, so the approach would have nothing to "
+                           "reach: remove robot.place and robot.grasp (the approach starts from robot.q and reaches "
+                           "approach.grasp), or the approach section");
   if (robot.has("place") && !(top.has("target") || top.has("law")))
     robot.at("place").fail("a plain motion has no target to grasp: give target and law");
   // A plain motion has neither target nor law; an impact needs both.
