@@ -26,6 +26,19 @@ TEST(ApproachStart, AJointOutsideItsLimitsIsNamed) {
   EXPECT_EQ(w[0].element, "joint7");
 }
 
+TEST(ApproachStart, ANearSingularStartIsWarnedBeforeTheApproachRuns) {
+  // The case: a start pose at a singularity of J* (sigma_min / sigma_max 5e-5, a 6-joint
+  // arm's wrist pitch at 0, its roll axes in line): said before the approach, not when it fails.
+  Scenario sc = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/tests/data/scenarios/arm6_reach_capture.json");
+  sc.approach = approachScenario().approach;  // the check reads the robot's start, not the grasp
+  EXPECT_TRUE(approachStartWarnings(sc).empty()) << "wrist pitch -0.5: well conditioned";
+  sc.capture.robot.state.q(sc.capture.robot.model->jointIndex("wrist_pitch_joint")) = 0.0;
+  const std::vector<Diagnostic> w = approachStartWarnings(sc);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].kind, "near_singular");
+  EXPECT_EQ(w[0].message.rfind("at the start of the approach: ", 0), 0u) << w[0].message;
+}
+
 TEST(ApproachStart, NoApproachNoCheck) {
   Scenario sc = approachScenario();
   sc.capture.robot.state.q(sc.capture.robot.model->jointIndex("joint7")) = 4.75;
