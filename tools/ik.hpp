@@ -28,7 +28,12 @@ struct IkCliOptions {
 
 CLI::App* addIk(CLI::App& app, IkCliOptions& options);
 
-/// The JSON object of a solution (keys are a contract: see the README).
+/// The solution's keys (joint_names, q, q_by_name, moved_joints, the residuals, iterations,
+/// attempts, preference_gradient, reaction_measure); also kdl_space.ik's dict.
+Json ikSolutionJson(const FloatingModel& model, const IkResult& result);
+
+/// The JSON object of a solution: the scenario, contact and goal, then ikSolutionJson (keys are a
+/// contract: see the README).
 Json ikJson(const Scenario& scenario, const KDL::Frame& goal, const IkResult& result);
 
 void runIk(const IkCliOptions& options, std::ostream& out);

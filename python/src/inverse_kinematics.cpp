@@ -3,26 +3,16 @@
 // residuals and angles as attributes, when the pose is out of reach.
 #include "capture_types.hpp"
 #include "conversions.hpp"
+#include "ik.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 
 namespace kdl_space::python {
 namespace {
 
+/// The CLI's JSON keys (ikSolutionJson), q as a NumPy array.
 py::dict solutionDict(const FloatingModel& model, const IkResult& r) {
-  py::dict q_by_name, d;
-  py::list moved;
-  for (unsigned int j = 0; j < model.nj(); ++j) q_by_name[py::str(model.jointNames()[j])] = r.q(j);
-  for (int j : r.chain_joints) moved.append(model.jointNames()[j]);
-  d["joint_names"] = model.jointNames();
+  py::dict d = py::module_::import("json").attr("loads")(cli::ikSolutionJson(model, r).dump());
   d["q"] = toNumpyVec(r.q.data);
-  d["q_by_name"] = q_by_name;
-  d["moved_joints"] = moved;
-  d["position_residual"] = r.position_residual;
-  d["orientation_residual"] = r.orientation_residual;
-  d["iterations"] = r.iterations;
-  d["attempts"] = r.attempts;
-  d["preference_gradient"] = r.preference_gradient;
-  d["reaction_measure"] = r.reaction_measure;
   return d;
 }
 

@@ -3,13 +3,13 @@
 1e-9 rad inside the limits, on the default arm, the dual-arm tree and a 6-joint arm; the scenario
 form; an out-of-reach pose raises InputError carrying how far it came."""
 import math
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 import kdl_space
 from conftest import SOURCE_DIR
+from urdf_numpy import homogeneous, rpy_matrix, urdf_fk, urdf_limits
 
 ROBOTS = [
     (SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector"),
@@ -18,84 +18,26 @@ ROBOTS = [
 ]
 
 
-def rpy_matrix(r, p, y):
-    """URDF's R = Rz(y) Ry(p) Rx(r)."""
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return rz @ ry @ rx
-
-
-def axis_angle(axis, angle):
-    k = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
-
-
-def homogeneous(R, p):
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, p
-    return T
-
-
-def urdf_fk(path, link, q_by_name, base_pose):
-    """World pose (4x4) of `link` from the URDF's joints alone."""
-    joints = {}
-    for j in ET.parse(path).getroot().iter("joint"):
-        origin = j.find("origin")
-        xyz = [float(v) for v in origin.get("xyz", "0 0 0").split()] if origin is not None else [0, 0, 0]
-        rpy = [float(v) for v in origin.get("rpy", "0 0 0").split()] if origin is not None else [0, 0, 0]
-        axis = j.find("axis")
-        joints[j.find("child").get("link")] = dict(
-            name=j.get("name"), type=j.get("type"), parent=j.find("parent").get("link"),
-            T=homogeneous(rpy_matrix(*rpy), xyz),
-            axis=[float(v) for v in axis.get("xyz").split()] if axis is not None else [1, 0, 0])
-    T = np.eye(4)
-    while link in joints:
-        j = joints[link]
-        q = q_by_name.get(j["name"], 0.0)
-        if j["type"] in ("revolute", "continuous"):
-            motion = homogeneous(axis_angle(j["axis"], q), [0, 0, 0])
-        elif j["type"] == "prismatic":
-            motion = homogeneous(np.eye(3), q * np.asarray(j["axis"]) / np.linalg.norm(j["axis"]))
-        else:
-            motion = np.eye(4)
-        T = j["T"] @ motion @ T
-        link = j["parent"]
-    return base_pose @ T
-
-
 def rotation_angle(Ra, Rb):
     R = Ra.T @ Rb
     s = 0.5 * np.linalg.norm([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
     return math.atan2(s, 0.5 * (np.trace(R) - 1))
 
 
-def limits_of(path):
-    out = {}
-    for j in ET.parse(path).getroot().iter("joint"):
-        lim = j.find("limit")
-        if j.get("type") in ("revolute", "prismatic") and lim is not None:
-            out[j.get("name")] = (float(lim.get("lower")), float(lim.get("upper")))
-        elif j.get("type") in ("revolute", "continuous", "prismatic"):
-            out[j.get("name")] = (-math.pi, math.pi)
-    return out
-
-
 @pytest.mark.parametrize("path,link", ROBOTS, ids=[p.stem for p, _ in ROBOTS])
 def test_reaches_poses_of_random_in_limit_configurations(path, link):
     model = kdl_space.load_urdf(str(path))
-    limits = limits_of(path)
+    limits = {name: (lo, hi) for name, (lo, hi, _) in urdf_limits(path).items()}
+    limits.update({name: (-math.pi, math.pi) for name in model.joint_names if name not in limits})  # continuous
     offset = np.array([0.02, 0.01, -0.04])
     base = homogeneous(rpy_matrix(0.2, 0.1, -0.7), [0.5, 1.0, -0.3])
     rng = np.random.default_rng(3)
     for _ in range(5):
         truth = {n: rng.uniform(*limits[n]) for n in model.joint_names}
-        goal = urdf_fk(path, link, truth, base) @ homogeneous(np.eye(3), offset)
+        goal = urdf_fk(path, truth, base)[link] @ homogeneous(np.eye(3), offset)
         seed = kdl_space.State(model, q={n: rng.uniform(*limits[n]) for n in model.joint_names}, base_pose=base)
         r = kdl_space.ik(seed, model.contact(link, offset), goal)
-        reached = urdf_fk(path, link, r["q_by_name"], base) @ homogeneous(np.eye(3), offset)
+        reached = urdf_fk(path, r["q_by_name"], base)[link] @ homogeneous(np.eye(3), offset)
         assert np.linalg.norm(reached[:3, 3] - goal[:3, 3]) <= 1e-9
         assert rotation_angle(reached[:3, :3], goal[:3, :3]) <= 1e-9
         assert r["position_residual"] <= 1e-9 and r["orientation_residual"] <= 1e-9
@@ -111,7 +53,7 @@ def test_reaches_poses_of_random_in_limit_configurations(path, link):
 def test_scenario_form_uses_the_scenarios_contact_and_base():
     scenario = kdl_space.load_scenario(str(SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"))
     truth = {"joint1": -0.2, "joint2": 0.9, "joint3": 0.4, "joint4": 1.2, "joint5": 0.3, "joint6": -0.8, "joint7": 0.5}
-    goal = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector", truth, np.eye(4)) @ homogeneous(
+    goal = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", truth, np.eye(4))["end_effector"] @ homogeneous(
         np.eye(3), [0, 0, 0.05])
     r = kdl_space.inverse_kinematics(scenario, goal, preferred=truth)
     for n, v in truth.items():  # the preferred posture is on the pose's self-motion: it is the answer
@@ -135,13 +77,13 @@ def test_prefer_reaction_turns_the_base_no_more_than_the_posture():
     self-motion in tests/study/test_ik_reaction.cpp.)"""
     scenario = kdl_space.load_scenario(str(SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"))
     truth = {"joint1": -0.2, "joint2": 0.9, "joint3": 0.4, "joint4": 1.2, "joint5": 0.3, "joint6": -0.8, "joint7": 0.5}
-    goal = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector", truth, np.eye(4)) @ homogeneous(
+    goal = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", truth, np.eye(4))["end_effector"] @ homogeneous(
         np.eye(3), [0, 0, 0.05])
     posture = kdl_space.ik(scenario, goal, preferred=truth)
     reaction = kdl_space.ik(scenario, goal, prefer="reaction")
     assert reaction["position_residual"] <= 1e-9 and reaction["orientation_residual"] <= 1e-9
     assert reaction["reaction_measure"] <= posture["reaction_measure"]
-    reached = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", "end_effector", reaction["q_by_name"], np.eye(4)) @ \
+    reached = urdf_fk(SOURCE_DIR / "urdf" / "space_arm7.urdf", reaction["q_by_name"], np.eye(4))["end_effector"] @ \
         homogeneous(np.eye(3), [0, 0, 0.05])
     assert np.abs(reached - goal).max() <= 1e-9
     with pytest.raises(ValueError, match="prefer"):

@@ -3,23 +3,14 @@ inside the URDF's limits (read here with ElementTree), better than the scenario 
 weighted sum that is the sum of its terms; the refusals."""
 import json
 import subprocess
-import xml.etree.ElementTree as ET
 
 import pytest
 
 import kdl_space
 from conftest import CAPTURE_SCENARIO, SOURCE_DIR, ARM
+from urdf_numpy import urdf_limits
 
 ARM6 = SOURCE_DIR / "tests" / "data" / "scenarios" / "arm6_reach_capture.json"
-
-
-def limits(urdf):
-    out = {}
-    for joint in ET.parse(urdf).getroot().iter("joint"):
-        limit = joint.find("limit")
-        if joint.get("type") in ("revolute", "prismatic") and limit is not None:
-            out[joint.get("name")] = (float(limit.get("lower")), float(limit.get("upper")), float(limit.get("velocity")))
-    return out
 
 
 def test_the_same_plan_as_the_command(cli):
@@ -37,7 +28,7 @@ def test_the_plan_is_inside_the_limits_and_better_than_the_nominal():
     plan = kdl_space.plan_capture(kdl_space.load_scenario(str(CAPTURE_SCENARIO)), scan=11)
     assert plan.optimum["feasible"]
     assert plan.objective < plan.nominal_objective
-    for name, (lower, upper, velocity) in limits(ARM).items():
+    for name, (lower, upper, velocity) in urdf_limits(ARM).items():
         assert lower <= plan.q_by_name[name] <= upper, name
         assert abs(plan.qdot_after[plan.joint_names.index(name)]) <= velocity, name
     assert list(plan.q) == [plan.q_by_name[n] for n in plan.joint_names]
