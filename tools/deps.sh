@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   libnlopt-cxx-dev                                                           # capture planning (kdl_space plan)
   gnuplot-nox
+  libjs-three                                                                # three.js, inlined into simulate --html's page
+  chromium                                                                   # headless browser: the --html page's tests
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
   python3-pykdl                                                              # its PyKDL interop tests
   python3-matplotlib                                                         # examples/notebook.py

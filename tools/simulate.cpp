@@ -12,6 +12,7 @@
 #include "capture.hpp"
 #include "cli_common.hpp"
 #include "csv_writer.hpp"
+#include "html_writer.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "operation_report.hpp"
 #include "plot_writer.hpp"
@@ -27,7 +28,9 @@ namespace fs = std::filesystem;
 void checkOutputs(const SimulateOptions& o) {
   if (!o.plot.empty()) plotTerminal(o.plot);
   if (!o.scene.empty()) sceneTerminal(o.scene, 3);
-  const std::pair<const char*, std::string> outputs[] = {{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}};
+  if (!o.html.empty()) checkHtmlLibrary("--html", o.html);
+  const std::pair<const char*, std::string> outputs[] = {
+      {"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}, {"--html", o.html}};
   std::error_code ec;
   for (const auto& [option, path] : outputs) {
     if (path.empty()) continue;
@@ -38,7 +41,7 @@ void checkOutputs(const SimulateOptions& o) {
         throw UsageError(std::string(option) + " and " + other + " name the same file " + path);
   }
   for (const auto& [option, path] : outputs)
-    if (!path.empty() && std::string(option) != "--csv" && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
+    if (!path.empty() && (std::string(option) == "--plot" || std::string(option) == "--scene") && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
       throw InputError(std::string(option) + " " + path +
                        ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
 }
@@ -71,9 +74,15 @@ struct Streams {
   std::optional<CsvWriter> csv;
   std::unique_ptr<AtomicFile> plot_file;
   std::optional<PlotWriter> plot;
+  std::unique_ptr<AtomicFile> html_file;
+  std::optional<HtmlWriter> html;  ///< the page's frames, decimated as the samples come
 
-  explicit Streams(const SimulateOptions& o) {
+  Streams(const SimulateOptions& o, const Scenario& sc) {
     if (!o.plot.empty()) plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
+    if (!o.html.empty()) {
+      html_file = std::make_unique<AtomicFile>(o.html, "--html");
+      html.emplace(sc);
+    }
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
     if (!o.csv.empty()) {
@@ -87,15 +96,24 @@ struct Streams {
   }
 };
 
-/// An approach that never reached its grasp: what happened is written out (the CSV, the plot)
-/// before the run is refused (its samples are held: at most approach.max_duration's).
-void writeApproachOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& partial, Streams& out) {
+/// An approach that never reached its grasp: what happened is written out (the CSV, the plot,
+/// the page: how close it came) before the run is refused (its samples are held: at most
+/// approach.max_duration's).
+void writeApproachOutputs(const SimulateOptions& o, const Scenario& sc, const OperationResult& partial, Streams& out,
+                          const std::string& why) {
   const std::vector<std::string>& joints = sc.capture.robot.model->jointNames();
-  for (const MotionSample& x : partial.approach_samples) out.add(o, sc, joints, x);
+  OperationResult so_far = partial;  // the robot alone: the system the approach moved
+  so_far.model = sc.capture.robot.model;
+  for (const MotionSample& x : partial.approach_samples) {
+    out.add(o, sc, joints, x);
+    if (out.html) out.html->add(so_far, x);
+  }
   if (out.csv) out.csv->close();
   if (out.plot) out.plot->draw(title(sc) + ": the approach", true);
+  if (out.html) out.html->write(*out.html_file, so_far, title(sc) + ": the approach", "The approach failed: " + why);
   if (out.csv) out.csv->file().commit();
   if (out.plot_file) out.plot_file->commit();
+  if (out.html_file) out.html_file->commit();
 }
 
 /// Ctrl-C while the outputs are drawn: nothing is named.
@@ -115,20 +133,19 @@ void writeOutputs(const SimulateOptions& o, const Scenario& sc, const OperationR
     scene_file = std::make_unique<AtomicFile>(o.scene, "--scene");
     writeScene(*scene_file, sceneSnapshots(sc, r), title(sc), "--scene");
   }
+  if (out.html) out.html->write(*out.html_file, r, title(sc));
   checkInterrupt();
-  AtomicFile* csv_file = out.csv ? &out.csv->file() : nullptr;
-  AtomicFile* plot_file = out.plot ? out.plot_file.get() : nullptr;
-  if (csv_file) csv_file->commit();
+  AtomicFile* const files[] = {out.csv ? &out.csv->file() : nullptr, out.plot ? out.plot_file.get() : nullptr,
+                               scene_file.get(), out.html ? out.html_file.get() : nullptr};
+  std::vector<AtomicFile*> named;
   try {
-    if (plot_file) plot_file->commit();
-    try {
-      if (scene_file) scene_file->commit();
-    } catch (const InputError&) {
-      if (plot_file) plot_file->retract();
-      throw;
-    }
-  } catch (const InputError&) {
-    if (csv_file) csv_file->retract();
+    for (AtomicFile* f : files)
+      if (f) {
+        f->commit();
+        named.push_back(f);
+      }
+  } catch (const InputError&) {  // a failed rename takes the others back
+    for (AtomicFile* f : named) f->retract();
     throw;
   }
 }
@@ -148,6 +165,10 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
       ->type_name("FILE")->check(file_name);
   cmd->add_option("--scene", o.scene, "Draw the scene in 3-D at the start, at the contact and at the end (.svg or .png)")
       ->type_name("FILE")->check(file_name);
+  cmd->add_option("--html", o.html,
+                  "Write the run as an interactive 3-D animation: one self-contained HTML page (the robot's URDF "
+                  "visuals, the target, the contact point, the hand's path, the impulse; a time line with the phases)")
+      ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   cmd->add_option("--max-output-rows", o.max_output_rows,
                   "Refuse a run that could give more output rows (samples of the approach and the motion) than this, "
@@ -159,17 +180,18 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
 void runSimulate(const SimulateOptions& o, std::ostream& out) {
   checkOutputs(o);
   const Scenario sc = loadScenario(o.scenario);
-  for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}})
+  for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}, {"--html", o.html}})
     refuseOverwritingInputs(option, path, scenarioInputs(sc));  // the URDFs it names too
   OperationOptions options;
   options.duration = o.duration;
   checkOutputSize(o, sc, options);
   options.keep_samples = false;  // the CSV and the plot's data are written as the samples come
   options.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
-  Streams streams(o);
-  if (!o.csv.empty() || !o.plot.empty())
+  Streams streams(o, sc);
+  if (!o.csv.empty() || !o.plot.empty() || !o.html.empty())
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
       streams.add(o, sc, so_far.model->jointNames(), x);
+      if (streams.html) streams.html->add(so_far, x);
     };
   // Before the run, --json too: a start pose near a singularity otherwise shows only as a failed
   // approach, which prints no JSON.
@@ -180,7 +202,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   } catch (const OperationError& e) {
     // Ctrl-C: the temporaries go with `streams`; nothing partial is left.
     if (e.code() == E_CANCELLED) throw Interrupted(std::string(e.what()) + "; no output written");
-    if (e.partial() && e.partial()->approach && !e.partial()->approach->record.reached) writeApproachOutputs(o, sc, *e.partial(), streams);
+    if (e.partial() && e.partial()->approach && !e.partial()->approach->record.reached) writeApproachOutputs(o, sc, *e.partial(), streams, e.what());
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);

@@ -13,7 +13,7 @@ namespace kdl_space::cli {
 struct SimulateOptions {
   std::string scenario;
   std::optional<double> duration;
-  std::string csv, plot, scene;
+  std::string csv, plot, scene, html;
   bool json = false;
   /// The most output rows a run may produce (approach and motion: estimatedOutputRows); a double,
   /// so that 1e9 can be written as such.

@@ -15,6 +15,7 @@
 #include "detail/text.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
+#include "parsers/urdf/urdf_parse.hpp"
 #include "parsers/urdf/urdf_xml.hpp"
 
 namespace kdl_space {
@@ -29,10 +30,12 @@ class CapturedLog : public console_bridge::OutputHandler {
   std::vector<std::string> errors;
 };
 
+}  // namespace
+
 /// Parses with urdfdom; its error messages become the error text. urdfdom returns a model even
 /// after some errors (an unparsable number in <inertial> leaves the link massless): any logged
 /// error refuses the file.
-urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& source) {
+urdf::ModelInterfaceSharedPtr parseUrdfXml(const std::string& xml, const std::string& source) {
   static std::mutex console_mutex;  // console_bridge's handler is process-wide
   std::lock_guard<std::mutex> lock(console_mutex);
   CapturedLog log;
@@ -55,6 +58,8 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, const std::string& s
   }
   return model;
 }
+
+namespace {
 
 /// The base inertia in the base link's frame, from urdfdom (kdl_parser would drop it).
 KDL::RigidBodyInertia baseInertia(const urdf::Link& base) {
@@ -114,7 +119,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
   std::vector<std::string> unlimited;
   const std::string xml = detail::withUnlimitedRevolutesContinuous(written, unlimited);
   for (const std::string& joint : unlimited) rules::checkRevoluteWithoutLimit(joint, findings);
-  const urdf::ModelInterfaceSharedPtr model = parse(xml, source);
+  const urdf::ModelInterfaceSharedPtr model = parseUrdfXml(xml, source);
   std::vector<Diagnostic> diagnostics;
   auto fail = [&](const std::string& what) -> void { throw ModelError(source + ": " + what); };
 
@@ -177,7 +182,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
 
   // kdl_parser on a copy prepared so it has nothing to warn about (PITFALLS.md #2): no root
   // inertia, the dropped floating joint gone.
-  const urdf::ModelInterfaceSharedPtr for_kdl = parse(xml, source);
+  const urdf::ModelInterfaceSharedPtr for_kdl = parseUrdfXml(xml, source);
   for_kdl->root_link_ = for_kdl->links_.at(base->name);
   for_kdl->root_link_->inertial.reset();
   KDL::Tree tree;

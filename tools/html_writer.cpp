@@ -1,0 +1,254 @@
+#include "html_writer.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "capture.hpp"
+#include "html_page.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
+#include "scene_writer.hpp"
+
+namespace kdl_space::cli {
+namespace {
+
+/// Base64 of raw bytes (the page decodes it with atob into typed arrays).
+std::string base64(const void* bytes, std::size_t n) {
+  static const char* const abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const auto* p = static_cast<const unsigned char*>(bytes);
+  std::string out;
+  out.reserve((n + 2) / 3 * 4);
+  for (std::size_t i = 0; i < n; i += 3) {
+    const unsigned v = (p[i] << 16) | ((i + 1 < n ? p[i + 1] : 0) << 8) | (i + 2 < n ? p[i + 2] : 0);
+    out += abc[(v >> 18) & 63];
+    out += abc[(v >> 12) & 63];
+    out += i + 1 < n ? abc[(v >> 6) & 63] : '=';
+    out += i + 2 < n ? abc[v & 63] : '=';
+  }
+  return out;
+}
+
+std::string readText(const std::string& path, const std::string& where) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || text.str().empty())
+    throw InputError(where + "cannot read " + path + " (Debian package libjs-three; tools/deps.sh installs it)");
+  return text.str();
+}
+
+/// Position and quaternion (x y z w) of a frame, appended as floats.
+void pushPose(std::vector<float>& out, const KDL::Frame& f) {
+  double x, y, z, w;
+  f.M.GetQuaternion(x, y, z, w);
+  for (double v : {f.p.x(), f.p.y(), f.p.z(), x, y, z, w}) out.push_back(static_cast<float>(v));
+}
+
+void pushHidden(std::vector<float>& out) {
+  for (int k = 0; k < 7; ++k) out.push_back(std::nanf(""));
+}
+
+Json poseJson(const KDL::Frame& f) {
+  double x, y, z, w;
+  f.M.GetQuaternion(x, y, z, w);
+  return Json::array({f.p.x(), f.p.y(), f.p.z(), x, y, z, w});
+}
+
+/// A body's box of inertia in its own frame (what a link without a drawable visual shows).
+Json inertiaBoxJson(const Body& b) {
+  const SceneBox box = equivalentBox(b.mass, b.I_com, b.com);
+  const Vector3d size = box.size.cwiseMax(1e-3);  // a point mass still shows
+  return {{"shape", "box"}, {"size", {size.x(), size.y(), size.z()}}, {"origin", poseJson(box.pose)},
+          {"rgba", {0.75, 0.75, 0.78, 0.5}}, {"inertia_box", true}};
+}
+
+Json visualJson(const LinkVisual& v) {
+  static const char* const shapes[] = {"box", "cylinder", "sphere", "mesh"};
+  Json j = {{"shape", shapes[static_cast<int>(v.shape)]},
+            {"size", {v.size.x(), v.size.y(), v.size.z()}},
+            {"origin", poseJson(v.origin)}};
+  if (v.rgba) j["rgba"] = {(*v.rgba)(0), (*v.rgba)(1), (*v.rgba)(2), (*v.rgba)(3)};
+  return j;
+}
+
+/// The page's text with `</` escaped, so that nothing inside a <script> ends it.
+std::string scriptSafe(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += "<\\";
+    else out += s[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+void checkHtmlLibrary(const std::string& option, const std::string& path) {
+  for (const char* file : {kThreeJs, kOrbitControlsJs})
+    if (std::ifstream(file).fail())
+      throw InputError(option + " " + path + ": three.js is not installed (" + file +
+                       "; Debian package libjs-three; tools/deps.sh installs it)");
+}
+
+HtmlWriter::HtmlWriter(const Scenario& sc, double frames_per_second, std::size_t max_frames)
+    : sc_(sc), step_(1.0 / frames_per_second), max_frames_(std::max<std::size_t>(2, max_frames)) {
+  const FloatingModel& robot = *sc.capture.robot.model;
+  for (const Body& b : robot.bodies()) links_.push_back(b.name);
+  visuals_ = readUrdfVisuals(sc.robot_urdf);
+  std::vector<Diagnostic> warnings;
+  for (const auto& [link, list] : visuals_)
+    for (const LinkVisual& v : list)
+      if (v.shape == LinkVisual::Shape::Mesh)
+        warnings.push_back({link, "--html: the mesh " + v.mesh_file +
+                                      " is drawn as the link's box of inertia (meshes are not read yet)",
+                            "", Severity::Warning});
+  warnOnStderr(warnings);
+  if (sc.impact)
+    if (const auto* rigid = std::get_if<RigidTarget>(&sc.capture.target)) {
+      target_ = *rigid;
+      tumble_.emplace(*rigid);
+    }
+}
+
+std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const MotionSample& x) {
+  const FloatingModel& model = *so_far.model;
+  if (model_ != &model) {  // a new system (the capture): its bodies by the robot's link names
+    model_ = &model;
+    index_.assign(links_.size(), -1);
+    target_body_ = -1;
+    for (std::size_t i = 0; i < model.bodies().size(); ++i) {
+      bool robot = false;
+      for (std::size_t k = 0; k < links_.size(); ++k)
+        if (model.bodies()[i].name == links_[k]) index_[k] = static_cast<int>(i), robot = true;
+      if (!robot && model.bodies()[i].mass > 0.0) target_body_ = static_cast<int>(i);  // the last: a joined target
+    }
+  }
+  State state(model);
+  state.world_T_base = KDL::Frame(KDL::Rotation::Quaternion(x.quat(0), x.quat(1), x.quat(2), x.quat(3)), toKDL(x.p));
+  for (Eigen::Index j = 0; j < x.q.size() && j < static_cast<Eigen::Index>(model.nj()); ++j) state.q(j) = x.q(j);
+  Kinematics kin(model);
+  std::vector<float> f;
+  if (forwardKinematics(model, state, kin) != E_NOERROR) return f;  // not drawn
+  const Contact& h = sc_.capture.robot.contact;
+  const int hand = h.body >= 0 ? index_[h.body] : -1;
+  const Vector3d c = hand >= 0 ? kin.point(Contact{hand, h.offset}) : Vector3d::Constant(std::nan(""));
+  for (int k = 0; k < 3; ++k) f.push_back(static_cast<float>(c(k)));
+  for (int i : index_)
+    if (i >= 0) pushPose(f, kin.pose(i)); else pushHidden(f);
+  if (!target_) return f;
+  // The target's frame: tumbling before the capture; then held by the hand, joined (its body's
+  // inertia box), or tumbling on from the capture.
+  const bool after = x.phase == Phase::Post && so_far.capture;
+  RigidTarget now = *target_;
+  if (!after) {
+    if (tumble_->at(x.t, now) != E_NOERROR) { pushHidden(f); return f; }
+    pushPose(f, now.pose);
+    return f;
+  }
+  if (so_far.joined && target_body_ >= 0) {
+    const SceneBox box = equivalentBox(model.bodies()[target_body_].mass, kin.I_com[target_body_], kin.com[target_body_]);
+    const SceneBox local = equivalentBox(target_->mass, target_->inertia, target_->com);
+    pushPose(f, box.pose * local.pose.Inverse());  // the frame whose box is where the body's is
+    return f;
+  }
+  const auto* at_contact = std::get_if<RigidTarget>(&so_far.at_contact.target);
+  if (!at_contact) { pushHidden(f); return f; }
+  if (so_far.payload_attached && hand >= 0) {
+    if (!hand_T_target_) hand_T_target_ = kin.pose(hand).Inverse() * at_contact->pose;  // the first sample after
+    pushPose(f, kin.pose(hand) * *hand_T_target_);
+    return f;
+  }
+  if (!after_) {
+    RigidTarget separated = *at_contact;
+    separated.twist = so_far.capture->target_twist_after;
+    after_.emplace(separated);
+  }
+  if (after_->at(x.t - so_far.t_capture, now) != E_NOERROR) pushHidden(f); else pushPose(f, now.pose);
+  return f;
+}
+
+void HtmlWriter::add(const OperationResult& so_far, const MotionSample& x) {
+  std::vector<float> f = frameOf(so_far, x);
+  if (f.empty()) return;
+  if (x.t >= next_t_ || x.phase == Phase::Capture) {
+    keep(std::move(f), x);
+    last_.clear();
+  } else {
+    last_ = std::move(f);
+    last_t_ = x.t;
+    last_phase_ = static_cast<int>(x.phase);
+  }
+}
+
+void HtmlWriter::keep(std::vector<float> frame, const MotionSample& x) {
+  if (!times_.empty() && x.t < times_.back()) return;
+  data_.insert(data_.end(), frame.begin(), frame.end());
+  times_.push_back(x.t);
+  phases_.push_back(static_cast<int>(x.phase));
+  next_t_ = x.t + step_;
+  if (times_.size() < max_frames_) return;
+  // Full: every other frame goes (the capture's stays), at half the rate from now on.
+  const std::size_t stride = frame.size();
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < times_.size(); ++k) {
+    if (k % 2 && phases_[k] != static_cast<int>(Phase::Capture) && k + 1 != times_.size()) continue;
+    std::memmove(&data_[kept * stride], &data_[k * stride], stride * sizeof(float));
+    times_[kept] = times_[k];
+    phases_[kept] = phases_[k];
+    ++kept;
+  }
+  data_.resize(kept * stride);
+  times_.resize(kept);
+  phases_.resize(kept);
+  step_ *= 2.0;
+  next_t_ = times_.back() + step_;
+}
+
+void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const std::string& title, const std::string& note) {
+  const std::string where = "--html " + file.path() + ": ";
+  if (!last_.empty() && (times_.empty() || last_t_ > times_.back())) {
+    data_.insert(data_.end(), last_.begin(), last_.end());
+    times_.push_back(last_t_);
+    phases_.push_back(last_phase_);
+    last_.clear();
+  }
+  if (times_.empty()) throw InputError(where + "the run gave no sample to draw");
+  const FloatingModel& robot = *sc_.capture.robot.model;
+  Json links = Json::array();
+  for (const Body& b : robot.bodies()) {
+    Json visuals = Json::array();
+    if (const auto it = visuals_.find(b.name); it != visuals_.end())
+      for (const LinkVisual& v : it->second) visuals.push_back(v.shape == LinkVisual::Shape::Mesh ? inertiaBoxJson(b) : visualJson(v));
+    if (visuals.empty()) visuals.push_back(inertiaBoxJson(b));
+    links.push_back({{"name", b.name}, {"visuals", visuals}});
+  }
+  Json data = {{"title", title}, {"note", note}, {"links", links}, {"frameCount", times_.size()},
+               {"stride", data_.size() / times_.size()}, {"frames", base64(data_.data(), data_.size() * sizeof(float))},
+               {"times", base64(times_.data(), times_.size() * sizeof(double))}, {"phases", phases_},
+               {"phaseNames", {"approach", "contact", "after", "motion"}}};
+  data["target"] = nullptr;
+  if (target_) {
+    const Vector3d size = equivalentBox(target_->mass, target_->inertia, target_->com).size.cwiseMax(1e-3);  // in its frame
+    const SceneBox local = equivalentBox(target_->mass, target_->inertia, target_->com);
+    data["target"] = {{"size", {size.x(), size.y(), size.z()}}, {"origin", poseJson(local.pose)}};
+  }
+  data["tCapture"] = nullptr;
+  data["impulse"] = nullptr;
+  if (sc_.impact && (r.approach || r.capture)) data["tCapture"] = r.t_capture;
+  if (r.capture) {
+    const Vector6d& F = r.capture->impulse.F;
+    data["impulse"] = {F(0), F(1), F(2)};
+  }
+  std::ofstream out(file.tmp(), std::ios::binary);
+  if (!out) throw InputError(where + "cannot write in its folder");
+  out << kHtmlHead << "<script>\n" << readText(kThreeJs, where) << "\n</script>\n<script>\n"
+      << readText(kOrbitControlsJs, where) << "\n</script>\n<script>\nwindow.KDL_DATA = "
+      << scriptSafe(data.dump()) << ";\n</script>\n" << kHtmlBody;
+  out.close();
+  if (!out) throw InputError(where + "cannot write the page (disk full?)");
+}
+
+}  // namespace kdl_space::cli

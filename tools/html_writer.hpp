@@ -1,0 +1,68 @@
+// The capture as an interactive 3-D animation (`kdl_space simulate --html FILE`): one
+// self-contained HTML page (three.js inlined from Debian's libjs-three; no server, no network)
+// with the robot's URDF visuals posed per frame, the target, the base frame, the contact point,
+// the hand's path, the impulse as an arrow, and a time line with the phases. The run's samples
+// are decimated to a display rate as they come: the memory held is the frames kept (at most
+// max_frames), not the run.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/parsers/urdf/urdf_visuals.hpp"
+#include "kdl_space/simulation/rigid_motion.hpp"
+
+namespace kdl_space::cli {
+
+/// Where the page's 3-D library comes from (Debian's libjs-three).
+inline const char* const kThreeJs = "/usr/share/javascript/three/three.min.js";
+inline const char* const kOrbitControlsJs = "/usr/share/javascript/three/examples/js/controls/OrbitControls.js";
+
+/// Throws InputError naming `option` and `path` when three.js is not installed.
+void checkHtmlLibrary(const std::string& option, const std::string& path);
+
+class HtmlWriter {
+ public:
+  /// Reads the robot's visuals (a mesh is drawn, for now, as its link's box of inertia: a warning
+  /// on stderr names the file). `frames_per_second`: the display rate.
+  HtmlWriter(const Scenario& sc, double frames_per_second = 30.0, std::size_t max_frames = 3000);
+  /// One sample of the run; `so_far.model` is the system it belongs to.
+  void add(const OperationResult& so_far, const MotionSample& x);
+  /// Writes the page into file.tmp() (the caller commits it). `note`: shown over the view (e.g.
+  /// "the approach did not reach its grasp").
+  void write(const AtomicFile& file, const OperationResult& r, const std::string& title, const std::string& note = "");
+  std::size_t frames() const { return times_.size(); }
+
+ private:
+  struct Frame;
+  std::vector<float> frameOf(const OperationResult& so_far, const MotionSample& x);
+  void keep(std::vector<float> frame, const MotionSample& x);
+
+  const Scenario& sc_;
+  double step_;          ///< the display interval [s], doubled when max_frames is passed
+  std::size_t max_frames_;
+  std::vector<std::string> links_;  ///< the robot's bodies, by name
+  std::map<std::string, std::vector<LinkVisual>> visuals_;
+  std::optional<RigidTarget> target_;     ///< a rigid target at t = 0
+  std::optional<FreeRigidMotion> tumble_;  ///< its motion before the capture
+  std::optional<FreeRigidMotion> after_;   ///< a separated target's motion after it
+  std::optional<KDL::Frame> hand_T_target_;  ///< a target held by the hand
+  const FloatingModel* model_ = nullptr;  ///< the system the index below is for
+  std::vector<int> index_;                ///< robot link -> body in model_ (-1: none)
+  int target_body_ = -1;                  ///< a joined target's body in model_
+  std::vector<float> data_;     ///< the frames kept, one after the other
+  std::vector<double> times_;
+  std::vector<int> phases_;
+  double next_t_ = -1e300;
+  std::vector<float> last_;     ///< the latest sample's frame (the run's end), if not kept
+  double last_t_ = 0.0;
+  int last_phase_ = 0;
+};
+
+}  // namespace kdl_space::cli
