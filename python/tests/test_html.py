@@ -3,6 +3,7 @@ The page's hook (window.kdlSpace) is read through `#selftest=K`, which writes it
 into <pre id="selftest"> for `--dump-dom`; the contact point is checked against the CSV of the
 same run through an independent forward kinematics (urdf_numpy), the URDF's visuals against what
 the test wrote into the URDF."""
+import base64
 import json
 import math
 import re
@@ -181,3 +182,21 @@ def test_html_may_not_overwrite_an_input(run, cli):
     done = subprocess.run([cli, "simulate", str(run["scenario"]), "--html", str(run["urdf"])], capture_output=True, text=True)
     assert done.returncode == 2 and "--html" in done.stderr and run["urdf"].exists()
     assert "<robot" in run["urdf"].read_text()
+
+
+def test_a_long_run_is_decimated(run, cli):
+    """250 s after the capture at 0.05 s (5000 samples): at most 3000 frames, in time order, the
+    run's end the last."""
+    page = run["dir"] / "long.html"
+    done = subprocess.run([cli, "simulate", str(run["scenario"]), "--duration", "250", "--html", str(page), "--json"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    data = page_data(page)
+    times = np.frombuffer(base64.b64decode(data["times"]), dtype=np.float64)
+    frames = np.frombuffer(base64.b64decode(data["frames"]), dtype=np.float32)
+    assert len(times) == data["frameCount"] <= 3000 and frames.size == data["frameCount"] * data["stride"]
+    assert np.all(np.diff(times) >= 0)
+    end = json.loads(done.stdout)
+    t_end = end["approach"]["t_contact"] + 250
+    assert abs(times[-1] - t_end) < 1e-6, (times[-1], t_end)
+    assert page.stat().st_size < 5e6
