@@ -97,7 +97,7 @@ HtmlWriter::HtmlWriter(const Scenario& sc, double frames_per_second, std::size_t
     : sc_(sc), step_(1.0 / frames_per_second), max_frames_(std::max<std::size_t>(2, max_frames)) {
   const FloatingModel& robot = *sc.capture.robot.model;
   for (const Body& b : robot.bodies()) links_.push_back(b.name);
-  visuals_ = readUrdfVisuals(sc.robot_urdf);
+  if (!sc.robot_urdf.empty()) visuals_ = readUrdfVisuals(sc.robot_urdf);
   std::vector<Diagnostic> warnings;
   for (const auto& [link, list] : visuals_)
     for (const LinkVisual& v : list)
