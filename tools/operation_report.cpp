@@ -156,6 +156,7 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"energy", record.first.T},
                          {"csv", files.csv.empty() ? Json(nullptr) : Json(files.csv)},
                          {"plot", files.plot.empty() ? Json(nullptr) : Json(files.plot)},
+                         {"html", files.html.empty() ? Json(nullptr) : Json(files.html)},
                          {"base", grounded ? "grounded" : "free"},
                          {"locked_joints", record.lockedJoints()},
                          {"momentum_balance_error", grounded ? Json(nullptr)
@@ -228,6 +229,7 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
         << " of its chart's singularity (|cos grasp_ry|): its angles are ill-conditioned there\n";
   if (!files.csv.empty()) out << "CSV: " << files.csv << "\n";
   if (!files.plot.empty()) out << "Plot: " << files.plot << "\n";
+  if (!files.html.empty()) out << "Page: " << files.html << " (open it in a browser)\n";
 }
 
 }  // namespace kdl_space::cli

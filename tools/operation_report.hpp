@@ -17,7 +17,7 @@ namespace kdl_space::cli {
 
 /// The output files named in the report (empty: none).
 struct OperationFiles {
-  std::string csv, plot;
+  std::string csv, plot, html;
 };
 
 /// The JSON object of `kdl_space simulate --json`.

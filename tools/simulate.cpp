@@ -210,7 +210,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   // What the motion found (a sampled controller's gains, a stiff servo): on stderr whatever the
   // format of stdout (they may explain a motion that then went wrong).
   warnOnStderr(r.warnings);
-  const OperationFiles files{o.csv, o.plot};
+  const OperationFiles files{o.csv, o.plot, o.html};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";
   else

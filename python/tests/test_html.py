@@ -197,6 +197,7 @@ def test_a_long_run_is_decimated(run, cli):
     assert len(times) == data["frameCount"] <= 3000 and frames.size == data["frameCount"] * data["stride"]
     assert np.all(np.diff(times) >= 0)
     end = json.loads(done.stdout)
+    assert end["simulation"]["html"] == str(page)
     t_end = end["approach"]["t_contact"] + 250
     assert abs(times[-1] - t_end) < 1e-6, (times[-1], t_end)
     assert page.stat().st_size < 5e6
