@@ -202,7 +202,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
   }
 }
 
-FloatingModel loadUrdfFile(const std::string& path) {
+std::string readUrdfText(const std::string& path) {
   // Before it is read: a device never ends, and a file of gigabytes is no robot.
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
@@ -214,8 +214,10 @@ FloatingModel loadUrdfFile(const std::string& path) {
   if (!in) throw ModelError(detail::shownPath(path) + ": cannot open the file");
   std::ostringstream text;
   text << in.rdbuf();
-  if (in.bad()) throw ModelError(path + ": cannot read the file");
-  return loadUrdfString(text.str(), path);
+  if (in.bad()) throw ModelError(detail::shownPath(path) + ": cannot read the file");
+  return text.str();
 }
+
+FloatingModel loadUrdfFile(const std::string& path) { return loadUrdfString(readUrdfText(path), path); }
 
 }  // namespace kdl_space

@@ -11,4 +11,8 @@ namespace kdl_space {
 /// document. \throws ModelError "SOURCE: not XML or not a usable URDF: ...".
 urdf::ModelInterfaceSharedPtr parseUrdfXml(const std::string& xml, const std::string& source);
 
+/// \brief A URDF file's text, checked before it is read (a regular file, within the input size
+/// limit). \throws ModelError "PATH: ..." when it is not, or cannot be opened or read.
+std::string readUrdfText(const std::string& path);
+
 }  // namespace kdl_space

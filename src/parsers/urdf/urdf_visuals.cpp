@@ -2,13 +2,8 @@
 
 #include <urdf_parser/urdf_parser.h>
 
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
-#include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/spatial/errors.hpp"
-#include "detail/text.hpp"
 #include "parsers/urdf/urdf_parse.hpp"
 
 namespace kdl_space {
@@ -74,14 +69,7 @@ std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::
 }
 
 std::map<std::string, std::vector<LinkVisual>> readUrdfVisuals(const std::string& path) {
-  if (const std::string why = fileTooLarge(path, "URDF file", max_input_file_bytes); !why.empty())
-    throw ModelError(detail::shownPath(path) + ": " + why);
-  std::ifstream in(path);
-  if (!in) throw ModelError(detail::shownPath(path) + ": cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ModelError(detail::shownPath(path) + ": cannot read the file");
-  return readUrdfVisualsString(text.str(), path);
+  return readUrdfVisualsString(readUrdfText(path), path);
 }
 
 }  // namespace kdl_space
