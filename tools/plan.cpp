@@ -44,6 +44,8 @@ void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
   if (!t.feasible) out << "           not within the limits: " << t.infeasible << "\n";
 }
 
+}  // namespace
+
 Json termsJson(const PlanTerms& t) {
   Json j;
   j["objective"] = t.objective;
@@ -55,8 +57,6 @@ Json termsJson(const PlanTerms& t) {
   if (!t.feasible) j["infeasible"] = t.infeasible;
   return j;
 }
-
-}  // namespace
 
 CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
   CLI::App* cmd = app.add_subcommand(

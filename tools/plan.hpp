@@ -29,6 +29,10 @@ struct PlanCliOptions {
 
 CLI::App* addPlan(CLI::App& app, PlanCliOptions& options);
 
+/// One configuration's terms: objective, base_rate, impulse, joint_rate_jump, feasible, violation
+/// (and infeasible: why not); also kdl_space.plan_capture's `optimum` and `nominal` dicts.
+Json termsJson(const PlanTerms& terms);
+
 /// The JSON object of a plan (keys are a contract: see the README).
 Json planJson(const Scenario& scenario, const PlanOptions& options, const CapturePlan& plan);
 

@@ -5,6 +5,7 @@
 #include "capture_types.hpp"
 #include "conversions.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
+#include "plan.hpp"
 
 namespace kdl_space::python {
 namespace {
@@ -14,17 +15,8 @@ struct PyPlan {
   std::string scenario;
 };
 
-py::dict termsDict(const PlanTerms& t) {
-  py::dict d;
-  d["objective"] = t.objective;
-  d["base_rate"] = t.base_rate;
-  d["impulse"] = t.impulse;
-  d["joint_rate_jump"] = t.joint_rate_jump;
-  d["feasible"] = t.feasible;
-  d["violation"] = t.violation;
-  if (!t.feasible) d["infeasible"] = t.infeasible;
-  return d;
-}
+/// The tool's JSON of the terms (cli::termsJson) as a dict.
+py::dict termsDict(const PlanTerms& t) { return py::module_::import("json").attr("loads")(cli::termsJson(t).dump()); }
 
 std::optional<PlanRange> rangeOf(py::handle r, const char* name) {
   if (r.is_none()) return std::nullopt;
