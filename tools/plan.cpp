@@ -31,10 +31,12 @@ void usageOrInput(const InputError& e) {
   const std::string what = e.what();
   for (const auto& [field, option] : {std::pair<std::string, std::string>{"self_motion: ", "--self-motion: "},
                                       {"wrist_roll: ", "--wrist-roll: "}, {"timing: ", "--timing: "},
+                                      {"closing_speed: ", "--closing-speed: "},
                                       {"objective: ", "--weights: "}, {"scan: ", "--scan: "}})
     if (what.rfind(field, 0) == 0) throw UsageError(option + what.substr(field.size()));
   if (what.rfind("plan: nothing to plan", 0) == 0)
-    throw UsageError(what + "; give a range with --self-motion (a redundant arm), --wrist-roll or --timing");
+    throw UsageError(what + "; give a range with --self-motion (a redundant arm), --wrist-roll, --timing or "
+                     "--closing-speed");
 }
 
 void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
@@ -60,7 +62,8 @@ Json termsJson(const PlanTerms& t) {
 
 CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
   CLI::App* cmd = app.add_subcommand(
-      "plan", "Capture planning: over the self-motion, the wrist roll and the capture instant, the arm configuration "
+      "plan", "Capture planning: over the self-motion, the wrist roll, the capture instant and the hand's closing "
+              "speed, the arm configuration "
               "whose capture disturbs the servicer least, within the joints' position and velocity limits");
   cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON) with a capture: robot, target, law")->required();
   cmd->add_option("--objective", o.objective, "What to minimise: base_rate (|w| of the base after), impulse (|f| of "
@@ -73,6 +76,10 @@ CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
       ->expected(2)->delimiter(',')->check(finiteNumber());
   cmd->add_option("--timing", o.timing, "The capture instant's range A,B [s] later along the target's tumble "
                                         "(default 0,0: now)")
+      ->expected(2)->delimiter(',')->check(finiteNumber());
+  cmd->add_option("--closing-speed", o.closing_speed,
+                  "The hand's velocity before the grasp: its closing speed along the contact frame's z, range A,B "
+                  "[m/s] (A >= 0; the joint rates before the capture are then planned; default: the scenario's)")
       ->expected(2)->delimiter(',')->check(finiteNumber());
   cmd->add_option("--scan", o.scan, "Points per searched parameter of the first scan")->check(CLI::Range(2u, 201u));
   cmd->add_option("--polish-starts", o.polish_starts, "Local polishes from the scan's best local minima")
@@ -103,6 +110,7 @@ PlanOptions planOptions(const PlanCliOptions& o) {
   if (!o.self_motion.empty()) p.self_motion = rangeOf(o.self_motion, "--self-motion");
   if (!o.wrist_roll.empty()) p.wrist_roll = rangeOf(o.wrist_roll, "--wrist-roll");
   if (!o.timing.empty()) p.timing = rangeOf(o.timing, "--timing");
+  if (!o.closing_speed.empty()) p.closing_speed = rangeOf(o.closing_speed, "--closing-speed");
   p.scan = o.scan;
   p.polish_starts = o.polish_starts;
   p.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
@@ -123,6 +131,8 @@ Json planJson(const Scenario& sc, const PlanOptions& options, const CapturePlan&
   j["joint_names"] = plan.joint_names;
   j["q"] = plan.q;
   j["q_by_name"] = by_name;
+  j["qdot_before"] = plan.qdot_before;
+  j["base_twist_before"] = plan.base_twist_before;
   j["qdot_after"] = plan.qdot_after;
   j["parameters"] = params;
   j["searched"] = plan.searched;
@@ -168,6 +178,14 @@ void runPlan(const PlanCliOptions& o, std::ostream& out) {
   for (std::size_t j = 0; j < plan.joint_names.size(); ++j)
     out << "  " << std::left << std::setw(static_cast<int>(width)) << plan.joint_names[j] << std::right << "  "
         << std::setprecision(12) << std::setw(18) << plan.q[j] << "  (" << plan.nominal_q[j] << ")\n";
+  if (!options.closing_speed) return;
+  out << "before the capture, closing on the grasp: joint rates [rad/s or m/s]\n";
+  for (std::size_t j = 0; j < plan.joint_names.size(); ++j)
+    out << "  " << std::left << std::setw(static_cast<int>(width)) << plan.joint_names[j] << std::right << "  "
+        << std::setprecision(12) << std::setw(18) << plan.qdot_before[j] << "\n";
+  out << "  base twist (v [m/s]; w [rad/s]):";
+  for (const double v : plan.base_twist_before) out << " " << std::setprecision(9) << v;
+  out << "\n";
 }
 
 }  // namespace kdl_space::cli

@@ -1,5 +1,5 @@
 // `kdl_space plan SCENARIO [--objective NAME | --weights NAME=W,...] [--self-motion A,B]
-// [--wrist-roll A,B] [--timing A,B] [--scan N] [--json]`: the arm configuration whose capture
+// [--wrist-roll A,B] [--timing A,B] [--closing-speed A,B] [--scan N] [--json]`: the arm configuration whose capture
 // disturbs the servicer least (the library's planCapture, printed): the joint angles by name, the
 // parameters, the objective at the optimum and at the scenario as written. Exit 2 for a usage
 // mistake (an unknown objective, bad weights, nothing to plan), 3 for a scenario it cannot plan.
@@ -22,6 +22,7 @@ struct PlanCliOptions {
   std::vector<double> self_motion;     ///< A B [rad]; empty: the library's default
   std::vector<double> wrist_roll;      ///< A B [rad]
   std::vector<double> timing;          ///< A B [s]
+  std::vector<double> closing_speed;   ///< A B [m/s]; empty: the scenario's rates before
   unsigned int scan = 21;
   unsigned int polish_starts = 5;
   bool json = false;

@@ -25,20 +25,28 @@ std::optional<PlanRange> rangeOf(py::handle r, const char* name) {
   return PlanRange{ab.first, ab.second};
 }
 
-PyPlan plan(const Scenario& sc, const std::string& objective, py::handle weights, py::handle self_motion,
-            py::handle wrist_roll, py::handle timing, unsigned int scan, unsigned int polish_starts) {
+/// plan_capture's keyword arguments (the ranges as given: None or a pair).
+struct PlanArgs {
+  std::string objective;
+  py::object weights, self_motion, wrist_roll, timing, closing_speed;
+  unsigned int scan, polish_starts;
+};
+
+PyPlan plan(const Scenario& sc, const PlanArgs& a) {
+  const py::handle weights = a.weights;
   PlanOptions o;
   if (!weights.is_none()) {
     o.weights.clear();
     for (const auto& [key, value] : weights.cast<py::dict>()) o.weights.emplace_back(py::str(key), value.cast<double>());
   } else {
-    o.weights = {{objective, 1.0}};
+    o.weights = {{a.objective, 1.0}};
   }
-  o.self_motion = rangeOf(self_motion, "self_motion");
-  if (const auto r = rangeOf(wrist_roll, "wrist_roll")) o.wrist_roll = *r;
-  if (const auto r = rangeOf(timing, "timing")) o.timing = *r;
-  o.scan = scan;
-  o.polish_starts = polish_starts;
+  o.self_motion = rangeOf(a.self_motion, "self_motion");
+  if (const auto r = rangeOf(a.wrist_roll, "wrist_roll")) o.wrist_roll = *r;
+  if (const auto r = rangeOf(a.timing, "timing")) o.timing = *r;
+  o.closing_speed = rangeOf(a.closing_speed, "closing_speed");
+  o.scan = a.scan;
+  o.polish_starts = a.polish_starts;
   PyPlan result{{}, sc.file};
   {
     py::gil_scoped_release nogil;
@@ -65,11 +73,15 @@ void bindPlanning(py::module_& m) {
       .def_property_readonly("q_by_name", [](const PyPlan& p) { return byName(p.plan.joint_names, p.plan.q); }, "Name -> angle.")
       .def_property_readonly("qdot_after", [](const PyPlan& p) { return toNumpyVec(Eigen::Map<const Eigen::VectorXd>(p.plan.qdot_after.data(), static_cast<Eigen::Index>(p.plan.qdot_after.size()))); },
                              "The joint rates after its capture (nj,).")
+      .def_property_readonly("qdot_before", [](const PyPlan& p) { return toNumpyVec(Eigen::Map<const Eigen::VectorXd>(p.plan.qdot_before.data(), static_cast<Eigen::Index>(p.plan.qdot_before.size()))); },
+                             "The joint rates before its capture (nj,): the scenario's, or the closing speed's when planned.")
+      .def_property_readonly("base_twist_before", [](const PyPlan& p) { return toNumpyVec(Eigen::Map<const Eigen::VectorXd>(p.plan.base_twist_before.data(), 6)); },
+                             "The base's twist before its capture (6,): (v of its origin; w), world frame.")
       .def_property_readonly("parameters", [](const PyPlan& p) {
         py::dict d;
         for (const auto& [name, value] : p.plan.parameters) d[py::str(name)] = value;
         return d;
-      }, "self_motion [rad], wrist_roll [rad], timing [s] at the optimum (those that apply).")
+      }, "self_motion [rad], wrist_roll [rad], timing [s], closing_speed [m/s] at the optimum (those that apply).")
       .def_property_readonly("searched", [](const PyPlan& p) { return p.plan.searched; }, "The parameters searched.")
       .def_property_readonly("objective", [](const PyPlan& p) { return p.plan.optimum.objective; }, "At the optimum.")
       .def_property_readonly("optimum", [](const PyPlan& p) { return termsDict(p.plan.optimum); },
@@ -86,30 +98,31 @@ void bindPlanning(py::module_& m) {
       });
   const char* doc =
       "Capture planning (as `kdl_space plan`): over a redundant arm's self-motion, the wrist roll about the contact "
-      "frame's z and optionally the capture instant, the configuration whose capture minimises `objective` "
+      "frame's z and optionally the capture instant and the hand's closing speed on the grasp before it (the joint "
+      "rates before the capture then follow from J*: see capture_plan.hpp), the configuration whose capture minimises `objective` "
       "(base_rate, impulse or joint_rate_jump) or the weighted sum `weights` ({name: weight}), inside the joints' "
       "position and velocity limits. Ranges are (lower, upper) pairs; None: the default (self_motion (-1, 1) for a "
-      "redundant arm, wrist_roll (-pi/2, pi/2), timing (0, 0)); (a, a) fixes one. Returns a CapturePlan; InputError "
+      "redundant arm, wrist_roll (-pi/2, pi/2), timing (0, 0), closing_speed: the scenario's rates); (a, a) fixes one. Returns a CapturePlan; InputError "
       "for nothing to plan, an unknown term or a bad weight.";
   m.def(
       "plan_capture",
       [=](const PyScenario& s, const std::string& objective, py::object weights, py::object self_motion, py::object wrist_roll,
-          py::object timing, unsigned int scan, unsigned int polish_starts) {
-        return plan(s.scenario, objective, weights, self_motion, wrist_roll, timing, scan, polish_starts);
+          py::object timing, py::object closing_speed, unsigned int scan, unsigned int polish_starts) {
+        return plan(s.scenario, {objective, weights, self_motion, wrist_roll, timing, closing_speed, scan, polish_starts});
       },
       py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
       py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),
-      py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
+      py::arg("closing_speed") = py::none(), py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
   m.def(
       "plan_capture",
       [=](const std::string& path, const std::string& objective, py::object weights, py::object self_motion,
-          py::object wrist_roll, py::object timing, unsigned int scan, unsigned int polish_starts) {
+          py::object wrist_roll, py::object timing, py::object closing_speed, unsigned int scan, unsigned int polish_starts) {
         const Scenario sc = loadScenario(path);
-        return plan(sc, objective, weights, self_motion, wrist_roll, timing, scan, polish_starts);
+        return plan(sc, {objective, weights, self_motion, wrist_roll, timing, closing_speed, scan, polish_starts});
       },
       py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
       py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),
-      py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
+      py::arg("closing_speed") = py::none(), py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
 }
 
 }  // namespace kdl_space::python

@@ -51,3 +51,18 @@ def test_refusals():
         kdl_space.plan_capture(str(ARM6), wrist_roll=(0.0, 0.0))
     with pytest.raises(ValueError, match="wrist_roll"):
         kdl_space.plan_capture(str(ARM6), wrist_roll=(1.0, -1.0))
+
+
+def test_a_planned_closing_speed_is_the_commands_and_within_the_rate_limits(cli):
+    plan = kdl_space.plan_capture(str(CAPTURE_SCENARIO), closing_speed=(0.01, 0.05), scan=5)
+    tool = json.loads(subprocess.run([cli, "plan", str(CAPTURE_SCENARIO), "--scan", "5", "--closing-speed", "0.01,0.05",
+                                      "--json"], check=True, capture_output=True, text=True).stdout)
+    assert plan.searched == tool["searched"] == ["self_motion", "wrist_roll", "closing_speed"]
+    assert plan.parameters == tool["parameters"]
+    assert list(plan.qdot_before) == tool["qdot_before"]
+    assert list(plan.base_twist_before) == tool["base_twist_before"]
+    assert 0.01 <= plan.parameters["closing_speed"] <= 0.05
+    for name, (_, _, velocity) in urdf_limits(ARM).items():
+        assert abs(plan.qdot_before[plan.joint_names.index(name)]) <= velocity, name
+    with pytest.raises(kdl_space.InputError, match="closing_speed: must be >= 0"):
+        kdl_space.plan_capture(str(ARM6), closing_speed=(-1.0, 0.0))

@@ -15,11 +15,17 @@
 namespace kdl_space {
 namespace {
 
-/// The searched parameters: their ranges, in the order self_motion, wrist_roll, timing.
+/// The searched parameters and their ranges, in the scan's order: the self-motion and the closing
+/// speed vary fastest (neither changes the hand's goal: one inverse kinematics serves their rows).
 struct Box {
-  std::vector<int> which;  ///< 0 self_motion, 1 wrist_roll, 2 timing
+  std::vector<int> which;  ///< 0 self_motion, 1 wrist_roll, 2 timing, 3 closing_speed
   std::vector<PlanRange> range;
+  unsigned int N = 2;      ///< the scan's points per parameter
 };
+
+double& coordinate(PlanPoint& p, int which) {
+  return which == 0 ? p.self_motion : which == 1 ? p.wrist_roll : which == 2 ? p.timing : p.closing_speed;
+}
 
 /// The search: the chart's evaluator, the box, and the best feasible configuration seen.
 struct Search {
@@ -31,6 +37,7 @@ struct Search {
   PlanPoint best;
   PlanTerms best_terms;
   bool cancelled = false;
+  std::string first_why;  ///< why the first configuration evaluated is out (for the error)
 
   bool stopped() {
     if (!cancelled && evaluator.options().cancelled) cancelled = evaluator.options().cancelled();
@@ -40,8 +47,7 @@ struct Search {
   PlanPoint point(const std::vector<double>& x) const {
     PlanPoint p = fixed;
     for (std::size_t k = 0; k < x.size(); ++k) {
-      const double v = std::clamp(x[k], box.range[k].lower, box.range[k].upper);
-      (box.which[k] == 0 ? p.self_motion : box.which[k] == 1 ? p.wrist_roll : p.timing) = v;
+      coordinate(p, box.which[k]) = std::clamp(x[k], box.range[k].lower, box.range[k].upper);
     }
     return p;
   }
@@ -49,7 +55,7 @@ struct Search {
     if (stopped()) return PlanEvaluator::score(PlanTerms{});
     const PlanPoint p = point(x);
     const PlanTerms t = evaluator.evaluate(p);
-    ++evaluations;
+    if (++evaluations == 1 && !t.feasible) first_why = t.infeasible;
     if (t.feasible && (!found || t.objective < best_terms.objective)) {
       found = true;
       best = p;
@@ -63,8 +69,8 @@ double nloptScore(const std::vector<double>& x, std::vector<double>& /*grad*/, v
   return static_cast<Search*>(data)->score(x);
 }
 
-/// The scan: N points per searched parameter, the self-motion varying fastest (the inverse
-/// kinematics of a (wrist_roll, timing) pair is computed once for its row). Returns the scores.
+/// The scan: N points per searched parameter, the box's first varying fastest (the inverse
+/// kinematics of a (wrist_roll, timing) pair is computed once for its rows). Returns the scores.
 std::vector<double> scan(Search& s, unsigned int N, std::vector<std::vector<double>>& points) {
   const std::size_t d = s.box.which.size();
   std::size_t total = 1;
@@ -135,38 +141,46 @@ void polish(Search& s, const std::vector<double>& start, unsigned int N, unsigne
 CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
   PlanEvaluator evaluator(scenario, options);  // or InputError: the options, nothing to plan
   const PlanOptions& o = evaluator.options();
-  Search s{evaluator, {}, {}, 0, false, {}, {}, false};
-  const PlanRange ranges[3] = {*o.self_motion, o.wrist_roll, o.timing};
-  for (int k = 0; k < 3; ++k) {
+  Search s{evaluator, {}, {}, 0, false, {}, {}, false, {}};
+  const bool closing = o.closing_speed.has_value();
+  const PlanRange ranges[4] = {*o.self_motion, o.wrist_roll, o.timing, closing ? *o.closing_speed : PlanRange{}};
+  for (const int k : {0, 3, 1, 2}) {
     if (ranges[k].searched()) {
       s.box.which.push_back(k);
       s.box.range.push_back(ranges[k]);
     }
   }
-  s.fixed = PlanPoint{ranges[0].lower, ranges[1].lower, ranges[2].lower};
+  for (int k = 0; k < 4; ++k) coordinate(s.fixed, k) = ranges[k].lower;
+  if (!closing) s.fixed.closing_speed = std::numeric_limits<double>::quiet_NaN();  // the scenario's rates
+  // The scan's points per parameter: `scan`, fewer when the grid would pass scan_limit in all.
+  const std::size_t d = s.box.which.size();
+  s.box.N = o.scan;
+  if (std::pow(static_cast<double>(o.scan), static_cast<double>(d)) > o.scan_limit)
+    s.box.N = std::max(2u, static_cast<unsigned int>(std::floor(std::pow(o.scan_limit, 1.0 / d) + 1e-9)));
   std::vector<std::vector<double>> points;
-  const std::vector<double> scores = scan(s, o.scan, points);
-  const std::vector<std::size_t> minima = localMinima(scores, o.scan, s.box.which.size());
-  for (std::size_t m = 0; m < minima.size() && m < o.polish_starts; ++m) polish(s, points[minima[m]], o.scan, o.polish_evaluations);
+  const std::vector<double> scores = scan(s, s.box.N, points);
+  const std::vector<std::size_t> minima = localMinima(scores, s.box.N, d);
+  for (std::size_t m = 0; m < minima.size() && m < o.polish_starts; ++m) polish(s, points[minima[m]], s.box.N, o.polish_evaluations);
   CapturePlan plan;
   plan.cancelled = s.cancelled;
   if (s.cancelled && !s.found) return plan;
   if (!s.found)
     throw InputError("plan: no configuration in the box keeps the joints inside their position and velocity limits "
-                     "(widen or move the ranges, or check the scenario's robot.q)");
+                     "(widen or move the ranges, or check the scenario's robot.q); at the box's first point: " +
+                     s.first_why);
 
   const FloatingModel& model = *scenario.capture.robot.model;
   plan.joint_names = model.jointNames();
-  plan.optimum = evaluator.evaluate(s.best, &plan.q, &plan.qdot_after);
-  const char* names[3] = {"self_motion", "wrist_roll", "timing"};
-  const double values[3] = {s.best.self_motion, s.best.wrist_roll, s.best.timing};
-  for (int k = 0; k < 3; ++k) {
+  plan.optimum = evaluator.evaluate(s.best, &plan);
+  const std::vector<std::string>& names = planParameters();
+  for (int k = 0; k < 4; ++k) {
     if (k == 0 && !evaluator.redundant()) continue;
     if (k == 2 && !ranges[2].searched() && ranges[2].lower == 0.0) continue;
-    plan.parameters.emplace_back(names[k], values[k]);
+    if (k == 3 && !closing) continue;
+    plan.parameters.emplace_back(names[k], coordinate(s.best, k));
     if (ranges[k].searched()) plan.searched.emplace_back(names[k]);
   }
-  plan.nominal = evaluator.evaluate(PlanPoint{});
+  plan.nominal = evaluator.evaluate(PlanPoint{});  // the scenario as written
   plan.nominal_q.resize(model.nj());
   for (unsigned int j = 0; j < model.nj(); ++j) plan.nominal_q[j] = scenario.capture.robot.state.q(j);
   plan.evaluations = s.evaluations + 2;

@@ -3,6 +3,8 @@
 // capture (CaptureSolver, the study's solver), its terms and the limits.
 #include "planning/plan_evaluator.hpp"
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <cmath>
 
@@ -27,6 +29,11 @@ void checkRange(const PlanRange& r, const char* name, double lowest) {
 const std::vector<std::string>& planObjectiveTerms() {
   static const std::vector<std::string> terms{"base_rate", "impulse", "joint_rate_jump"};
   return terms;
+}
+
+const std::vector<std::string>& planParameters() {
+  static const std::vector<std::string> names{"self_motion", "wrist_roll", "timing", "closing_speed"};
+  return names;
 }
 
 PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& options)
@@ -59,13 +66,98 @@ PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& option
   checkRange(options_.timing, "timing", 0.0);
   if (options_.timing.upper > 0.0 && !rigid)
     throw InputError("timing: only a rigid target's tumble can be followed (the target is free-floating)");
-  if (!options_.self_motion->searched() && !options_.wrist_roll.searched() && !options_.timing.searched())
-    throw InputError("plan: nothing to plan: no parameter has a range (self_motion, wrist_roll, timing)");
+  if (options_.closing_speed) checkRange(*options_.closing_speed, "closing_speed", 0.0);
+  if (!options_.self_motion->searched() && !options_.wrist_roll.searched() && !options_.timing.searched() &&
+      !(options_.closing_speed && options_.closing_speed->searched()))
+    throw InputError("plan: nothing to plan: no parameter has a range (self_motion, wrist_roll, timing, closing_speed)");
   if (options_.scan < 2) throw InputError("scan: at least 2 points per parameter, got " + std::to_string(options_.scan));
+  if (options_.scan_limit < 2) throw InputError("scan_limit: at least 2 points, got " + std::to_string(options_.scan_limit));
   hand0_ = contactFrame(*robot.model, robot.state, robot.contact);
   if (rigid && options_.timing.upper > 0.0) tumble_.emplace(*rigid);  // or ModelError "FreeRigidMotion: ..."
   problem_ = scenario.capture;
   if (rigid) target_at_ = *rigid;
+  if (options_.closing_speed) setUpClosing();
+}
+
+void PlanEvaluator::setUpClosing() {
+  const FloatingSystem& robot = scenario_.capture.robot;
+  if (robot.response == Response::JointsLocked)
+    throw InputError("closing_speed: the robot's joints are locked at the capture (its response): the hand cannot be "
+                     "moved to close on the grasp; plan with free joints");
+  // The system's momentum is what the scenario's state gives: the arm's rates before the capture
+  // change, the servicer's momentum does not (the base moves as they make it: MATH.md eq. 4).
+  dynamics_ = std::make_unique<FreeFloatingSolver>(robot.model);
+  if (const int rc = dynamics_->compute(robot.state))
+    throw ModelError(std::string("closing_speed: the robot's dynamics at the scenario's state: ") + strError(rc));
+  if (const int rc = dynamics_->momentum(robot.velocity.base_twist, robot.velocity.qdot, PL_g_))
+    throw ModelError(std::string("closing_speed: the robot's momentum at the scenario's state: ") + strError(rc));
+  if (const auto* other = std::get_if<FloatingSystem>(&scenario_.capture.target)) {
+    // A free-floating target stays where the scenario puts it (timing is for a rigid one): its
+    // grasp point's twist, once.
+    FreeFloatingSolver target(other->model);
+    Vector6d PL_g;
+    KDL::Twist t;
+    int rc = target.compute(other->state);
+    if (!rc) rc = target.momentum(other->velocity.base_twist, other->velocity.qdot, PL_g);
+    if (!rc) rc = target.handTwist(other->contact, other->velocity.qdot, PL_g, t);
+    if (rc) throw ModelError(std::string("closing_speed: the target's grasp point twist: ") + strError(rc));
+    floating_target_twist_ = toEigen(t);
+  }
+}
+
+bool PlanEvaluator::closing(FloatingSystem& robot, double speed, std::string& why) {
+  const FloatingModel& model = *robot.model;
+  const unsigned int n = model.nj();
+  if (const int rc = dynamics_->compute(robot.state)) {
+    why = std::string("closing_speed: the robot's dynamics cannot be computed here (") + strError(rc) + ")";
+    return false;
+  }
+  // The twist the hand must have: the grasp point's on the target, plus the closing speed along
+  // the contact frame's z (the approach axis); no rotation relative to the target.
+  const KDL::Frame hand = contactFrame(model, robot.state, robot.contact);
+  Vector6d t_h = floating_target_twist_;
+  if (std::holds_alternative<RigidTarget>(problem_.target)) {
+    const RigidTarget& target = std::get<RigidTarget>(problem_.target);
+    const Vector3d com = toEigen(target.pose * toKDL(target.com));
+    t_h = target.twist;
+    t_h.head<3>() += target.twist.tail<3>().cross(toEigen(hand.p) - com);
+  }
+  t_h.head<3>() += speed * toEigen(hand.M.UnitZ());
+  // What the joints must add to the twist the hand has with them still: the momentum's share
+  // R_h M_a^-1 (P_g; L_g) free-floating (eq. 4), the base's twist carried to h when grounded.
+  KDL::Jacobian jac(n);
+  KDL::Twist still;
+  int rc = 0;
+  const bool grounded = robot.response == Response::Grounded;
+  if (grounded) {
+    rc = dynamics_->J(robot.contact, jac);
+    still = robot.velocity.base_twist.RefPoint(hand.p - robot.state.world_T_base.p);
+  } else {
+    rc = dynamics_->J_star(robot.contact, jac);
+    if (!rc) rc = dynamics_->handTwist(robot.contact, KDL::JntArray(n), PL_g_, still);
+  }
+  if (rc) {
+    why = std::string("closing_speed: the hand's Jacobian cannot be computed here (") + strError(rc) + ")";
+    return false;
+  }
+  Eigen::MatrixXd A = jac.data;
+  for (unsigned int j = 0; j < n && !robot.locked.empty(); ++j)
+    if (robot.locked[j]) A.col(j).setZero();  // braked: its rate stays 0
+  const Vector6d b = t_h - toEigen(still);
+  // The smallest joint rates that give it (J*+; a redundant arm's self-motion rate is 0).
+  const Eigen::VectorXd qdot = A.completeOrthogonalDecomposition().solve(b);
+  const double miss = (A * qdot - b).norm();
+  if (!qdot.allFinite() || miss > 1e-9 * std::max(1.0, b.norm())) {
+    why = "closing_speed: the arm cannot give the hand the grasp point's twist (it misses by " + detail::number(miss) +
+          "): fewer than 6 free joints, or a singular configuration";
+    return false;
+  }
+  robot.velocity.qdot.data = qdot;
+  if (!grounded && (rc = dynamics_->baseTwist(PL_g_, robot.velocity.qdot, robot.velocity.base_twist))) {
+    why = std::string("closing_speed: the base's twist cannot be computed (") + strError(rc) + ")";
+    return false;
+  }
+  return true;
 }
 
 bool PlanEvaluator::handPlaced(const PlanPoint& x, std::string& why) {
@@ -108,25 +200,32 @@ bool PlanEvaluator::handPlaced(const PlanPoint& x, std::string& why) {
   return true;
 }
 
-double PlanEvaluator::violation(const std::vector<double>& q, const KDL::JntArray& qdot_after, std::string& why) const {
-  const FloatingModel& model = *scenario_.capture.robot.model;
+double PlanEvaluator::violation(const FloatingSystem& robot, const KDL::JntArray& qdot_after, bool rates_before,
+                                std::string& why) const {
+  const FloatingModel& model = *robot.model;
   double v = 0.0;
   for (unsigned int j = 0; j < model.nj(); ++j) {
     const JointProperties& p = model.jointProperties()[j];
-    const double outside = std::max(p.lower - q[j], q[j] - p.upper);
+    const double q = robot.state.q(j);
+    const double outside = std::max(p.lower - q, q - p.upper);
     const double over = std::abs(qdot_after(j)) - p.velocity;
+    // The rates before the capture are the scenario's unless the plan sets them (closing_speed).
+    const double before = rates_before ? std::abs(robot.velocity.qdot(j)) - p.velocity : 0.0;
     if (outside > 0.0 && why.empty())
-      why = "joint " + model.jointNames()[j] + " at " + detail::number(q[j]) + ", outside its limits [" +
+      why = "joint " + model.jointNames()[j] + " at " + detail::number(q) + ", outside its limits [" +
             detail::number(p.lower) + ", " + detail::number(p.upper) + "]";
+    if (before > 0.0 && why.empty())
+      why = "joint " + model.jointNames()[j] + ": rate " + detail::number(robot.velocity.qdot(j)) +
+            " before the capture (closing on the grasp), over its velocity limit " + detail::number(p.velocity);
     if (over > 0.0 && why.empty())
       why = "joint " + model.jointNames()[j] + ": rate " + detail::number(qdot_after(j)) +
             " after the capture, over its velocity limit " + detail::number(p.velocity);
-    v += std::max(outside, 0.0) + std::max(over, 0.0);
+    v += std::max(outside, 0.0) + std::max(over, 0.0) + std::max(before, 0.0);
   }
   return v;
 }
 
-PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, std::vector<double>* q_out, std::vector<double>* qdot_out) {
+PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, CapturePlan* joints) {
   PlanTerms t;
   t.objective = std::numeric_limits<double>::quiet_NaN();
   if (!handPlaced(x, t.infeasible)) return t;
@@ -147,6 +246,9 @@ PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, std::vector<double>* q_out
       return t;
     }
   if (std::holds_alternative<RigidTarget>(problem_.target)) problem_.target = target_at_;
+  robot.velocity = scenario_.capture.robot.velocity;
+  const bool closes = dynamics_ && !std::isnan(x.closing_speed);
+  if (closes && !closing(robot, x.closing_speed, t.infeasible)) return t;
   const CaptureResult* r = nullptr;
   try {
     r = &capture_.solve(problem_);
@@ -165,10 +267,15 @@ PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, std::vector<double>* q_out
   t.objective = 0.0;
   for (const auto& [name, weight] : options_.weights)
     t.objective += weight * (name == "base_rate" ? t.base_rate : name == "impulse" ? t.impulse : t.joint_rate_jump);
-  t.violation = violation(q, r->robot.after.qdot, t.infeasible);
+  t.violation = violation(robot, r->robot.after.qdot, closes, t.infeasible);
   t.feasible = t.violation == 0.0 && std::isfinite(t.objective);
-  if (q_out) *q_out = q;
-  if (qdot_out) *qdot_out = std::vector<double>(r->robot.after.qdot.data.data(), r->robot.after.qdot.data.data() + n);
+  if (joints) {
+    joints->q = q;
+    joints->qdot_before.assign(robot.velocity.qdot.data.data(), robot.velocity.qdot.data.data() + n);
+    const Vector6d base = toEigen(robot.velocity.base_twist);
+    joints->base_twist_before.assign(base.data(), base.data() + 6);
+    joints->qdot_after.assign(r->robot.after.qdot.data.data(), r->robot.after.qdot.data.data() + n);
+  }
   return t;
 }
 

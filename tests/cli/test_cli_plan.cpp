@@ -17,13 +17,20 @@ namespace {
 const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml";
 const std::string kArm6 = dataDir() + "/scenarios/arm6_reach_capture.json";
 
-/// scenarios/tumbling_box_capture.yaml's capture (its robot, target and law; the motion section
-/// dropped) with the joints at `q`, as a file: its `q:` line replaced, its URDF path made absolute.
-std::string captureScenario(const nlohmann::json& q_by_name) {
+std::string byName(const nlohmann::json& by_name) {
   std::ostringstream q;
   q.precision(17);
-  for (auto it = q_by_name.begin(); it != q_by_name.end(); ++it)
-    q << (it == q_by_name.begin() ? "" : ", ") << it.key() << ": " << it.value().get<double>();
+  for (auto it = by_name.begin(); it != by_name.end(); ++it)
+    q << (it == by_name.begin() ? "" : ", ") << it.key() << ": " << it.value().get<double>();
+  return q.str();
+}
+
+/// scenarios/tumbling_box_capture.yaml's capture (its robot, target and law; the motion section
+/// dropped) with the joints at `q`, as a file: its `q:` line replaced, its URDF path made absolute;
+/// with `qdot` and `base_twist` (not null) its rates before and its base's twist replaced too.
+std::string captureScenario(const nlohmann::json& q_by_name, const nlohmann::json& qdot = nullptr,
+                            const nlohmann::json& base_twist = nullptr) {
+  const std::string q = byName(q_by_name);
   const std::string path = ::testing::TempDir() + "kdl_space_planned_" + std::to_string(getpid()) + ".yaml";
   std::ifstream in(kScenario);
   std::ofstream f(path);
@@ -31,8 +38,15 @@ std::string captureScenario(const nlohmann::json& q_by_name) {
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("simulation:", 0) == 0) break;
     if (line.rfind("  q: {", 0) == 0) {
-      line = "  q: {" + q.str() + "}";
+      line = "  q: {" + q + "}";
       ++replaced;
+    }
+    if (!qdot.is_null() && line.rfind("  qdot: {", 0) == 0) line = "  qdot: {" + byName(qdot) + "}";
+    if (!base_twist.is_null() && line.rfind("  base: {", 0) == 0) {
+      std::ostringstream t;
+      t.precision(17);
+      for (std::size_t k = 0; k < 6; ++k) t << (k ? ", " : "") << base_twist[k].get<double>();
+      line = "  base: {position: [0, 0, 0], rpy: [0, 0, 0], twist: [" + t.str() + "]}";
     }
     if (line.rfind("  urdf: ../urdf/", 0) == 0) line = "  urdf: " + urdfDir() + "/" + line.substr(16);
     f << line << "\n";
@@ -75,6 +89,29 @@ TEST(PlanTool, ThePlannedJointsReproduceTheObjectiveThroughCapture) {
               1e-9 * j.at("nominal_objective").get<double>());
 }
 
+TEST(PlanTool, APlannedClosingSpeedGivesTheRatesBeforeThatReproduceItThroughCapture) {
+  const ToolRun run = kdlSpace("plan " + kScenario + " --scan 7 --closing-speed 0.01,0.05 --json");
+  ASSERT_EQ(run.rc, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j.at("searched"), (nlohmann::json{"self_motion", "wrist_roll", "closing_speed"}));
+  const double c = j.at("parameters").at("closing_speed").get<double>();
+  EXPECT_GE(c, 0.01);
+  EXPECT_LE(c, 0.05);
+  nlohmann::json qdot = nlohmann::json::object();
+  for (std::size_t k = 0; k < 7; ++k) qdot[j.at("joint_names")[k].get<std::string>()] = j.at("qdot_before")[k];
+  ASSERT_EQ(j.at("base_twist_before").size(), 6u);
+  const std::string path = captureScenario(j.at("q_by_name"), qdot, j.at("base_twist_before"));
+  const ToolRun capture = kdlSpace("capture " + path + " --json");
+  std::remove(path.c_str());
+  ASSERT_EQ(capture.rc, 0) << capture.err;
+  const double planned = j.at("objective").get<double>();
+  EXPECT_NEAR(baseRateOf(nlohmann::json::parse(capture.out)), planned, 1e-9 * planned);
+  // The text names the rates before the capture.
+  const ToolRun text = kdlSpace("plan " + kScenario + " --scan 5 --closing-speed 0.01,0.05");
+  ASSERT_EQ(text.rc, 0) << text.err;
+  EXPECT_NE(text.out.find("before the capture, closing on the grasp"), std::string::npos) << text.out;
+}
+
 TEST(PlanTool, PrintsTheJointAnglesByNameAndBothObjectives) {
   const ToolRun run = kdlSpace("plan " + kArm6 + " --scan 9 --objective joint_rate_jump");
   ASSERT_EQ(run.rc, 0) << run.err;
@@ -96,6 +133,7 @@ TEST(PlanTool, UsageMistakesExit2NamingTheOption) {
   expect(kArm6 + " --wrist-roll 0,0", 2, "nothing to plan");
   expect(kArm6 + " --self-motion -1,1", 2, "--self-motion");
   expect(kArm6 + " --wrist-roll 1,-1", 2, "--wrist-roll");
+  expect(kArm6 + " --closing-speed -0.1,0.1", 2, "--closing-speed: must be >= 0");
   expect(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/base_attitude_control.yaml", 3, "no capture to plan");
 }
 

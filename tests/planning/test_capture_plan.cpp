@@ -11,7 +11,9 @@
 #include <map>
 #include <memory>
 
+#include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
@@ -31,6 +33,8 @@ struct Configuration {
   std::vector<double> q;
   RigidTarget target;
   KDL::Frame goal;
+  bool closing = false;      ///< the rates before are `velocity` (closingRates), not the scenario's
+  FloatingVelocity velocity;
 };
 
 bool configure(const Scenario& sc, double s, double psi, double t, Configuration& c) {
@@ -70,12 +74,52 @@ bool configure(const Scenario& sc, double s, double psi, double t, Configuration
   return true;
 }
 
+/// The grasp point's twist on a rigid target (v at p; w), world frame.
+Vector6d pointTwist(const RigidTarget& target, const Vector3d& p) {
+  Vector6d t = target.twist;
+  t.head<3>() += target.twist.tail<3>().cross(p - toEigen(target.pose * toKDL(target.com)));
+  return t;
+}
+
+/// The chart's rates before the capture at closing speed `speed` (capture_plan.hpp), rebuilt
+/// here: the hand's twist the grasp point's plus speed along the contact frame's z; the joint
+/// rates J*^+ (t_h - R_h M_a^-1 (P_g; L_g)) by an SVD's least squares; the base's twist from the
+/// scenario's momentum. False where the arm cannot give that twist.
+bool closingRates(const Scenario& sc, Configuration& c, double speed) {
+  const FloatingSystem& robot = sc.capture.robot;
+  const unsigned int n = robot.model->nj();
+  FreeFloatingSolver at_scenario(robot.model), here(robot.model);
+  Vector6d PL_g;
+  EXPECT_EQ(at_scenario.compute(robot.state), 0);
+  EXPECT_EQ(at_scenario.momentum(robot.velocity.base_twist, robot.velocity.qdot, PL_g), 0);
+  State s = robot.state;
+  for (unsigned int j = 0; j < n; ++j) s.q(j) = c.q[j];
+  EXPECT_EQ(here.compute(s), 0);
+  KDL::Jacobian J_star(n);
+  KDL::Twist still;
+  EXPECT_EQ(here.J_star(robot.contact, J_star), 0);
+  EXPECT_EQ(here.handTwist(robot.contact, KDL::JntArray(n), PL_g, still), 0);
+  const KDL::Frame hand = contactFrame(*robot.model, s, robot.contact);
+  Vector6d t_h = pointTwist(c.target, toEigen(hand.p));
+  t_h.head<3>() += speed * toEigen(hand.M.UnitZ());
+  const Vector6d b = t_h - toEigen(still);
+  const Eigen::MatrixXd A = J_star.data;
+  const Eigen::VectorXd qdot = A.jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(b);
+  if ((A * qdot - b).norm() > 1e-9 * std::max(1.0, b.norm())) return false;
+  c.velocity.qdot = KDL::JntArray(n);
+  c.velocity.qdot.data = qdot;
+  EXPECT_EQ(here.baseTwist(PL_g, c.velocity.qdot, c.velocity.base_twist), 0);
+  c.closing = true;
+  return true;
+}
+
 /// |w| of the base after the capture at `c` by solveCapture; NaN outside the joints' position or
 /// velocity limits (or where the capture cannot be computed).
 double baseRate(const Scenario& sc, const Configuration& c, CaptureResult* out = nullptr) {
   CaptureProblem p = sc.capture;
   const FloatingModel& model = *p.robot.model;
   for (unsigned int j = 0; j < model.nj(); ++j) p.robot.state.q(j) = c.q[j];
+  if (c.closing) p.robot.velocity = c.velocity;
   p.target = c.target;
   CaptureResult r;
   try {
@@ -86,7 +130,8 @@ double baseRate(const Scenario& sc, const Configuration& c, CaptureResult* out =
   if (out) *out = r;
   for (unsigned int j = 0; j < model.nj(); ++j) {
     const JointProperties& lim = model.jointProperties()[j];
-    if (c.q[j] < lim.lower || c.q[j] > lim.upper || std::abs(r.robot.after.qdot(j)) > lim.velocity)
+    if (c.q[j] < lim.lower || c.q[j] > lim.upper || std::abs(r.robot.after.qdot(j)) > lim.velocity ||
+        (c.closing && std::abs(p.robot.velocity.qdot(j)) > lim.velocity))
       return std::numeric_limits<double>::quiet_NaN();
   }
   return toEigen(r.robot.after.base_twist).tail<3>().norm();
@@ -212,6 +257,124 @@ TEST(CapturePlan, AWeightedSumIsTheSumOfItsTerms) {
   EXPECT_NEAR(t.impulse, r.impulse.F.head<3>().norm(), 1e-12 * t.impulse);
 }
 
+TEST(CapturePlan, SixJointArmNoWorseThanA41x41GridOfWristRollAndClosingSpeed) {
+  const Scenario sc = loadScenario(kArm6);
+  PlanOptions o;
+  o.closing_speed = PlanRange{0.0, 0.1};
+  const CapturePlan plan = planCapture(sc, o);
+  ASSERT_EQ(plan.searched, (std::vector<std::string>{"wrist_roll", "closing_speed"}));
+  const GridBest best = grid(sc, o.wrist_roll, *o.closing_speed, [&](double psi, double c, Configuration& cfg) {
+    return configure(sc, 0.0, psi, 0.0, cfg) && closingRates(sc, cfg, c);
+  });
+  ASSERT_GT(best.feasible, 100);
+  EXPECT_LE(plan.optimum.objective, best.value);
+  // Its numbers through solveCapture, with the joints and the rates before that it reports.
+  Configuration c;
+  ASSERT_TRUE(configure(sc, 0.0, parameter(plan, "wrist_roll"), 0.0, c));
+  c.q = plan.q;
+  c.closing = true;
+  c.velocity = FloatingVelocity(*sc.capture.robot.model);
+  c.velocity.qdot.data = Eigen::Map<const Eigen::VectorXd>(plan.qdot_before.data(), 6);
+  c.velocity.base_twist = toTwist(Eigen::Map<const Vector6d>(plan.base_twist_before.data()));
+  EXPECT_NEAR(baseRate(sc, c), plan.optimum.base_rate, 1e-12 * plan.optimum.base_rate);
+}
+
+TEST(CapturePlan, ClosingRatesGiveTheHandTheGraspPointsTwistWithTheScenariosMomentum) {
+  // The redundant arm, all four parameters: the scan is 10 points a parameter (scan_limit), and
+  // still no worse than a 41 x 41 grid of a slice of its box (self-motion 0, capture now).
+  const Scenario sc = loadScenario(dataDir() + "/scenarios/srs_arm7_capture.yaml");
+  PlanOptions o;
+  o.self_motion = PlanRange{-1.0, 1.0};
+  o.timing = PlanRange{0.0, 2.0};
+  o.closing_speed = PlanRange{0.01, 0.08};
+  const CapturePlan plan = planCapture(sc, o);
+  ASSERT_EQ(plan.searched, (std::vector<std::string>{"self_motion", "wrist_roll", "timing", "closing_speed"}));
+  EXPECT_LE(plan.evaluations, o.scan_limit + o.polish_starts * o.polish_evaluations + 2);
+  const GridBest best = grid(sc, o.wrist_roll, *o.closing_speed, [&](double psi, double c, Configuration& cfg) {
+    return configure(sc, 0.0, psi, 0.0, cfg) && closingRates(sc, cfg, c);
+  });
+  ASSERT_GT(best.feasible, 100);
+  EXPECT_LE(plan.optimum.objective, best.value);
+
+  // Its rates before, by the second route (MomentumSolver's sweep, not J*): the hand moves with the
+  // grasp point plus the closing speed along its z, and the system's momentum is the scenario's.
+  const FloatingSystem& robot = sc.capture.robot;
+  const unsigned int n = robot.model->nj();
+  MomentumSolver second(robot.model);
+  Kinematics kin(*robot.model);
+  ASSERT_EQ(forwardKinematics(*robot.model, robot.state, kin), 0);
+  ASSERT_EQ(second.compute(kin, robot.velocity), 0);
+  const Vector6d scenario_momentum = second.momentumAtCoM();  // (P_g; L_g): the chart holds it
+  State s = robot.state;
+  for (unsigned int j = 0; j < n; ++j) s.q(j) = plan.q[j];
+  FloatingVelocity v(*robot.model);
+  v.qdot.data = Eigen::Map<const Eigen::VectorXd>(plan.qdot_before.data(), n);
+  v.base_twist = toTwist(Eigen::Map<const Vector6d>(plan.base_twist_before.data()));
+  ASSERT_EQ(forwardKinematics(*robot.model, s, kin), 0);
+  ASSERT_EQ(second.compute(kin, v), 0);
+  EXPECT_LE((second.momentumAtCoM() - scenario_momentum).norm(), 1e-12 * std::max(1.0, scenario_momentum.norm()));
+  Vector6d hand_twist;
+  ASSERT_EQ(second.contactTwist(robot.contact, hand_twist), 0);
+  RigidTarget target = std::get<RigidTarget>(sc.capture.target);
+  FreeRigidMotion tumble(target);
+  ASSERT_EQ(tumble.at(parameter(plan, "timing"), target), 0);
+  const KDL::Frame hand = contactFrame(*robot.model, s, robot.contact);
+  Vector6d expected = pointTwist(target, toEigen(hand.p));
+  expected.head<3>() += parameter(plan, "closing_speed") * toEigen(hand.M.UnitZ());
+  EXPECT_LE((hand_twist - expected).norm(), 1e-12 * expected.norm()) << hand_twist.transpose() << "\n" << expected.transpose();
+  // The smallest such rates: no share along the self-motion (J*'s null space).
+  FreeFloatingSolver here(robot.model);
+  ASSERT_EQ(here.compute(s), 0);
+  KDL::Jacobian J_star(n);
+  ASSERT_EQ(here.J_star(robot.contact, J_star), 0);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J_star.data, Eigen::ComputeFullV);
+  EXPECT_LE(std::abs(svd.matrixV().col(n - 1).dot(v.qdot.data)), 1e-12 * v.qdot.data.norm());
+  // Inside the rate limits before the capture too.
+  for (unsigned int j = 0; j < n; ++j) EXPECT_LE(std::abs(v.qdot(j)), robot.model->jointProperties()[j].velocity);
+}
+
+TEST(CapturePlan, ClosingOnAFreeFloatingTargetMatchesItsContactTwist) {
+  Scenario sc = loadScenario(dataDir() + "/scenarios/braked_robot_to_robot.yaml");
+  PlanOptions o;
+  o.self_motion = PlanRange{};
+  o.wrist_roll = PlanRange{};
+  o.closing_speed = PlanRange{0.03, 0.05};  // > 0: the closing term is part of the check
+  // Its robot brakes two joints: five cannot give the hand a 6-D twist, and the plan says so.
+  try {
+    planCapture(sc, o);
+    ADD_FAILURE() << "a five-joint arm closed on the grasp";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot give the hand the grasp point's twist"), std::string::npos) << e.what();
+  }
+  sc.capture.robot.locked.clear();
+  // A target that moves ten times slower than the scenario's: the arm follows it within its rate limits.
+  FloatingSystem& slower = std::get<FloatingSystem>(sc.capture.target);
+  slower.velocity.base_twist = slower.velocity.base_twist * 0.1;
+  slower.velocity.qdot.data *= 0.1;
+  const CapturePlan plan = planCapture(sc, o);
+  ASSERT_EQ(plan.searched, (std::vector<std::string>{"closing_speed"}));
+  // The target's contact twist by the second route (MomentumSolver on the target's state).
+  const FloatingSystem& target = std::get<FloatingSystem>(sc.capture.target);
+  MomentumSolver on_target(target.model), on_robot(sc.capture.robot.model);
+  Kinematics kin_t(*target.model), kin_r(*sc.capture.robot.model);
+  ASSERT_EQ(forwardKinematics(*target.model, target.state, kin_t), 0);
+  ASSERT_EQ(on_target.compute(kin_t, target.velocity), 0);
+  Vector6d grasp_point;
+  ASSERT_EQ(on_target.contactTwist(target.contact, grasp_point), 0);
+  const FloatingSystem& robot = sc.capture.robot;
+  FloatingVelocity v(*robot.model);
+  v.qdot.data = Eigen::Map<const Eigen::VectorXd>(plan.qdot_before.data(), robot.model->nj());
+  v.base_twist = toTwist(Eigen::Map<const Vector6d>(plan.base_twist_before.data()));
+  ASSERT_EQ(forwardKinematics(*robot.model, robot.state, kin_r), 0);
+  ASSERT_EQ(on_robot.compute(kin_r, v), 0);
+  Vector6d hand_twist;
+  ASSERT_EQ(on_robot.contactTwist(robot.contact, hand_twist), 0);
+  const KDL::Frame hand = contactFrame(*robot.model, robot.state, robot.contact);
+  Vector6d expected = grasp_point;
+  expected.head<3>() += parameter(plan, "closing_speed") * toEigen(hand.M.UnitZ());
+  EXPECT_LE((hand_twist - expected).norm(), 1e-12 * expected.norm()) << hand_twist.transpose() << "\n" << expected.transpose();
+}
+
 TEST(CapturePlan, RefusesWhatItCannotPlan) {
   const Scenario arm6 = loadScenario(kArm6);
   const auto refused = [&](const PlanOptions& o, const std::string& start) {
@@ -236,6 +399,9 @@ TEST(CapturePlan, RefusesWhatItCannotPlan) {
   o = PlanOptions{};
   o.timing = PlanRange{-1.0, 0.0};
   refused(o, "timing: must be >= 0");
+  o = PlanOptions{};
+  o.closing_speed = PlanRange{-0.1, 0.1};
+  refused(o, "closing_speed: must be >= 0");
   const Scenario plain = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/base_attitude_control.yaml");
   EXPECT_THROW(planCapture(plain), InputError);
 }

@@ -2,7 +2,7 @@
 // one whose capture disturbs the servicer least (reaction-null-space planning after Yoshida and
 // Nenchev, by search). What `kdl_space plan` and kdl_space.plan_capture() run.
 //
-// The configurations are a chart of up to three parameters, each a documented function of the
+// The configurations are a chart of up to four parameters, each a documented function of the
 // public API, so that a caller can rebuild any of them (the tests do):
 //   timing t   the capture t [s] later: the rigid target moved on along its torque-free tumble
 //              (FreeRigidMotion::at), the grasp frame riding with it:
@@ -15,9 +15,19 @@
 //              from elsewhere), unless the goal is H0 itself (t = 0 and psi = 0): the scenario's
 //              q, as written;
 //   self_motion s [rad] along a redundant arm's self-motion from there (selfMotionJoints of the
-//              scenario with that q): the hand's pose held. Absent for a non-redundant arm.
+//              scenario with that q): the hand's pose held. Absent for a non-redundant arm;
+//   closing_speed c [m/s] (optional: unset, the scenario's rates before the capture, as written)
+//              the hand's velocity before the grasp: its twist is the grasp point's twist on the
+//              target (the rigid target's v_c + w x (p_h - c), w at t; a free-floating target's
+//              contact twist) plus c along the contact frame's z, the approach axis; the joint
+//              rates are the smallest that give it, qdot = J*^+ (t_h - R_h M_a^-1 (P_g; L_g))
+//              (eq. 4; J and the base's twist carried to h for a grounded robot; braked joints at
+//              0), with the system's momentum (P_g; L_g) the scenario's state gives, and the
+//              base's twist follows from that momentum (FreeFloatingSolver::baseTwist). The
+//              rates before then count against the joints' velocity limits too.
 // The capture of each configuration is the scenario's (solveCapture: the same base pose and
-// twist, joint rates, target and law; the target at its pose and twist at t).
+// twist, joint rates, target and law; the target at its pose and twist at t), with the rates
+// before it the closing speed's where that is planned.
 #pragma once
 
 #include <functional>
@@ -49,8 +59,14 @@ struct PlanOptions {
   std::optional<PlanRange> self_motion;
   PlanRange wrist_roll{-1.5707963267948966, 1.5707963267948966};  ///< [rad]
   PlanRange timing{0.0, 0.0};  ///< [s], >= 0; a rigid target only
-  /// Points per searched parameter of the first scan (a grid over the box), >= 2.
+  /// The hand's closing speed on the grasp before the capture [m/s], >= 0. Unset: the scenario's
+  /// joint rates and base twist before the capture, as written.
+  std::optional<PlanRange> closing_speed;
+  /// Points per searched parameter of the first scan (a grid over the box), >= 2 ...
   unsigned int scan = 21;
+  /// ... and at most this many points in all: with more parameters searched, each gets
+  /// max(2, floor(scan_limit^(1/d))) points (4 parameters: 10 each by default).
+  unsigned int scan_limit = 10000;
   /// Local polishes (NLopt LN_BOBYQA, or LN_COBYLA in one dimension) from the scan's best local
   /// minima, at most this many.
   unsigned int polish_starts = 5;
@@ -75,8 +91,11 @@ struct PlanTerms {
 struct CapturePlan {
   std::vector<std::string> joint_names;  ///< model order
   std::vector<double> q;                 ///< the optimum's joint angles [rad or m]
+  std::vector<double> qdot_before;       ///< the joint rates before its capture
+  std::vector<double> base_twist_before; ///< the base's twist before it (v of its origin; w), world
   std::vector<double> qdot_after;        ///< the joint rates after its capture
-  /// The parameters, in the order self_motion, wrist_roll, timing (present ones only), their values.
+  /// The parameters, in the order self_motion, wrist_roll, timing, closing_speed (present ones
+  /// only), their values.
   std::vector<std::pair<std::string, double>> parameters;
   std::vector<std::string> searched;     ///< the names of those that were searched
   PlanTerms optimum;                     ///< at the optimum (always feasible)
