@@ -221,6 +221,8 @@ class CapturePlan:
     joint_names: list[str]
     q: Array
     q_by_name: dict[str, float]
+    qdot_before: Array
+    base_twist_before: Array
     qdot_after: Array
     parameters: dict[str, float]
     searched: list[str]
@@ -233,11 +235,13 @@ class CapturePlan:
 @overload
 def plan_capture(scenario: Scenario, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
                  self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
-                 timing: Optional[Tuple[float, float]] = None, scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
+                 timing: Optional[Tuple[float, float]] = None, closing_speed: Optional[Tuple[float, float]] = None,
+                 scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
 @overload
 def plan_capture(scenario: str, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
                  self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
-                 timing: Optional[Tuple[float, float]] = None, scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
+                 timing: Optional[Tuple[float, float]] = None, closing_speed: Optional[Tuple[float, float]] = None,
+                 scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
 @overload
 def attach_target(scenario_or_problem: Scenario, result: CaptureResult) -> Model: ...
 @overload
