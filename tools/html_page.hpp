@@ -71,11 +71,24 @@ function kdlSpaceMain() {
  }
  // --- meshes (STL, COLLADA): each file of D.meshes parsed once by three's own loaders; a visual
  // is a clone sharing its geometry, in a group that carries the visual's origin and URDF scale.
+ function meshMaterial(rgba) {  // both sides lit: a mesh's triangles need not all face out
+   var m = material(rgba);
+   m.side = THREE.DoubleSide;
+   return m;
+ }
  var meshSources = (D.meshes || []).map(function (m) {
    try {
      var bytes = decode(m.data, Uint8Array);
-     if (m.format === 'stl') return new THREE.Mesh(new THREE.STLLoader().parse(bytes.buffer), material(null));
+     if (m.format === 'stl') {
+       // An STL's facet normals are often zeros (then the mesh is black): from its triangles.
+       var g = new THREE.STLLoader().parse(bytes.buffer);
+       g.computeVertexNormals();
+       return new THREE.Mesh(g, meshMaterial(null));
+     }
      var dae = new THREE.ColladaLoader().parse(new TextDecoder().decode(bytes), '');
+     dae.scene.traverse(function (o) {  // a DAE without normals: from its triangles
+       if (o.isMesh && o.geometry.isBufferGeometry && !o.geometry.attributes.normal) o.geometry.computeVertexNormals();
+     });
      // <unit> is kept (the loader scales by it, as RViz does); <up_axis> is not: RViz ignores it,
      // so a mesh's coordinates are its link's, whatever the DAE says is up (three's loader turns
      // Z_UP into its own Y up, which this Z-up page must not).
@@ -91,7 +104,7 @@ function kdlSpaceMain() {
    if (source) {
      var object = source.clone();
      if (v.rgba) {  // the URDF's colour wins over a DAE's own materials
-       var m = material(v.rgba);
+       var m = meshMaterial(v.rgba);
        object.traverse(function (o) { if (o.isMesh) o.material = m; });
      }
      group.add(object);
