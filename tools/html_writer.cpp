@@ -112,7 +112,7 @@ CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs) {
   const CLI::Validator folder(
       [](std::string& dir) {
         std::error_code ec;
-        return std::filesystem::is_directory(dir, ec) ? std::string() : "--mesh-path " + dir + ": is not a folder";
+        return std::filesystem::is_directory(dir, ec) ? std::string() : dir + " is not a folder (give the folder that holds the package folders)";
       },
       "");
   return cmd->add_option("--mesh-path", dirs,
