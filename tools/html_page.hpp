@@ -69,7 +69,53 @@ function kdlSpaceMain() {
    object.position.set(pose[0], pose[1], pose[2]);
    object.quaternion.set(pose[3], pose[4], pose[5], pose[6]);
  }
+ // --- meshes (STL, COLLADA): each file of D.meshes parsed once by three's own loaders; a visual
+ // is a clone sharing its geometry, in a group that carries the visual's origin and URDF scale.
+ function meshMaterial(rgba) {  // both sides lit: a mesh's triangles need not all face out
+   var m = material(rgba);
+   m.side = THREE.DoubleSide;
+   return m;
+ }
+ var meshSources = (D.meshes || []).map(function (m) {
+   try {
+     var bytes = decode(m.data, Uint8Array);
+     if (m.format === 'stl') {
+       // An STL's facet normals are often zeros (then the mesh is black): from its triangles.
+       var g = new THREE.STLLoader().parse(bytes.buffer);
+       g.computeVertexNormals();
+       return new THREE.Mesh(g, meshMaterial(null));
+     }
+     var dae = new THREE.ColladaLoader().parse(new TextDecoder().decode(bytes), '');
+     dae.scene.traverse(function (o) {  // a DAE without normals: from its triangles
+       if (o.isMesh && o.geometry.isBufferGeometry && !o.geometry.attributes.normal) o.geometry.computeVertexNormals();
+     });
+     // <unit> is kept (the loader scales by it, as RViz does); <up_axis> is not: RViz ignores it,
+     // so a mesh's coordinates are its link's, whatever the DAE says is up (three's loader turns
+     // Z_UP into its own Y up, which this Z-up page must not).
+     dae.scene.quaternion.set(0, 0, 0, 1);
+     return dae.scene;
+   } catch (e) {
+     K.errors.push('the mesh ' + m.file + ' could not be read: ' + (e && e.message));
+     return null;
+   }
+ });
+ function meshVisual(v) {
+   var group = new THREE.Group(), source = meshSources[v.mesh];
+   if (source) {
+     var object = source.clone();
+     if (v.rgba) {  // the URDF's colour wins over a DAE's own materials
+       var m = meshMaterial(v.rgba);
+       object.traverse(function (o) { if (o.isMesh) o.material = m; });
+     }
+     group.add(object);
+   }
+   place(group, v.origin);
+   group.scale.set(v.scale[0], v.scale[1], v.scale[2]);
+   return group;
+ }
+ // --- end of meshes
  function visualMesh(v) {
+   if (v.shape === 'mesh') return meshVisual(v);
    var g;
    if (v.shape === 'cylinder') {
      g = new THREE.CylinderBufferGeometry(v.size[0], v.size[0], v.size[1], 32);
@@ -123,6 +169,19 @@ function kdlSpaceMain() {
    var group = new THREE.Group();
    link.visuals.forEach(function (v) { group.add(visualMesh(v)); });
    return add(group, 'link ' + link.name);
+ });
+ // The meshes as drawn, for the tests: their vertices and their box in the link's frame (the
+ // links are still at the origin here).
+ K.meshes = [];
+ links.forEach(function (group, i) {
+   group.updateMatrixWorld(true);
+   D.links[i].visuals.forEach(function (v, j) {
+     if (v.shape !== 'mesh') return;
+     var object = group.children[j], count = 0, box = new THREE.Box3().setFromObject(object);
+     object.traverse(function (o) { if (o.isMesh) count += o.geometry.attributes.position.count; });
+     K.meshes.push({ link: D.links[i].name, file: v.file, vertices: count,
+                     box: box.isEmpty() ? null : [box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z] });
+   });
  });
  var axes = new THREE.AxesHelper(0.25 * size);
  if (links.length) { links[0].add(axes); objects.push(axes); axes.name = 'base frame'; }
@@ -265,7 +324,8 @@ function kdlSpaceMain() {
  var ok = typeof K.current === 'function', k = ok ? K.current() : -1;
  document.getElementById('selftest').textContent = JSON.stringify({
    errors: K.errors, objectCount: ok ? K.objectCount() : 0, frameCount: K.frameCount, frame: k,
-   time: ok ? K.time(k) : null, contactPoint: ok ? K.contactPoint(k) : null, impactFrame: ok ? K.impactFrame : -1 });
+   time: ok ? K.time(k) : null, contactPoint: ok ? K.contactPoint(k) : null, impactFrame: ok ? K.impactFrame : -1,
+   meshes: K.meshes || [] });
 })();
 </script>
 </body></html>

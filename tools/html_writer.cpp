@@ -1,7 +1,11 @@
 #include "html_writer.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -73,6 +77,24 @@ Json visualJson(const LinkVisual& v) {
   return j;
 }
 
+// --- meshes (STL, COLLADA) --------------------------------------------------------------------
+
+/// "stl" or "dae" by the file's extension (any case); "" for a format the page does not read.
+std::string meshFormat(const std::string& file) {
+  std::string ext = std::filesystem::path(file).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".stl" ? "stl" : ext == ".dae" ? "dae" : "";
+}
+
+/// A mesh visual drawn from the page's mesh `index` (D.meshes), scaled by the URDF's scale.
+Json meshVisualJson(const LinkVisual& v, int index) {
+  Json j = visualJson(v);
+  j["mesh"] = index;
+  j["scale"] = {v.mesh_scale.x(), v.mesh_scale.y(), v.mesh_scale.z()};
+  j["file"] = v.mesh_file;
+  return j;
+}
+
 /// The page's text with `</` escaped, so that nothing inside a <script> ends it.
 std::string scriptSafe(const std::string& s) {
   std::string out;
@@ -86,6 +108,66 @@ std::string scriptSafe(const std::string& s) {
 
 }  // namespace
 
+CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs) {
+  const CLI::Validator folder(
+      [](std::string& dir) {
+        std::error_code ec;
+        return std::filesystem::is_directory(dir, ec) ? std::string() : dir + " is not a folder (give the folder that holds the package folders)";
+      },
+      "");
+  return cmd->add_option("--mesh-path", dirs,
+                         "A folder where the URDF's package://PACKAGE/... meshes are looked for (as DIR/PACKAGE/..., or "
+                         "DIR/... when DIR is named PACKAGE); repeatable, searched in order before ROS_PACKAGE_PATH")
+      ->type_name("DIR")->check(folder)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+std::vector<std::string> meshSearchPath(const std::vector<std::string>& mesh_path_options) {
+  std::vector<std::string> dirs = mesh_path_options;
+  if (const char* ros = std::getenv("ROS_PACKAGE_PATH")) {
+    std::istringstream list(ros);
+    for (std::string dir; std::getline(list, dir, ':');)
+      if (!dir.empty()) dirs.push_back(dir);
+  }
+  return dirs;
+}
+
+int HtmlWriter::meshIndex(const std::string& path) const {
+  for (std::size_t i = 0; i < meshes_.size(); ++i)
+    if (meshes_[i].path == path) return static_cast<int>(i);
+  return -1;
+}
+
+/// Each STL and COLLADA file read once; every other mesh is left to its box of inertia (its
+/// mesh_path cleared) with a warning that says why and what to do.
+void HtmlWriter::readMeshes() {
+  for (auto& [link, list] : visuals_)
+    for (LinkVisual& v : list) {
+      if (v.shape != LinkVisual::Shape::Mesh) continue;
+      const std::string format = meshFormat(v.mesh_path.empty() ? v.mesh_file : v.mesh_path);
+      std::string why;
+      if (v.mesh_path.empty()) {
+        why = "was not found (" + v.mesh_problem +
+              "): give --mesh-path DIR (the folder holding the package's folder) or set ROS_PACKAGE_PATH";
+      } else if (format.empty()) {
+        why = "(" + v.mesh_path + ") is not drawn: only STL and COLLADA (.dae) meshes are read; convert it to one of them";
+      } else if (std::ifstream(format == "stl" ? kStlLoaderJs : kColladaLoaderJs).fail()) {
+        why = "is not drawn: three.js's loader is not installed (Debian package libjs-three; tools/deps.sh installs it)";
+      } else if (meshIndex(v.mesh_path) < 0) {
+        std::ifstream in(v.mesh_path, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        if (!in || bytes.str().empty())
+          why = "(" + v.mesh_path + ") cannot be read or is empty: check the file";
+        else
+          meshes_.push_back({v.mesh_path, format, bytes.str()});
+      }
+      if (why.empty()) continue;
+      warnings_.push_back({link, "--html: the mesh " + v.mesh_file + " " + why + "; the page draws the link's box of inertia",
+                           "mesh_not_drawn", Severity::Warning});
+      v.mesh_path.clear();
+    }
+}
+
 void checkHtmlLibrary(const std::string& option, const std::string& path) {
   for (const char* file : {kThreeJs, kOrbitControlsJs})
     if (std::ifstream(file).fail())
@@ -93,19 +175,14 @@ void checkHtmlLibrary(const std::string& option, const std::string& path) {
                        "; Debian package libjs-three; tools/deps.sh installs it)");
 }
 
-HtmlWriter::HtmlWriter(const Scenario& sc, double frames_per_second, std::size_t max_frames)
+HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_search_path, double frames_per_second,
+                       std::size_t max_frames)
     : sc_(sc), step_(1.0 / frames_per_second), max_frames_(std::max<std::size_t>(2, max_frames)) {
   const FloatingModel& robot = *sc.capture.robot.model;
   for (const Body& b : robot.bodies()) links_.push_back(b.name);
-  if (!sc.robot_urdf.empty()) visuals_ = readUrdfVisuals(sc.robot_urdf);
-  std::vector<Diagnostic> warnings;
-  for (const auto& [link, list] : visuals_)
-    for (const LinkVisual& v : list)
-      if (v.shape == LinkVisual::Shape::Mesh)
-        warnings.push_back({link, "--html: the mesh " + v.mesh_file +
-                                      " is drawn as the link's box of inertia (meshes are not read yet)",
-                            "", Severity::Warning});
-  warnOnStderr(warnings);
+  if (!sc.robot_urdf.empty()) visuals_ = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  readMeshes();
+  warnOnStderr(warnings_);
   if (sc.impact)
     if (const auto* rigid = std::get_if<RigidTarget>(&sc.capture.target)) {
       target_ = *rigid;
@@ -221,7 +298,11 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
   for (const Body& b : robot.bodies()) {
     Json visuals = Json::array();
     if (const auto it = visuals_.find(b.name); it != visuals_.end())
-      for (const LinkVisual& v : it->second) visuals.push_back(v.shape == LinkVisual::Shape::Mesh ? inertiaBoxJson(b) : visualJson(v));
+      for (const LinkVisual& v : it->second) {
+        if (v.shape != LinkVisual::Shape::Mesh) visuals.push_back(visualJson(v));
+        else if (v.mesh_path.empty()) visuals.push_back(inertiaBoxJson(b));  // warned about
+        else visuals.push_back(meshVisualJson(v, meshIndex(v.mesh_path)));
+      }
     if (visuals.empty()) visuals.push_back(inertiaBoxJson(b));
     links.push_back({{"name", b.name}, {"visuals", visuals}});
   }
@@ -229,6 +310,13 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
                {"stride", data_.size() / times_.size()}, {"frames", base64(data_.data(), data_.size() * sizeof(float))},
                {"times", base64(times_.data(), times_.size() * sizeof(double))}, {"phases", phases_},
                {"phaseNames", {"approach", "contact", "after", "motion"}}};
+  // Each mesh file once (a mesh several links use is stored once), base64.
+  data["meshes"] = Json::array();
+  bool stl = false, dae = false;
+  for (const MeshData& m : meshes_) {
+    data["meshes"].push_back({{"file", m.path}, {"format", m.format}, {"data", base64(m.bytes.data(), m.bytes.size())}});
+    (m.format == "stl" ? stl : dae) = true;
+  }
   data["target"] = nullptr;
   if (target_) {
     const Vector3d size = equivalentBox(target_->mass, target_->inertia, target_->com).size.cwiseMax(1e-3);  // in its frame
@@ -245,7 +333,11 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
   std::ofstream out(file.tmp(), std::ios::binary);
   if (!out) throw InputError(where + "cannot write in its folder");
   out << kHtmlHead << "<script>\n" << readText(kThreeJs, where) << "\n</script>\n<script>\n"
-      << readText(kOrbitControlsJs, where) << "\n</script>\n<script>\nwindow.KDL_DATA = "
+      << readText(kOrbitControlsJs, where) << "\n</script>\n";
+  // The mesh loaders only in a page that has such a mesh (the page stays small without).
+  if (stl) out << "<script>\n" << readText(kStlLoaderJs, where) << "\n</script>\n";
+  if (dae) out << "<script>\n" << readText(kColladaLoaderJs, where) << "\n</script>\n";
+  out << "<script>\nwindow.KDL_DATA = "
       << scriptSafe(data.dump()) << ";\n</script>\n" << kHtmlBody;
   out.close();
   if (!out) throw InputError(where + "cannot write the page (disk full?)");

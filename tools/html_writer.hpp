@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_common.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
@@ -23,21 +25,39 @@ namespace kdl_space::cli {
 /// Where the page's 3-D library comes from (Debian's libjs-three).
 inline const char* const kThreeJs = "/usr/share/javascript/three/three.min.js";
 inline const char* const kOrbitControlsJs = "/usr/share/javascript/three/examples/js/controls/OrbitControls.js";
+/// three.js's own mesh loaders (r111, non-module: they define THREE.STLLoader and
+/// THREE.ColladaLoader), inlined only into a page that has such a mesh.
+inline const char* const kStlLoaderJs = "/usr/share/javascript/three/examples/js/loaders/STLLoader.js";
+inline const char* const kColladaLoaderJs = "/usr/share/javascript/three/examples/js/loaders/ColladaLoader.js";
+
+/// \brief `--mesh-path DIR` (repeatable) on a subcommand that writes a page: folders where a
+/// URDF's package:// meshes are looked for (DIR/PACKAGE/..., or DIR itself when it is named
+/// PACKAGE), before ROS_PACKAGE_PATH's. A DIR that is not a folder is a usage error.
+CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
+/// \brief The folders package:// meshes are searched in, in order: `mesh_path_options` (the
+/// --mesh-path folders), then the ROS_PACKAGE_PATH environment variable's (colon-separated). The
+/// tool reads the environment; the library is given the list (resolveMeshFile).
+std::vector<std::string> meshSearchPath(const std::vector<std::string>& mesh_path_options);
 
 /// Throws InputError naming `option` and `path` when three.js is not installed.
 void checkHtmlLibrary(const std::string& option, const std::string& path);
 
 class HtmlWriter {
  public:
-  /// Reads the robot's visuals (a mesh is drawn, for now, as its link's box of inertia: a warning
-  /// on stderr names the file). `frames_per_second`: the display rate.
-  HtmlWriter(const Scenario& sc, double frames_per_second = 30.0, std::size_t max_frames = 3000);
+  /// Reads the robot's visuals and their STL and COLLADA meshes, found through
+  /// `mesh_search_path` (meshSearchPath); a mesh that cannot be drawn (not found, unreadable,
+  /// another format) is its link's box of inertia, with a warning on stderr naming the link, the
+  /// file and what to do (warnings() keeps them for the JSON). `frames_per_second`: the display rate.
+  explicit HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_search_path = {},
+                      double frames_per_second = 30.0, std::size_t max_frames = 3000);
   /// One sample of the run; `so_far.model` is the system it belongs to.
   void add(const OperationResult& so_far, const MotionSample& x);
   /// Writes the page into file.tmp() (the caller commits it). `note`: shown over the view (e.g.
   /// "the approach did not reach its grasp").
   void write(const AtomicFile& file, const OperationResult& r, const std::string& title, const std::string& note = "");
   std::size_t frames() const { return times_.size(); }
+  /// The meshes drawn as boxes of inertia (printed on stderr already; for the run's JSON).
+  const std::vector<Diagnostic>& warnings() const { return warnings_; }
 
  private:
   struct Frame;
@@ -49,6 +69,15 @@ class HtmlWriter {
   std::size_t max_frames_;
   std::vector<std::string> links_;  ///< the robot's bodies, by name
   std::map<std::string, std::vector<LinkVisual>> visuals_;
+  /// The meshes the page embeds, each file once ({file, format, data}); a mesh visual's
+  /// LinkVisual::mesh_path is cleared when it is not drawn.
+  struct MeshData {
+    std::string path, format, bytes;
+  };
+  std::vector<MeshData> meshes_;
+  std::vector<Diagnostic> warnings_;
+  void readMeshes();
+  int meshIndex(const std::string& path) const;
   std::optional<RigidTarget> target_;     ///< a rigid target at t = 0
   std::optional<FreeRigidMotion> tumble_;  ///< its motion before the capture
   std::optional<FreeRigidMotion> after_;   ///< a separated target's motion after it

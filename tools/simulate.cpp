@@ -81,7 +81,7 @@ struct Streams {
     if (!o.plot.empty()) plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
     if (!o.html.empty()) {
       html_file = std::make_unique<AtomicFile>(o.html, "--html");
-      html.emplace(sc);
+      html.emplace(sc, meshSearchPath(o.mesh_path));
     }
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
@@ -169,6 +169,7 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
                   "Write the run as an interactive 3-D animation: one self-contained HTML page (the robot's URDF "
                   "visuals, the target, the contact point, the hand's path, the impulse; a time line with the phases)")
       ->type_name("FILE")->check(file_name);
+  addMeshPathOption(cmd, o.mesh_path);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   cmd->add_option("--max-output-rows", o.max_output_rows,
                   "Refuse a run that could give more output rows (samples of the approach and the motion) than this, "
@@ -210,6 +211,8 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   // What the motion found (a sampled controller's gains, a stiff servo): on stderr whatever the
   // format of stdout (they may explain a motion that then went wrong).
   warnOnStderr(r.warnings);
+  // The page's meshes drawn as boxes of inertia: on stderr at the start, in the JSON's warnings too.
+  if (streams.html) r.warnings.insert(r.warnings.end(), streams.html->warnings().begin(), streams.html->warnings().end());
   const OperationFiles files{o.csv, o.plot, o.html};
   if (o.json)
     out << operationJson(sc, r, files).dump(2) << "\n";

@@ -7,6 +7,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace kdl_space::cli {
 
@@ -14,6 +15,7 @@ struct SimulateOptions {
   std::string scenario;
   std::optional<double> duration;
   std::string csv, plot, scene, html;
+  std::vector<std::string> mesh_path;  ///< --mesh-path folders (the page's package:// meshes)
   bool json = false;
   /// The most output rows a run may produce (approach and motion: estimatedOutputRows); a double,
   /// so that 1e9 can be written as such.

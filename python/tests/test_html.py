@@ -24,8 +24,8 @@ SCENARIO = SOURCE_DIR / "scenarios" / "approach_tumbling_box.yaml"
 # path, the impulse's arrow.
 MARKERS = 4
 
-# What the test puts into the arm's URDF: one visual of each kind (a mesh is drawn as its link's
-# box of inertia for now).
+# What the test puts into the arm's URDF: one visual of each kind (the mesh's file does not exist:
+# its link's box of inertia; test_html_meshes.py draws meshes).
 VISUALS = {
     "satellite": '<visual><origin xyz="0 0 0.1"/><geometry><box size="0.8 0.6 0.4"/></geometry>'
                  '<material name="gold"><color rgba="0.9 0.7 0.1 1"/></material></visual>',

@@ -2,6 +2,7 @@
 
 #include <urdf_parser/urdf_parser.h>
 
+#include <filesystem>
 
 #include "kdl_space/spatial/errors.hpp"
 #include "parsers/urdf/urdf_parse.hpp"
@@ -44,9 +45,49 @@ bool shapeOf(const urdf::Geometry& g, LinkVisual& v) {
   return false;
 }
 
+bool isFile(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec);
+}
+
+bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
 }  // namespace
 
-std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::string& xml, const std::string& source) {
+MeshLocation resolveMeshFile(const std::string& filename, const std::string& urdf_dir,
+                             const std::vector<std::string>& package_path) {
+  namespace fs = std::filesystem;
+  if (startsWith(filename, "package://")) {
+    const std::string rest = filename.substr(10);
+    const std::size_t slash = rest.find('/');
+    if (slash == 0 || slash == std::string::npos || slash + 1 == rest.size())
+      return {"", "is not package://PACKAGE/PATH"};
+    const std::string package = rest.substr(0, slash), inside = rest.substr(slash + 1);
+    for (const std::string& dir : package_path) {
+      if (dir.empty()) continue;
+      const fs::path d(dir);
+      if (isFile(d / package / inside)) return {(d / package / inside).lexically_normal().string(), ""};
+      // A folder that is the package itself ("a/b/PKG/"'s name is PKG too).
+      if ((d.filename().empty() ? d.parent_path() : d).filename() == package && isFile(d / inside))
+        return {(d / inside).lexically_normal().string(), ""};
+    }
+    std::string searched;
+    for (const std::string& dir : package_path)
+      if (!dir.empty()) searched += (searched.empty() ? "" : ", ") + dir;
+    return {"", searched.empty() ? "package '" + package + "': no package folder to search"
+                                 : "package '" + package + "' has no " + inside + " in " + searched};
+  }
+  fs::path file;
+  if (startsWith(filename, "file://")) file = filename.substr(7);
+  else if (filename.find("://") != std::string::npos) return {"", "only package:// and file:// are read"};
+  else file = fs::path(filename).is_absolute() ? fs::path(filename) : fs::path(urdf_dir) / filename;
+  if (file.empty() || !isFile(file)) return {"", "no such file " + file.string()};
+  return {file.lexically_normal().string(), ""};
+}
+
+std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::string& xml, const std::string& source,
+                                                                      const std::vector<std::string>& package_path) {
+  const std::string urdf_dir = std::filesystem::path(source).parent_path().string();
   const urdf::ModelInterfaceSharedPtr model = parseUrdfXml(xml, source);
   std::map<std::string, std::vector<LinkVisual>> out;
   for (const auto& [name, link] : model->links_) {
@@ -55,6 +96,11 @@ std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::
       if (!visual || !visual->geometry) continue;
       LinkVisual v;
       if (!shapeOf(*visual->geometry, v)) continue;
+      if (v.shape == LinkVisual::Shape::Mesh) {
+        MeshLocation found = resolveMeshFile(v.mesh_file, urdf_dir.empty() ? "." : urdf_dir, package_path);
+        v.mesh_path = std::move(found.path);
+        v.mesh_problem = std::move(found.problem);
+      }
       v.origin = frameOf(visual->origin);
       urdf::MaterialSharedPtr material = visual->material;
       // urdfdom leaves a named robot-level material's colour on the visual's material already;
@@ -68,8 +114,9 @@ std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::
   return out;
 }
 
-std::map<std::string, std::vector<LinkVisual>> readUrdfVisuals(const std::string& path) {
-  return readUrdfVisualsString(readUrdfText(path), path);
+std::map<std::string, std::vector<LinkVisual>> readUrdfVisuals(const std::string& path,
+                                                                const std::vector<std::string>& package_path) {
+  return readUrdfVisualsString(readUrdfText(path), path, package_path);
 }
 
 }  // namespace kdl_space
