@@ -312,7 +312,9 @@ void HtmlWriter::plotsJson(Json& data, const OperationResult& r) {
   plot("joint rates", "joint rates [rad/s or m/s]", robot, 6);
   if (torques) plot("joint torques", "joint torques applied (control + friction) [N m or N]", robot, 6 + nj);
   plot("momentum", "momentum: |P| [N s], |L| about the world origin [N m s]", {"|P|", "|L|"}, 6 + 2 * nj);
-  plot("energy", "energy [J]: kinetic T, balance T - T0 - work (from each phase's start)", {"T", "T - T0 - work"}, 8 + 2 * nj);
+  plot("energy", "kinetic energy T [J]", {"T"}, 8 + 2 * nj);
+  // On its own axes: a balance error is some 1e-12 of T.
+  plot("energy balance", "energy balance T - T0 - work [J] (from each phase's start)", {"T - T0 - work"}, 9 + 2 * nj);
   if (sc_.simulation.base_control.attitude.on)
     plot("base control", "base control torque (world axes) [N m]", {"n_x", "n_y", "n_z"}, 10 + 2 * nj);
   std::vector<float> series;

@@ -69,7 +69,7 @@ def expected_series(col, phases, i, joints):
     # run's first, after the capture from the first post row.
     start = phases.index("post") if phases[i] == "post" else 0
     work = sum(col[name][i] for name in col if name.startswith("work_"))
-    e[("energy", "T - T0 - work")] = T[i] - T[start] - work
+    e[("energy balance", "T - T0 - work")] = T[i] - T[start] - work
     if "base_control_nx" in col:
         for c in "xyz":
             e[("base control", f"n_{c}")] = col[f"base_control_n{c}"][i]
@@ -114,9 +114,9 @@ def test_plotted_values_are_the_csvs(run):
     joints = [f"joint{j}" for j in range(1, 8)]
     plots, checked = check_values(run["page"], run["csv"], joints)
     names = [p["name"] for p in plots]
-    assert names == ["attitude", "angular rate", "joint rates", "joint torques", "momentum", "energy"], names
+    assert names == ["attitude", "angular rate", "joint rates", "joint torques", "momentum", "energy", "energy balance"], names
     assert next(p for p in plots if p["name"] == "joint rates")["series"] == joints
-    assert checked == 6 * (3 + 3 + 7 + 7 + 2 + 2)
+    assert checked == 6 * (3 + 3 + 7 + 7 + 2 + 1 + 1)
 
 
 def geometry_script(name, targets):
@@ -239,7 +239,7 @@ def test_a_run_without_torques_has_no_torque_plot(free_run):
     col, _ = columns(free_run["csv"])
     assert all(np.all(col[f"tau_{j}"] == 0) for j in joints), "the scenario applies no torque"
     plots, _ = check_values(free_run["page"], free_run["csv"], joints)
-    assert [p["name"] for p in plots] == ["attitude", "angular rate", "joint rates", "momentum", "energy"]
+    assert [p["name"] for p in plots] == ["attitude", "angular rate", "joint rates", "momentum", "energy", "energy balance"]
 
 
 @needs_browser
