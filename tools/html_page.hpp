@@ -91,6 +91,7 @@ function kdlSpacePlots(K, D, times, slider, phaseColours) {
      }
    if (!(hi >= lo)) { lo = -1; hi = 1; }
    if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { var pad = Math.max(Math.abs(hi) * 0.1, 1e-9); lo -= pad; hi += pad; }
+   else { var margin = 0.05 * (hi - lo); lo -= margin; hi += margin; }  // a flat line off the frame
    return { spec: p, canvas: canvas, back: document.createElement('canvas'), lo: lo, hi: hi, hover: -1 };
  });
  function xOf(q, t) { return LEFT + (t - t0) / span * (q.back.width - LEFT - RIGHT); }
