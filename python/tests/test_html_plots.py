@@ -253,3 +253,24 @@ def test_base_control_has_its_plot(tmp_path, cli):
     assert [p["name"] for p in plots][-1] == "base control"
     col, _ = columns(csv)
     assert np.abs(col["base_control_nz"]).max() > 1e-6, "the control acts"
+
+
+def test_a_humanoids_page_stays_small(tmp_path, cli):
+    """A 20 s run of the 46-joint humanoid (tests/data/real_patterns/humanoid44.urdf, free joints
+    with their URDF friction) at 100 rows a second: the page, its plots' series included, under
+    5 MB (about 2.6 MB: 501 frames, 102 float32 a frame for the plots, 272 kB in base64)."""
+    scenario = tmp_path / "humanoid.yaml"
+    scenario.write_text(f"robot:\n  urdf: {SOURCE_DIR / 'tests' / 'data' / 'real_patterns' / 'humanoid44.urdf'}\n"
+                        "  base: {position: [0, 0, 0], rpy: [0, 0, 0], twist: [0.01, 0, 0, 0.02, -0.01, 0.03]}\n"
+                        "simulation:\n  duration: 20\n  output_step: 0.01\n  integrator: rosenbrock\n"
+                        "  rtol: 1.0e-6\n  atol: 1.0e-8\n")
+    page = tmp_path / "humanoid.html"
+    done = subprocess.run([cli, "simulate", str(scenario), "--html", str(page)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    data = page_data(page)
+    rates = next(p for p in data["plots"] if p["name"] == "joint rates")
+    assert len(rates["series"]) == 46
+    series = __import__("base64").b64decode(data["series"])
+    assert len(series) == 4 * data["frameCount"] * data["seriesStride"]
+    assert data["seriesStride"] >= 6 + 46 + 2 + 2
+    assert page.stat().st_size < 5e6, page.stat().st_size
