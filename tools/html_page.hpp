@@ -20,6 +20,12 @@ inline const char* const kHtmlHead = R"HTML(<!DOCTYPE html>
  #note { color: #b00; font-weight: bold; }
  #selftest { display: none; }
  button, select, label { margin-right: 8px; }
+ /* The linked plots (issue 27, item 3): two rows of small canvases between the view and the bar. */
+ #plots { position: absolute; left: 0; right: 0; bottom: 74px; height: 240px; display: none; background: #fff; border-top: 1px solid #ccc; }
+ body.with-plots #plots { display: grid; grid-template-rows: 1fr 1fr; grid-auto-flow: column; }
+ body.with-plots #view { bottom: 314px; }
+ #plots canvas { width: 100%; height: 100%; display: block; cursor: crosshair; min-width: 0; min-height: 0; }
+ #plots div { position: relative; min-width: 0; min-height: 0; border-left: 1px solid #eee; }
 </style>
 <script>
  // The page's errors, kept for its tests (window.kdlSpace.errors) from the first script on.
@@ -37,6 +43,7 @@ inline const char* const kHtmlHead = R"HTML(<!DOCTYPE html>
 
 inline const char* const kHtmlBody = R"HTML(</head><body>
 <div id="view"></div>
+<div id="plots"></div>
 <div id="info"><div id="title"></div><div id="note"></div><div id="time"></div><div id="legend"></div></div>
 <div id="bar">
  <div id="phasebar"></div>
@@ -51,6 +58,159 @@ inline const char* const kHtmlBody = R"HTML(</head><body>
 </div>
 <pre id="selftest"></pre>
 <script>
+// --- The linked plots (issue 27, item 3) --------------------------------------------------------
+// Small canvas 2-D plots of the run's series (D.plots, D.series: float32, one row per frame, the
+// frames' times), the phases shaded as on the time line, a cursor at the slider's frame; a click
+// or a drag on a plot moves the slider (an 'input' event on it, as a user's). Each plot is drawn
+// once per size into a canvas of its own, and the cursor over a copy of it. Many series (the
+// joints of a humanoid): coloured from a palette of 10, named in the legend up to 8, else the
+// one nearest the pointer is named (and drawn thicker) on hover.
+function kdlSpacePlots(K, D, times, slider, phaseColours) {
+ 'use strict';
+ var box = document.getElementById('plots'), n = times.length;
+ if (!D.plots || !D.plots.length || !D.series || !box) return null;
+ var bytes = atob(D.series), raw = new Uint8Array(bytes.length);
+ for (var b = 0; b < bytes.length; ++b) raw[b] = bytes.charCodeAt(b);
+ var values = new Float32Array(raw.buffer), stride = D.seriesStride;
+ var PALETTE = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#7f7f7f', '#bcbd22', '#17becf'];
+ var CURSOR = '#ff00ff', LEFT = 52, RIGHT = 8, TOP = 16, BOTTOM = 14;
+ var t0 = times[0], span = Math.max(times[n - 1] - t0, 1e-12), current = 0;
+ document.body.classList.add('with-plots');
+ box.style.gridTemplateColumns = 'repeat(' + Math.ceil(D.plots.length / 2) + ', 1fr)';
+ function value(p, s, k) { return values[k * stride + p.column + s]; }
+ var plots = D.plots.map(function (p) {
+   var cell = document.createElement('div'), canvas = document.createElement('canvas');
+   cell.appendChild(canvas);
+   box.appendChild(cell);
+   canvas.title = p.label;
+   var lo = Infinity, hi = -Infinity;
+   for (var k = 0; k < n; ++k)
+     for (var s = 0; s < p.series.length; ++s) {
+       var v = value(p, s, k);
+       if (isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+     }
+   if (!(hi >= lo)) { lo = -1; hi = 1; }
+   if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { var pad = Math.max(Math.abs(hi) * 0.1, 1e-9); lo -= pad; hi += pad; }
+   else { var margin = 0.05 * (hi - lo); lo -= margin; hi += margin; }  // a flat line off the frame
+   return { spec: p, canvas: canvas, back: document.createElement('canvas'), lo: lo, hi: hi, hover: -1 };
+ });
+ function xOf(q, t) { return LEFT + (t - t0) / span * (q.back.width - LEFT - RIGHT); }
+ function yOf(q, v) { return TOP + (q.hi - v) / (q.hi - q.lo) * (q.back.height - TOP - BOTTOM); }
+ function drawBack(q) {
+   var c = q.back.getContext('2d'), w = q.back.width, h = q.back.height, p = q.spec;
+   c.fillStyle = '#fff'; c.fillRect(0, 0, w, h);
+   for (var s0 = 0; s0 < n; ) {  // the phases
+     var e = s0;
+     while (e + 1 < n && D.phases[e + 1] === D.phases[s0]) ++e;
+     c.globalAlpha = 0.12;
+     c.fillStyle = phaseColours[D.phases[s0]] || '#999';
+     var x0 = xOf(q, times[s0]), x1 = xOf(q, times[Math.min(e + 1, n - 1)]);
+     c.fillRect(x0, TOP, Math.max(x1 - x0, 1), h - TOP - BOTTOM);
+     c.globalAlpha = 1;
+     s0 = e + 1;
+   }
+   c.strokeStyle = '#bbb'; c.lineWidth = 1;
+   c.strokeRect(LEFT, TOP, w - LEFT - RIGHT, h - TOP - BOTTOM);
+   if (q.lo < 0 && q.hi > 0) { c.beginPath(); c.moveTo(LEFT, yOf(q, 0)); c.lineTo(w - RIGHT, yOf(q, 0)); c.stroke(); }
+   for (var s = 0; s < p.series.length; ++s) {
+     c.strokeStyle = PALETTE[s % PALETTE.length];
+     c.lineWidth = s === q.hover ? 2.5 : 1;
+     c.beginPath();
+     var up = false;
+     for (var k = 0; k < n; ++k) {
+       var v = value(p, s, k);
+       if (!isFinite(v)) { up = false; continue; }
+       if (up) c.lineTo(xOf(q, times[k]), yOf(q, v)); else c.moveTo(xOf(q, times[k]), yOf(q, v));
+       up = true;
+     }
+     c.stroke();
+   }
+   c.fillStyle = '#222'; c.font = '10px sans-serif'; c.textBaseline = 'top';
+   c.fillText(p.label, 4, 2);
+   c.fillText(q.hi.toPrecision(3), 2, TOP);
+   c.textBaseline = 'bottom';
+   c.fillText(q.lo.toPrecision(3), 2, h - BOTTOM);
+   c.fillText(t0.toFixed(2) + ' s', LEFT, h);
+   c.textAlign = 'right';
+   c.fillText(times[n - 1].toFixed(2) + ' s', w - RIGHT, h);
+   c.textBaseline = 'top';
+   var legend = p.series.length <= 8 ? null : p.series.length + ' series: hover for a name';
+   if (q.hover >= 0) legend = p.series[q.hover] + ' = ' + value(p, q.hover, current).toPrecision(5);
+   if (legend !== null) { c.fillStyle = '#222'; c.fillText(legend, w - RIGHT - 2, TOP + 2); }
+   else
+     for (var s2 = p.series.length - 1, x = w - RIGHT - 2; s2 >= 0; --s2) {
+       c.fillStyle = PALETTE[s2 % PALETTE.length];
+       c.fillText(p.series[s2], x, TOP + 2);
+       x -= c.measureText(p.series[s2]).width + 8;
+     }
+   c.textAlign = 'left';
+ }
+ function drawCursor(q) {
+   var c = q.canvas.getContext('2d'), x = Math.round(xOf(q, times[current])) + 0.5;
+   c.drawImage(q.back, 0, 0);
+   c.strokeStyle = CURSOR; c.lineWidth = 1;
+   c.beginPath(); c.moveTo(x, TOP); c.lineTo(x, q.canvas.height - BOTTOM); c.stroke();
+   q.cursorX = x - 0.5;
+ }
+ function resize() {
+   plots.forEach(function (q) {
+     var w = Math.max(q.canvas.clientWidth, 60), h = Math.max(q.canvas.clientHeight, 40);
+     q.canvas.width = q.back.width = w; q.canvas.height = q.back.height = h;
+     drawBack(q); drawCursor(q);
+   });
+ }
+ // The frame nearest a time.
+ function frameAt(t) {
+   var lo = 0, hi = n - 1;
+   while (hi - lo > 1) { var mid = (lo + hi) >> 1; if (times[mid] <= t) lo = mid; else hi = mid; }
+   return Math.abs(times[hi] - t) < Math.abs(t - times[lo]) ? hi : lo;
+ }
+ function timeAtX(q, clientX) {
+   var r = q.canvas.getBoundingClientRect(), x = (clientX - r.left) * q.canvas.width / Math.max(r.width, 1);
+   return t0 + (x - LEFT) / (q.canvas.width - LEFT - RIGHT) * span;
+ }
+ var dragging = null;
+ function moveTo(q, e) {
+   slider.value = String(frameAt(timeAtX(q, e.clientX)));
+   slider.dispatchEvent(new Event('input'));
+ }
+ plots.forEach(function (q) {
+   q.canvas.addEventListener('mousedown', function (e) { dragging = q; moveTo(q, e); e.preventDefault(); });
+   q.canvas.addEventListener('mousemove', function (e) {
+     if (dragging === q) { moveTo(q, e); return; }
+     var r = q.canvas.getBoundingClientRect(), y = (e.clientY - r.top) * q.canvas.height / Math.max(r.height, 1);
+     var k = frameAt(timeAtX(q, e.clientX)), best = -1, d = 8;  // the series within 8 px of the pointer
+     for (var s = 0; s < q.spec.series.length; ++s) {
+       var v = value(q.spec, s, k);
+       if (isFinite(v) && Math.abs(yOf(q, v) - y) < d) { d = Math.abs(yOf(q, v) - y); best = s; }
+     }
+     if (best !== q.hover) { q.hover = best; drawBack(q); drawCursor(q); }
+   });
+   q.canvas.addEventListener('mouseleave', function () { if (q.hover >= 0) { q.hover = -1; drawBack(q); drawCursor(q); } });
+ });
+ window.addEventListener('mouseup', function () { dragging = null; });
+ window.addEventListener('resize', resize);
+ function find(name) {
+   for (var i = 0; i < plots.length; ++i) if (plots[i].spec.name === name) return plots[i];
+   return null;
+ }
+ // The tests' hooks.
+ K.plots = plots.map(function (q) { return { name: q.spec.name, label: q.spec.label, series: q.spec.series.slice(), samples: n }; });
+ K.plotValue = function (name, series, k) {
+   var q = find(name), s = q ? q.spec.series.indexOf(series) : -1;
+   return s < 0 || k < 0 || k >= n ? null : value(q.spec, s, k);
+ };
+ // Where a time is on a plot, in the page's coordinates (for a mouse event), and the cursor drawn.
+ K.plotPoint = function (name, t) {
+   var q = find(name), r = q.canvas.getBoundingClientRect();
+   return { x: r.left + xOf(q, t) * r.width / q.canvas.width, y: r.top + r.height / 2 };
+ };
+ K.plotCursor = function (name) { var q = find(name); return { frame: current, x: q.cursorX, time: times[current] }; };
+ K.plotCanvas = function (name) { return find(name).canvas; };
+ resize();
+ return { cursor: function (k) { current = k; plots.forEach(drawCursor); } };
+}
+// --- end of the linked plots ---------------------------------------------------------------------
 function kdlSpaceMain() {
  'use strict';
  var K = window.kdlSpace, D = window.KDL_DATA;
@@ -276,6 +436,7 @@ function kdlSpaceMain() {
        D.phaseNames[D.phases[k]] + '), frame ' + k + ' of ' + n;
    controls.update();
    renderer.render(scene, camera);
+   if (plots) plots.cursor(k);  // the linked plots' cursor
  }
  K.setFrame = setFrame;
  K.contactPoint = function (k) { var f = k * stride; return [frames[f], frames[f + 1], frames[f + 2]]; };
@@ -307,6 +468,7 @@ function kdlSpaceMain() {
    last = now;
    requestAnimationFrame(tick);
  }
+ var plots = kdlSpacePlots(K, D, times, slider, PHASE_COLOURS);  // the linked plots (before the view's size)
  resize();
  var hash = /[#&](frame|selftest)=(\w+)/.exec(location.hash);
  var start = hash ? (hash[2] === 'last' ? n - 1 : parseInt(hash[2], 10)) : 0;

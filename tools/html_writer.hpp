@@ -63,6 +63,10 @@ class HtmlWriter {
   struct Frame;
   std::vector<float> frameOf(const OperationResult& so_far, const MotionSample& x);
   void keep(std::vector<float> frame, const MotionSample& x);
+  // --- the linked plots (issue 27, item 3): their values ride at the end of each frame (kept
+  // and decimated with it) and are split off into `series` when the page is written.
+  void appendSeries(std::vector<float>& f, const OperationResult& so_far, const MotionSample& x);
+  void plotsJson(Json& data, const OperationResult& r);
 
   const Scenario& sc_;
   double step_;          ///< the display interval [s], doubled when max_frames is passed
@@ -92,6 +96,14 @@ class HtmlWriter {
   std::vector<float> last_;     ///< the latest sample's frame (the run's end), if not kept
   double last_t_ = 0.0;
   int last_phase_ = 0;
+  // The plots' series (appendSeries): where they begin in a frame, the joints' columns in the
+  // samples' model (by the robot's joint names), the energy balance's start.
+  std::size_t series_at_ = 0, series_size_ = 0;
+  const FloatingModel* series_model_ = nullptr;
+  std::vector<int> series_joints_;
+  bool series_phase0_ = false;
+  Phase series_phase_ = Phase::Post;
+  double series_T0_ = 0.0;
 };
 
 }  // namespace kdl_space::cli

@@ -1,18 +1,21 @@
-// The plot of `kdl_space simulate --plot FILE` (.svg or .png), drawn by gnuplot: base attitude,
-// joint positions, the change of momentum and energy since the start, and the joint torques when a
-// controller runs. Many joints are drawn in several panels (at most kJointsPerPanel each), so
+// The plot of `kdl_space simulate --plot FILE` (.svg or .png), drawn by gnuplot: base attitude
+// and angular rate, the base control's torque (and force) when the scenario has one, joint
+// positions (the servos' hold error q - set point for the joints a PD servo holds), the change of
+// momentum and energy since the start, and the joint torques when a controller runs. Many joints are drawn in several panels (at most kJointsPerPanel each), so
 // that a legend never squeezes a panel. The samples are streamed to gnuplot's data file as they
 // come (PlotWriter): the memory a plot takes does not grow with the run.
 #pragma once
 
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli_common.hpp"
 #include "gnuplot_text.hpp"
 #include "kdl_space/operation/motion_sample.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::cli {
 
@@ -29,8 +32,10 @@ std::string plotTerminal(const std::string& path, std::size_t panels = 3);
 /// sample (the balance restarts at the capture).
 class PlotWriter {
  public:
-  /// Opens the data file; throws InputError if it cannot. `joints`: the samples' joints.
-  PlotWriter(const AtomicFile& out, std::vector<std::string> joints);
+  /// Opens the data file; throws InputError if it cannot. `joints`: the samples' joints. `sc`
+  /// (optional): the scenario whose servos (simulation.joints' PD, by the robot's joint names) and
+  /// base control the plot shows.
+  PlotWriter(const AtomicFile& out, std::vector<std::string> joints, const Scenario* sc = nullptr);
   PlotWriter(const PlotWriter&) = delete;
   PlotWriter& operator=(const PlotWriter&) = delete;
   /// One row; throws InputError when it cannot be written (a full disk) at once.
@@ -54,6 +59,11 @@ class PlotWriter {
   Phase phase0_ = Phase::Post;
   Vector6d h0_ = Vector6d::Zero();
   double T0_ = 0.0;
+  // What the scenario adds (plotScenario): by sample joint, its PD servo's set point (NaN: `hold`,
+  // the joint's position where the servo's phase begins), none for a joint without a servo.
+  std::vector<std::optional<double>> set_points_;
+  std::vector<double> held_;  ///< the set points in force (NaN before the servo's phase)
+  bool servos_ = false, base_torque_ = false, base_force_ = false;
 };
 
 /// The plot of samples held in memory (an approach that never reached its grasp), through PlotWriter.

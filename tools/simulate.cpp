@@ -90,7 +90,7 @@ struct Streams {
       csv->write(x);
     }
     if (plot_file) {
-      if (!plot) plot.emplace(*plot_file, joints);
+      if (!plot) plot.emplace(*plot_file, joints, &sc);
       plot->add(x);
     }
   }
