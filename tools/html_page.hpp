@@ -171,6 +171,15 @@ function kdlSpaceMain() {
    return add(group, 'target link ' + link.name);
  });
  var targetLinksAt = 3 + 7 * N + (D.target ? 7 : 0);
+ if (targetLinks.length) {  // the camera frames the target's links too
+   for (var kt = 0; kt < n; ++kt)
+     for (var it = 0; it < targetLinks.length; ++it) {
+       var ot = kt * stride + targetLinksAt + 7 * it;
+       if (!isNaN(frames[ot])) { p.set(frames[ot], frames[ot + 1], frames[ot + 2]); lo.min(p); hi.max(p); }
+     }
+   centre = lo.clone().add(hi).multiplyScalar(0.5);
+   size = Math.max(hi.clone().sub(lo).length(), 0.2);
+ }
  var graspHolder = target || targetLinks[0] || null, graspAxes = null;
  if (D.grasp && graspHolder) {
    graspAxes = new THREE.AxesHelper(0.12 * size);
@@ -321,6 +330,7 @@ function kdlSpaceMain() {
 (function () {
  var K = window.kdlSpace;
  try { kdlSpaceMain(); } catch (e) { K.errors.push('the page could not start: ' + (e && e.message)); }
+ K.readyMs = performance.now();  // [ms] from the navigation's start: how long the page took to open
  K.ready = true;
  if (!/[#&]selftest=/.test(location.hash)) return;
  var ok = typeof K.current === 'function', k = ok ? K.current() : -1;
@@ -328,7 +338,7 @@ function kdlSpaceMain() {
    errors: K.errors, objectCount: ok ? K.objectCount() : 0, frameCount: K.frameCount, frame: k,
    time: ok ? K.time(k) : null, contactPoint: ok ? K.contactPoint(k) : null, impactFrame: ok ? K.impactFrame : -1,
    graspFrame: ok && K.graspFrame ? K.graspFrame(k) : null, closest: ok ? K.closest : null,
-   note: document.getElementById('note').textContent,
+   note: document.getElementById('note').textContent, readyMs: K.readyMs,
    targetLinkPoses: ok && K.targetLinkPose ? Array.apply(null, Array(K.targetLinkCount)).map(function (_, i) { return K.targetLinkPose(k, i); }) : [] });
 })();
 </script>

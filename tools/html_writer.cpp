@@ -330,6 +330,7 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
   data["closest"] = nullptr;
   if (r.approach && !r.approach->record.reached && std::isfinite(r.approach->record.closest_distance))
     data["closest"] = {{"distance", r.approach->record.closest_distance}, {"time", r.approach->record.closest_time}};
+  if (r.approach && !r.approach->record.reached) data["tCapture"] = nullptr;  // no contact: no impact to step to
 }
 
 void writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureResult& result, const std::string& title) {

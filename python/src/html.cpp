@@ -57,8 +57,9 @@ using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
 void operationToHtml(py::object self, const std::string& path) {
   const PyOperationRun& run = py::cast<const PyOperationRun&>(self.attr("_run"));
   const py::dict samples = self["samples"];
-  const Rows t = samples["t"], p = samples["base_position"], quat = samples["base_quaternion"], q = samples["q"];
-  const py::list phase = samples["phase"];
+  const auto t = samples["t"].cast<Rows>(), p = samples["base_position"].cast<Rows>(),
+             quat = samples["base_quaternion"].cast<Rows>(), q = samples["q"].cast<Rows>();
+  const auto phase = samples["phase"].cast<py::list>();
   const py::ssize_t k = t.size(), n = q.ndim() == 2 ? q.shape(1) : 0;
   const OperationResult& r = *run.result;
   if (p.ndim() != 2 || p.shape(0) != k || p.shape(1) != 3 || quat.ndim() != 2 || quat.shape(0) != k || quat.shape(1) != 4 ||
