@@ -21,6 +21,9 @@ robot:
 simulation:
   duration: 20
   output_step: 0.01
+  integrator: rosenbrock
+  rtol: 1.0e-6
+  atol: 1.0e-8
 YAML
 start=$(date +%s.%N)
 "$cli" simulate "$dir/humanoid.yaml" --html "$dir/humanoid.html" >/dev/null 2>"$dir/stderr"

@@ -140,6 +140,7 @@ def test_failed_approach_page_shows_how_close_it_came(tmp_path, cli):
     last = selftest(page, data["frameCount"] - 1)
     assert last["errors"] == [], last["errors"]
     assert last["note"].startswith("The approach failed") and "Closest to the grasp point" in last["note"]
+    assert last["impactFrame"] == -1, "no contact, no impact to step to"
     assert abs(last["closest"]["distance"] - closest) <= 1e-5 * closest  # the message's 6 digits
     assert abs(last["closest"]["time"] - when) <= 1e-5 * max(when, 1e-3)
     head, rows = csv_rows(csv)
@@ -226,11 +227,13 @@ HUMANOID = SOURCE_DIR / "tests" / "data" / "real_patterns" / "humanoid44.urdf"
 
 
 def humanoid_scenario(folder):
-    """A plain motion of the humanoid: 20 s of tumbling (its free joints swung by the base's
-    rotation), a row every 0.01 s (2001 samples: the page keeps 30 a second)."""
+    """A plain motion of the humanoid: 20 s of tumbling (its joints swung by the base's rotation), a
+    row every 0.01 s (2001 samples: the page keeps 30 a second). Its fingers' joints are stiff for an
+    explicit integrator: rosenbrock, as the tool advises."""
     path = folder / "humanoid.yaml"
     path.write_text(f"robot:\n  urdf: {HUMANOID}\n  base: {{twist: [0.02, 0.01, 0, 0.05, -0.03, 0.04]}}\n"
-                    "simulation:\n  duration: 20\n  output_step: 0.01\n")
+                    "simulation:\n  duration: 20\n  output_step: 0.01\n  integrator: rosenbrock\n"
+                    "  rtol: 1.0e-6\n  atol: 1.0e-8\n")
     return path
 
 
