@@ -58,6 +58,14 @@ PyProblem makeProblem(const PyState& state, const PyContact& contact, const Rigi
   return p;
 }
 
+/// A problem alone as a scenario (what its result's to_html draws): its robot's URDF, if known.
+std::shared_ptr<const Scenario> scenarioOf(const PyProblem& p) {
+  auto sc = std::make_shared<Scenario>();
+  sc->capture = p.problem;
+  sc->robot_urdf = p.robot_source;
+  return sc;
+}
+
 template <class C, class Get>
 void vec6Property(C& cls, const char* name, Get get, const char* doc) {
   cls.def_property_readonly(name, [get](const typename C::type& x) { return toNumpy6(get(x)); }, doc);
@@ -169,12 +177,7 @@ void bindCapture(py::module_& m) {
     return solve(s.scenario.capture, std::make_shared<const Scenario>(s.scenario));
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
      "the part.");
-  m.def("solve_capture", [](const PyProblem& p) {
-    auto sc = std::make_shared<Scenario>();  // a problem alone: its robot's URDF (if known) draws the robot
-    sc->capture = p.problem;
-    sc->robot_urdf = p.robot_source;
-    return solve(p.problem, std::move(sc));
-  }, py::arg("scenario_or_problem"),
+  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, scenarioOf(p)); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
     return Model{attachTarget(p, r.r), source};  // an Error naming the part
