@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "html_writer.hpp"
 #include "inspect.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -68,6 +69,10 @@ CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
   const CLI::Validator file_name(
       [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "");
   cmd->add_option("--scene", o.scene, "Draw the robot, the target and the contact point at the impact in 3-D (.svg or .png)")
+      ->type_name("FILE")->check(file_name);
+  cmd->add_option("--html", o.html,
+                  "Write the impact as an interactive 3-D page (one self-contained HTML file: the robot's URDF visuals "
+                  "at the impact, the target, the contact point, the grasp frame, the impulse as an arrow; before and after)")
       ->type_name("FILE")->check(file_name);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   return cmd;
@@ -228,8 +233,17 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     if (std::system("command -v gnuplot >/dev/null 2>&1") != 0)
       throw InputError("--scene " + o.scene + ": gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
   }
+  if (!o.html.empty()) {
+    checkHtmlLibrary("--html", o.html);
+    checkOutputFile(o.html, "--html");
+    refuseOverwritingInputs("--html", o.html, {{"the scenario file", o.scenario}});
+    std::error_code ec;
+    if (!o.scene.empty() && (o.html == o.scene || std::filesystem::equivalent(o.html, o.scene, ec)))
+      throw UsageError("--html and --scene name the same file " + o.html);
+  }
   const Scenario sc = loadScenario(o.scenario);
   refuseOverwritingInputs("--scene", o.scene, scenarioInputs(sc));
+  refuseOverwritingInputs("--html", o.html, scenarioInputs(sc));  // the URDFs it names too
   if (!sc.impact)
     throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
   if (sc.approach)
@@ -243,17 +257,24 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
                "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
     scene.commit();
   }
+  if (!o.html.empty()) {
+    AtomicFile page(o.html, "--html");
+    writeCaptureHtml(page, sc, result, "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
+    page.commit();
+  }
   const std::vector<Diagnostic> warnings = captureWarnings(sc.capture);
   if (!o.json) warnOnStderr(warnings);  // the JSON carries them; its runs keep stderr for errors
   if (o.json) {
     Json j = captureJson(sc, result);
     j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);
+    j["html"] = o.html.empty() ? Json(nullptr) : Json(o.html);  // the page (--html), or null
     j["warnings"] = warningsJson(warnings);
     out << j.dump(2) << "\n";
   } else {
     printCaptureSummary(out, sc, result);
     printWarnings(out, warnings);
     if (!o.scene.empty()) out << "Scene: " << o.scene << "\n";
+    if (!o.html.empty()) out << "Page: " << o.html << " (open it in a browser)\n";
   }
 }
 

@@ -1,6 +1,6 @@
-// `kdl_space capture SCENARIO [--scene FILE] [--json]`: the impact of the robot with its target,
+// `kdl_space capture SCENARIO [--scene FILE] [--html FILE] [--json]`: the impact of the robot with its target,
 // everything before and after (the library's loadScenario and solveCapture, printed), and a
-// picture of the impact instant (--scene).
+// picture of the impact instant (--scene), or an interactive 3-D page of it (--html).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,6 +17,7 @@ namespace kdl_space::cli {
 struct CaptureOptions {
   std::string scenario;
   std::string scene;  ///< --scene FILE (.svg or .png); empty: none
+  std::string html;   ///< --html FILE: the instant as an interactive 3-D page; empty: none
   bool json = false;
 };
 

@@ -381,6 +381,75 @@ function kdlSpaceMain() {
  }
  document.getElementById('legend').textContent = legend;
 
+ // --- A free-floating target's links, the grasp frame, a failed approach's closest distance ---
+ // A frame holds, after the robot's links (and a rigid target's frame), a free-floating target's
+ // link poses; the grasp frame rides on the target's frame (a rigid target's, or the base's).
+ var targetLinks = (D.targetLinks || []).map(function (link) {
+   var group = new THREE.Group();
+   link.visuals.forEach(function (v) { group.add(visualMesh(v)); });
+   return add(group, 'target link ' + link.name);
+ });
+ var targetLinksAt = 3 + 7 * N + (D.target ? 7 : 0);
+ if (targetLinks.length) {  // the camera frames the target's links too
+   for (var kt = 0; kt < n; ++kt)
+     for (var it = 0; it < targetLinks.length; ++it) {
+       var ot = kt * stride + targetLinksAt + 7 * it;
+       if (!isNaN(frames[ot])) { p.set(frames[ot], frames[ot + 1], frames[ot + 2]); lo.min(p); hi.max(p); }
+     }
+   centre = lo.clone().add(hi).multiplyScalar(0.5);
+   size = Math.max(hi.clone().sub(lo).length(), 0.2);
+ }
+ var graspHolder = target || targetLinks[0] || null, graspAxes = null;
+ if (D.grasp && graspHolder) {
+   graspAxes = new THREE.AxesHelper(0.12 * size);
+   place(graspAxes, D.grasp.pose);
+   graspHolder.add(graspAxes);
+   objects.push(graspAxes);
+   graspAxes.name = 'grasp frame';
+   document.getElementById('legend').textContent += '; small axes on the target: the grasp frame';
+ }
+ if (targetLinks.length)
+   document.getElementById('legend').textContent += '; orange links: the free-floating target (its URDF visuals, or boxes of inertia)';
+ function poseTargetLinks(f) {
+   for (var i = 0; i < targetLinks.length; ++i) {
+     var o = f + targetLinksAt + 7 * i;
+     targetLinks[i].visible = !isNaN(frames[o]);
+     if (targetLinks[i].visible) place(targetLinks[i], frames.subarray(o, o + 7));
+   }
+ }
+ function poseArray(o) {
+   var a = [];
+   for (var i = 0; i < 7; ++i) a.push(frames[o + i]);
+   return isNaN(a[0]) ? null : a;
+ }
+ // The world pose [x, y, z, qx, qy, qz, qw] of the grasp frame at frame k (null: none drawn).
+ K.graspFrame = function (k) {
+   if (!graspAxes) return null;
+   var holder = poseArray(k * stride + (target ? 3 + 7 * N : targetLinksAt));
+   if (!holder) return null;
+   var g = D.grasp.pose, m = new THREE.Matrix4().compose(new THREE.Vector3(holder[0], holder[1], holder[2]),
+       new THREE.Quaternion(holder[3], holder[4], holder[5], holder[6]), new THREE.Vector3(1, 1, 1));
+   m.multiply(new THREE.Matrix4().compose(new THREE.Vector3(g[0], g[1], g[2]), new THREE.Quaternion(g[3], g[4], g[5], g[6]),
+                                          new THREE.Vector3(1, 1, 1)));
+   var p = new THREE.Vector3(), q = new THREE.Quaternion(), s = new THREE.Vector3();
+   m.decompose(p, q, s);
+   return [p.x, p.y, p.z, q.x, q.y, q.z, q.w];
+ };
+ K.targetLinkCount = targetLinks.length;
+ K.targetLinkPose = function (k, i) { return poseArray(k * stride + targetLinksAt + 7 * i); };
+ // A failed approach: how close the hand came, when, and the frame nearest that instant.
+ K.closest = null;
+ if (D.closest) {
+   var kClosest = 0;
+   for (var kc = 1; kc < n; ++kc) if (Math.abs(times[kc] - D.closest.time) < Math.abs(times[kClosest] - D.closest.time)) kClosest = kc;
+   K.closest = { distance: D.closest.distance, time: D.closest.time, frame: kClosest };
+   var line = document.createElement('div');
+   line.id = 'closest';
+   line.textContent = 'Closest to the grasp point: ' + D.closest.distance.toPrecision(4) + ' m at t = ' +
+                      D.closest.time.toFixed(3) + ' s (frame ' + kClosest + ')';
+   document.getElementById('note').appendChild(line);
+ }
+
  var controls = new THREE.OrbitControls(camera, renderer.domElement);
  controls.target.copy(centre);
  camera.position.copy(centre).add(new THREE.Vector3(1.2 * size, -1.6 * size, 0.9 * size));
@@ -421,6 +490,7 @@ function kdlSpaceMain() {
      target.visible = !isNaN(frames[t]);
      if (target.visible) place(target, frames.subarray(t, t + 7));
    }
+   poseTargetLinks(f);
    contact.visible = !isNaN(frames[f]);
    contact.position.set(frames[f], frames[f + 1], frames[f + 2]);
    if (arrow) arrow.visible = k >= kImpact;
@@ -481,13 +551,17 @@ function kdlSpaceMain() {
 (function () {
  var K = window.kdlSpace;
  try { kdlSpaceMain(); } catch (e) { K.errors.push('the page could not start: ' + (e && e.message)); }
+ K.readyMs = performance.now();  // [ms] from the navigation's start: how long the page took to open
  K.ready = true;
  if (!/[#&]selftest=/.test(location.hash)) return;
  var ok = typeof K.current === 'function', k = ok ? K.current() : -1;
  document.getElementById('selftest').textContent = JSON.stringify({
    errors: K.errors, objectCount: ok ? K.objectCount() : 0, frameCount: K.frameCount, frame: k,
    time: ok ? K.time(k) : null, contactPoint: ok ? K.contactPoint(k) : null, impactFrame: ok ? K.impactFrame : -1,
-   meshes: K.meshes || [] });
+   meshes: K.meshes || [],
+   graspFrame: ok && K.graspFrame ? K.graspFrame(k) : null, closest: ok ? K.closest : null,
+   note: document.getElementById('note').textContent, readyMs: K.readyMs,
+   targetLinkPoses: ok && K.targetLinkPose ? Array.apply(null, Array(K.targetLinkCount)).map(function (_, i) { return K.targetLinkPose(k, i); }) : [] });
 })();
 </script>
 </body></html>

@@ -188,6 +188,20 @@ HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_
       target_ = *rigid;
       tumble_.emplace(*rigid);
     }
+  // A free-floating target: its links, drawn from its URDF's visuals (or their boxes of inertia).
+  if (sc.impact)
+    if (const auto* other = std::get_if<FloatingSystem>(&sc.capture.target)) {
+      target_model_ = other->model;
+      if (!sc.target_urdf.empty()) target_visuals_ = readUrdfVisuals(sc.target_urdf);
+      std::vector<Diagnostic> target_warnings;
+      for (const auto& [link, list] : target_visuals_)
+        for (const LinkVisual& v : list)
+          if (v.shape == LinkVisual::Shape::Mesh)
+            target_warnings.push_back({"target " + link, "--html: the mesh " + v.mesh_file +
+                                           " is drawn as the link's box of inertia (meshes are not read yet)",
+                                       "", Severity::Warning});
+      warnOnStderr(target_warnings);
+    }
 }
 
 std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const MotionSample& x) {
@@ -215,6 +229,10 @@ std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const Moti
   for (int k = 0; k < 3; ++k) f.push_back(static_cast<float>(c(k)));
   for (int i : index_)
     if (i >= 0) pushPose(f, kin.pose(i)); else pushHidden(f);
+  if (target_model_) {
+    pushFloatingTarget(f, so_far, x, kin);
+    return f;
+  }
   if (!target_) return f;
   // The target's frame: tumbling before the capture; then held by the hand, joined (its body's
   // inertia box), or tumbling on from the capture.
@@ -334,6 +352,7 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
     const Vector6d& F = r.capture->impulse.F;
     data["impulse"] = {F(0), F(1), F(2)};
   }
+  writeTargetAndGrasp(data, r);
   std::ofstream out(file.tmp(), std::ios::binary);
   if (!out) throw InputError(where + "cannot write in its folder");
   out << kHtmlHead << "<script>\n" << readText(kThreeJs, where) << "\n</script>\n<script>\n"
@@ -389,6 +408,12 @@ void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_f
 /// joint torque acted (the run's record says so), no base control plot without its attitude
 /// control.
 void HtmlWriter::plotsJson(Json& data, const OperationResult& r) {
+  if (!series_size_) {  // no sample's series (a capture's instant: before and after at one t): no plots
+    data["plots"] = Json::array();
+    data["seriesStride"] = 0;
+    data["series"] = "";
+    return;
+  }
   const std::size_t n = times_.size(), stride = data_.size() / n, pose = stride - series_size_;
   const std::vector<std::string>& robot = sc_.capture.robot.model->jointNames();
   const std::size_t nj = robot.size();
@@ -419,6 +444,89 @@ void HtmlWriter::plotsJson(Json& data, const OperationResult& r) {
   data["plots"] = plots;
   data["seriesStride"] = columns.size();
   data["series"] = base64(series.data(), series.size() * sizeof(float));
+}
+
+// --- A free-floating target, the grasp frame, a failed approach's closest distance -------------
+
+void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult& so_far, const MotionSample& x,
+                                    const Kinematics& kin) {
+  const FloatingModel& model = *so_far.model;
+  const std::vector<Body>& links = target_model_->bodies();
+  if (target_index_for_ != &model) {  // joined to the robot: its links by their (prefixed) names
+    target_index_for_ = &model;
+    target_index_.assign(links.size(), -1);
+    if (so_far.joined)
+      for (std::size_t k = 0; k < links.size(); ++k)
+        for (std::size_t i = 0; i < model.bodies().size(); ++i)
+          if (model.bodies()[i].name == so_far.joined->target_prefix + links[k].name) target_index_[k] = static_cast<int>(i);
+  }
+  if (so_far.joined) {  // the joined tree keeps each link's frame (joinAtGrasp re-roots, it does not move them)
+    for (int i : target_index_)
+      if (i >= 0) pushPose(f, kin.pose(i)); else pushHidden(f);
+    return;
+  }
+  // Not part of the system that moves: at the contact instant where the capture problem has it;
+  // after a point impact it drifts on by itself, which the page does not draw.
+  const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
+  if (target_at_contact_.empty() && other) {
+    Kinematics target_kin(*other->model);
+    if (forwardKinematics(*other->model, other->state, target_kin) == E_NOERROR)
+      for (std::size_t i = 0; i < links.size(); ++i) target_at_contact_.push_back(target_kin.pose(static_cast<int>(i)));
+  }
+  const bool at_contact = x.t <= so_far.t_capture && target_at_contact_.size() == links.size();
+  for (std::size_t i = 0; i < links.size(); ++i)
+    if (at_contact) pushPose(f, target_at_contact_[i]); else pushHidden(f);
+}
+
+void HtmlWriter::addKept(const OperationResult& so_far, const MotionSample& x) {
+  std::vector<float> f = frameOf(so_far, x);
+  if (!f.empty()) keep(std::move(f), x);
+}
+
+void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const {
+  data["targetLinks"] = nullptr;
+  if (target_model_) {
+    Json links = Json::array();
+    for (const Body& b : target_model_->bodies()) {
+      Json visuals = Json::array();
+      if (const auto it = target_visuals_.find(b.name); it != target_visuals_.end())
+        for (const LinkVisual& v : it->second)
+          visuals.push_back(v.shape == LinkVisual::Shape::Mesh ? inertiaBoxJson(b) : visualJson(v));
+      if (visuals.empty()) visuals.push_back(inertiaBoxJson(b));
+      for (Json& v : visuals)
+        if (!v.contains("rgba") || v.value("inertia_box", false)) v["rgba"] = {1.0, 0.5, 0.05, 0.55};  // the target's orange
+      links.push_back({{"name", b.name}, {"visuals", visuals}});
+    }
+    data["targetLinks"] = links;
+  }
+  // The grasp frame rides on the target's frame (a rigid target's, a free-floating one's base).
+  data["grasp"] = nullptr;
+  if (sc_.grasp_frame && (target_ || target_model_)) data["grasp"] = {{"pose", poseJson(*sc_.grasp_frame)}};
+  // A failed approach: how close the hand came to the grasp point, and when.
+  data["closest"] = nullptr;
+  if (r.approach && !r.approach->record.reached && std::isfinite(r.approach->record.closest_distance))
+    data["closest"] = {{"distance", r.approach->record.closest_distance}, {"time", r.approach->record.closest_time}};
+  if (r.approach && !r.approach->record.reached) data["tCapture"] = nullptr;  // no contact: no impact to step to
+}
+
+void writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureResult& result, const std::string& title) {
+  OperationResult instant;  // the capture at the scenario's states, as the operation would have it at t = 0
+  instant.at_contact = sc.capture;
+  instant.capture = result;
+  instant.model = sc.capture.robot.model;
+  MotionSample x;
+  const State& s = sc.capture.robot.state;
+  x.p = toEigen(s.world_T_base.p);
+  s.world_T_base.M.GetQuaternion(x.quat(0), x.quat(1), x.quat(2), x.quat(3));
+  x.q = s.q.data;
+  HtmlWriter writer(sc);
+  OperationResult before = instant;  // the first frame: before the impact
+  before.capture.reset();
+  x.phase = Phase::Capture;
+  writer.addKept(before, x);
+  x.phase = Phase::Post;
+  writer.addKept(instant, x);
+  writer.write(file, instant, title);
 }
 
 }  // namespace kdl_space::cli

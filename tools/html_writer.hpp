@@ -17,6 +17,7 @@
 #include "cli_common.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/parsers/urdf/urdf_visuals.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 
@@ -52,6 +53,8 @@ class HtmlWriter {
                       double frames_per_second = 30.0, std::size_t max_frames = 3000);
   /// One sample of the run; `so_far.model` is the system it belongs to.
   void add(const OperationResult& so_far, const MotionSample& x);
+  /// One sample kept whatever the display rate (a capture's instant: before and after at one time).
+  void addKept(const OperationResult& so_far, const MotionSample& x);
   /// Writes the page into file.tmp() (the caller commits it). `note`: shown over the view (e.g.
   /// "the approach did not reach its grasp").
   void write(const AtomicFile& file, const OperationResult& r, const std::string& title, const std::string& note = "");
@@ -104,6 +107,25 @@ class HtmlWriter {
   bool series_phase0_ = false;
   Phase series_phase_ = Phase::Post;
   double series_T0_ = 0.0;
+
+  // --- A free-floating target (its links posed per frame) and the grasp frame ----------------
+  /// Appends a free-floating target's link poses to frame `f` (7 floats a link; NaN: not drawn).
+  void pushFloatingTarget(std::vector<float>& f, const OperationResult& so_far, const MotionSample& x,
+                          const Kinematics& kin);
+  /// The target's links and the grasp frame (`data`'s "targetLinks", "grasp", "closest").
+  void writeTargetAndGrasp(Json& data, const OperationResult& r) const;
+  std::shared_ptr<const FloatingModel> target_model_;  ///< a free-floating target's model, or none
+  std::map<std::string, std::vector<LinkVisual>> target_visuals_;  ///< of its URDF (target.urdf)
+  std::vector<KDL::Frame> target_at_contact_;  ///< its links (world) at the contact instant
+  std::vector<int> target_index_;              ///< its link -> body in model_ when joined (-1: none)
+  const FloatingModel* target_index_for_ = nullptr;  ///< the system target_index_ is for
 };
+
+/// \brief The page of a capture at the scenario's states (`kdl_space capture --html`, Python's
+/// CaptureResult.to_html): the instant as two frames at t = 0, before and after the impact (the
+/// configuration does not change at an impact; the impulse's arrow shows from the first).
+/// Writes into file.tmp() (the caller commits it).
+void writeCaptureHtml(const AtomicFile& file, const Scenario& scenario, const CaptureResult& result,
+                      const std::string& title);
 
 }  // namespace kdl_space::cli

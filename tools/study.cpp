@@ -13,6 +13,8 @@
 #include <thread>
 
 #include "capture.hpp"
+#include "html_writer.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
 #include "plot_writer.hpp"
 #include "study_plot.hpp"
 #include "study_table.hpp"
@@ -37,11 +39,50 @@ CLI::App* addStudy(CLI::App& app, StudyOptions& o) {
   cmd->add_option("--groups", o.groups,
                   "Write the per-grid-point aggregates (mean, q95, max of each outcome, P(exceeds.*)) as CSV")
       ->type_name("FILE");
+  cmd->add_option("--html", o.html,
+                  "Write the study's nominal sample (its scenario as written: the capture, and the study's motion "
+                  "after it) as an interactive 3-D page (one self-contained HTML file)")
+      ->type_name("FILE");
   cmd->add_flag("--json", o.json, "Print the summary as one JSON object instead of text");
   return cmd;
 }
 
 namespace {
+
+/// \brief The page of the study's nominal sample (`--html`): its scenario as written, the capture at
+/// its states and, if the study has a motion, that motion after it (as a sample's: the servos hold
+/// the capture configuration). Written under a temporary name before the study runs (a page
+/// that cannot be drawn is refused before the long work); the caller commits it. A motion that
+/// fails still gives its page, noted, with a warning: the study's samples may fail too.
+std::unique_ptr<AtomicFile> nominalSamplePage(const Study& st, const std::string& path) {
+  auto file = std::make_unique<AtomicFile>(path, "--html");
+  const Scenario& sc = st.scenario;
+  const std::string title = "kdl_space study " + fs::path(st.file).filename().string() + ": the nominal sample";
+  if (!(st.motion_duration > 0.0)) {
+    const CaptureResult r = inScenario(sc, [&] { return solveCapture(sc.capture); });
+    writeCaptureHtml(*file, sc, r, title);
+    return file;
+  }
+  HtmlWriter page(sc);
+  OperationOptions o;  // what a sample's motion runs (StudyEvaluator's motionPeaks)
+  o.approach = false;
+  o.duration = st.motion_duration;
+  o.output_step = st.motion_output_step;
+  o.hold_servos = true;
+  o.keep_samples = false;
+  o.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
+  o.observer = [&](const OperationResult& so_far, const MotionSample& x) { page.add(so_far, x); };
+  try {
+    page.write(*file, runCaptureOperation(sc, o), title);
+  } catch (const OperationError& e) {
+    if (e.code() == E_CANCELLED) throw Interrupted(std::string(e.what()) + "; no output written");
+    if (!e.partial() || page.frames() == 0) throw;
+    std::cerr << "kdl_space: warning: --html " << path << ": the nominal sample's motion failed; its page shows it "
+              << "until then: " << e.what() << "\n";
+    page.write(*file, *e.partial(), title, std::string("The nominal sample's motion failed: ") + e.what());
+  }
+  return file;
+}
 
 /// "i/N" -> rows [floor((i-1) S / N), floor(i S / N)).
 std::pair<std::uint64_t, std::uint64_t> shardRange(const std::string& text, std::uint64_t samples, std::uint64_t& i,
@@ -354,7 +395,8 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     table = fs::path(st.file).stem().string() +
             (shard_n ? ".part-" + std::to_string(shard_i) + "-of-" + std::to_string(shard_n) : std::string()) + ".csv";
   const std::pair<const char*, std::string> outputs[] = {
-      {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}, {"--groups", o.groups}};
+      {"--table", table}, {"--plot", o.plot}, {"--heat-map", o.heat_map}, {"--summary", o.summary}, {"--groups", o.groups},
+      {"--html", o.html}};
   if (o.merge.empty() && StudyGrid{begin, end, chunkSize(o, st)}.count() > kMaxChunks)
     throw UsageError("--chunk-size " + std::to_string(chunkSize(o, st)) + ": " +
                      std::to_string(StudyGrid{begin, end, chunkSize(o, st)}.count()) + " chunk files for samples " +
@@ -371,6 +413,16 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   }
   if ((!o.plot.empty() || (!o.heat_map.empty() && map_ext != ".csv")) && std::system("command -v gnuplot >/dev/null 2>&1") != 0)
     throw InputError("--plot: gnuplot is not installed (Debian package gnuplot-nox; tools/deps.sh installs it)");
+  std::unique_ptr<AtomicFile> page;
+  if (!o.html.empty()) {
+    for (const auto& [other, other_path] : outputs)  // the page in no other output's file
+      if (std::string(other) != "--html" && !other_path.empty() && (o.html == other_path || fs::equivalent(o.html, other_path, ec)))
+        throw UsageError("--html and " + std::string(other) + " name the same file " + o.html);
+    if (!o.shard.empty() || !o.merge.empty())
+      throw UsageError("--html " + o.html + ": the nominal sample's page is drawn by the whole study's run (not with --shard or --merge)");
+    checkHtmlLibrary("--html", o.html);
+    page = nominalSamplePage(st, o.html);
+  }
 
   // The summary from the rows as the table is written, a block at a time: never the whole table.
   StudySummarizer summarizer(study);
@@ -397,7 +449,8 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     return;
   }
   const StudySummary summary = summarizer.finish();
-  const Json json = studySummaryJson(st, summary, table);
+  Json json = studySummaryJson(st, summary, table);
+  json["html"] = o.html.empty() ? Json(nullptr) : Json(o.html);  // the nominal sample's page, or null
   if (!o.summary.empty()) {
     AtomicFile f(o.summary, "--summary");
     std::ofstream s(f.tmp());
@@ -424,10 +477,12 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     writeStudyHeatMap(f, st, summary);
     f.commit();
   }
+  if (page) page->commit();
   if (o.json) {
     out << json.dump(2) << "\n";
   } else {
     printSummary(out, st, summary, table);
+    if (page) out << "Page of the nominal sample: " << o.html << " (open it in a browser)\n";
     out << "\n(" << how << ")\n";
   }
 }

@@ -44,6 +44,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     JointRecord,
     Model,
     ModelError,
+    OperationResult,
     RecursiveExIITSolver,
     RigidTarget,
     Scenario,
@@ -89,7 +90,7 @@ ik = inverse_kinematics  # the short name (as the command `kdl_space ik`)
 __all__ = [
     "CaptureProblem", "CapturePlan", "CaptureResult", "ComputeError", "Contact", "DenseForwardDynamicsSolver",
     "Diagnostic", "ElementType", "Error", "Finding", "ForwardDynamicsSolver", "FreeFloatingSolver",
-    "ImpactLaw", "Impulse", "InputError", "Integrator", "JointRecord", "Model", "ModelError",
+    "ImpactLaw", "Impulse", "InputError", "Integrator", "JointRecord", "Model", "ModelError", "OperationResult",
     "RecursiveExIITSolver", "RigidTarget", "Scenario", "Severity", "SideResult", "SimulationResult",
     "SimulationStats", "Simulator", "State", "Stiffness", "Study", "StudyResult", "attach_target",
     "check_urdf", "codes", "ik", "inverse_kinematics",

@@ -196,13 +196,17 @@ class CaptureResult:
     virtual_mass: Optional[float]
     contact_body_pose: Array
     warnings: list[dict[str, str]]  # the robot's configuration at the capture: {kind, element, message}
+    def to_html(self, path: str) -> None: ...  # the instant as `kdl_space capture --html` draws it
+
+class OperationResult(dict[str, Any]):  # run_operation's dict (`simulate --json`'s keys, 'samples')
+    def to_html(self, path: str) -> None: ...  # the run as `kdl_space simulate --html` draws it
 
 def load_scenario(path: str) -> Scenario: ...
 def run_operation(scenario: Scenario, *, duration: Optional[float] = None, output_step: Optional[float] = None,
                   approach: bool = True, motion: bool = True,
                   observer: Optional[Callable[[float, str, Array, Array], None]] = None,
                   controller: Optional["Controller"] = None, control_rate: Optional[float] = None,
-                  max_output_rows: int = 10_000_000, check_gains: bool = True) -> dict[str, Any]: ...
+                  max_output_rows: int = 10_000_000, check_gains: bool = True) -> OperationResult: ...
 def solve_capture(scenario_or_problem: Union[Scenario, CaptureProblem]) -> CaptureResult: ...
 @overload
 def inverse_kinematics(state: State, contact: Contact, goal: Union[ArrayLike, Tuple[ArrayLike, ArrayLike]], *,

@@ -4,6 +4,7 @@
 
 #include "conversions.hpp"
 #include "capture_types.hpp"
+#include "html.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/impact/capture.hpp"
@@ -12,13 +13,13 @@
 namespace kdl_space::python {
 namespace {
 
-PyResult solve(const CaptureProblem& p) {
+PyResult solve(const CaptureProblem& p, std::shared_ptr<const Scenario> scenario) {
   CaptureResult r;
   {
     py::gil_scoped_release nogil;
     r = solveCapture(p);  // InputError or a side's ModelError, as kdl_space's
   }
-  PyResult out{r, PySide{r.robot, p.robot.model->jointNames()}, std::nullopt};
+  PyResult out{r, PySide{r.robot, p.robot.model->jointNames()}, std::nullopt, {}, std::move(scenario)};
   if (r.floating_target)
     out.floating_target = PySide{*r.floating_target, std::get<FloatingSystem>(p.target).model->jointNames()};
   Conditioning c;  // a state the solver refused has failed the capture above: only the limits then
@@ -55,6 +56,14 @@ PyProblem makeProblem(const PyState& state, const PyContact& contact, const Rigi
   else if (method == "dense") p.problem.method = ExIITMethod::Dense;
   else throw py::value_error("method: expected 'recursive' or 'dense', got '" + method + "'");
   return p;
+}
+
+/// A problem alone as a scenario (what its result's to_html draws): its robot's URDF, if known.
+std::shared_ptr<const Scenario> scenarioOf(const PyProblem& p) {
+  auto sc = std::make_shared<Scenario>();
+  sc->capture = p.problem;
+  sc->robot_urdf = p.robot_source;
+  return sc;
 }
 
 template <class C, class Get>
@@ -149,6 +158,11 @@ void bindCapture(py::module_& m) {
   vec6Property(result, "target_twist_after", [](const PyResult& x) { return x.r.target_twist_after; }, "(6,).");
   vec6Property(result, "momentum_before", [](const PyResult& x) { return x.r.momentum_before; }, "(P; L about the origin), both sides, (6,).");
   vec6Property(result, "momentum_after", [](const PyResult& x) { return x.r.momentum_after; }, "(6,).");
+  result.def("to_html", &captureToHtml, py::arg("path"),
+             "Writes the capture's instant as the interactive 3-D page of `kdl_space capture --html` (one "
+             "self-contained HTML file, the same writer): the robot at the impact, the target, the contact point, "
+             "the grasp frame, the impulse's arrow; before and after. ValueError for a path that is one of the "
+             "scenario's inputs, OSError for a folder that cannot hold it or three.js missing; each names the path.");
   result.def("__repr__", [](const PyResult& x) {
     std::ostringstream s;
     s << "<kdl_space.CaptureResult F=[" << x.r.impulse.F.transpose() << "], energy lost " << x.r.energyLost() << " J>";
@@ -160,10 +174,10 @@ void bindCapture(py::module_& m) {
         "that loads no model: the loader's ModelError, with the same 'FILE:LINE: robot.urdf: ' in front).");
   m.def("solve_capture", [](const PyScenario& s) {
     if (!s.scenario.impact) throw py::value_error("scenario: '" + s.scenario.file + "' has no target and no law (a plain motion)");
-    return solve(s.scenario.capture);
+    return solve(s.scenario.capture, std::make_shared<const Scenario>(s.scenario));
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
      "the part.");
-  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem); }, py::arg("scenario_or_problem"),
+  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, scenarioOf(p)); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
     return Model{attachTarget(p, r.r), source};  // an Error naming the part

@@ -2,6 +2,7 @@
 // capture starts from them).
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ struct PyResult {
   std::optional<PySide> floating_target;
   /// The robot's configuration at the capture (checkConfiguration: limits, a near-singular J*).
   std::vector<Diagnostic> warnings = {};
+  /// The scenario it solved (a CaptureProblem's: the problem, its robot's URDF): what to_html draws.
+  std::shared_ptr<const Scenario> scenario = nullptr;
 };
 
 }  // namespace kdl_space::python

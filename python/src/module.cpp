@@ -2,6 +2,7 @@
 // state, solvers, impact laws, capture, forward dynamics, simulation, studies); the package kdl_space
 // (python/kdl_space) re-exports it.
 #include "conversions.hpp"
+#include "html.hpp"
 
 PYBIND11_MODULE(_kdl_space, m) {
   m.doc() = "Free-floating space manipulator dynamics (kdl_space, Yoshida et al.): the C++ library's "
@@ -18,6 +19,7 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindSimulation(m);
   bindStudy(m);
   bindOperation(m);
+  bindHtml(m);
   bindInverseKinematics(m);
   bindPlanning(m);
 }

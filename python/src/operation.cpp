@@ -7,6 +7,7 @@
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
+#include "html.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "operation_report.hpp"
 #include "simulation_types.hpp"
@@ -51,7 +52,7 @@ py::dict samplesDict(const OperationResult& r) {
   return d;
 }
 
-py::dict runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
+py::object runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
                       py::object observer, py::object controller, py::object control_rate,
                       std::uint64_t max_output_rows, bool check_gains) {
   const Scenario& sc = ps.scenario;
@@ -115,7 +116,7 @@ py::dict runOperation(const PyScenario& ps, py::object duration, py::object outp
   const py::dict d = py::module_::import("json").attr("loads")(cli::operationJson(sc, r).dump());
   reportWarnings(r.warnings);  // the motion's warnings (also in d["warnings"]) as RuntimeWarnings
   d["samples"] = samplesDict(r);
-  return d;
+  return operationResultOf(d, std::make_shared<const Scenario>(sc), std::move(r));  // a dict with to_html
 }
 
 }  // namespace
@@ -130,7 +131,7 @@ void bindOperation(py::module_& m) {
         "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
         "'samples': the approach's and the motion's samples as NumPy arrays (t, phase, base_position, "
         "base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, work, impulse, grasp_distance; "
-        "joint_names). `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
+        "joint_names); an OperationResult (a dict) whose to_html(path) writes the run's 3-D page. `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
         "`observer(t, phase, q, qdot)` sees every sample. With control_rate and check_gains the controller is "
         "first probed at the start of the motion (2 calls a joint, its rate perturbed): a rate gain kd above "

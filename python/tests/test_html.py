@@ -21,8 +21,8 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 needs_browser = pytest.mark.skipif(CHROMIUM is None, reason="no chromium binary (Debian package chromium; tools/deps.sh installs it)")
 SCENARIO = SOURCE_DIR / "scenarios" / "approach_tumbling_box.yaml"
 # Markers besides the links and the target: the base frame's axes, the contact point, the hand's
-# path, the impulse's arrow.
-MARKERS = 4
+# path, the impulse's arrow, the grasp frame's axes (approach.grasp, riding on the target).
+MARKERS = 5
 
 # What the test puts into the arm's URDF: one visual of each kind (the mesh's file does not exist:
 # its link's box of inertia; test_html_meshes.py draws meshes).

@@ -38,7 +38,7 @@ TEST_P(CaptureTool, ReproducesTheReferenceEngine) {
   EXPECT_EQ(r.err, "");
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(keys(j), (std::vector<std::string>{"G_B", "G_star", "contact_point", "contact_point_in_target",
-                                               "energy_after", "energy_before", "energy_lost", "grasp", "impulse",
+                                               "energy_after", "energy_before", "energy_lost", "grasp", "html", "impulse",
                                                "momentum_after", "momentum_before", "robot", "scene", "target",
                                                "virtual_mass", "warnings"}));
   EXPECT_EQ(keys(j.at("robot")), (std::vector<std::string>{"base_twist_after", "base_twist_before",

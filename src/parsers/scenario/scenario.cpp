@@ -301,6 +301,7 @@ Scenario loadScenario(const std::string& path) {
     if (robot.has("place") && !s.grasp_solution) {  // a rigid target: its frame (pose, or its link's)
       s.grasp_solution = placeAtGrasp(robot, s.capture.robot, std::get<RigidTarget>(s.capture.target).pose);
     }
+    if (s.grasp_solution) s.grasp_frame = pose(robot.at("grasp").at("target_frame"));
     if (target.has("grasp")) target.at("grasp").fail("the grasp frame is the robot's field: robot.grasp.target_frame");
     s.capture.law = law(top.at("law"), s.capture.has_normal);
   } else if (!top.has("simulation")) {
@@ -312,6 +313,7 @@ Scenario loadScenario(const std::string& path) {
     if (std::holds_alternative<FloatingSystem>(s.capture.target))
       approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
     s.approach = sections::approach(approach, *s.capture.robot.model);
+    s.grasp_frame = s.approach->grasp;
   }
   if (top.has("simulation")) {
     const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);

@@ -56,6 +56,10 @@ struct Scenario {
   /// target's grasp frame (`robot.grasp.target_frame`, in the target's frame); its q is
   /// capture.robot.state.q (joints off the contact's chain keep robot.q).
   std::optional<IkResult> grasp_solution;
+  /// The grasp frame in the target's frame (a rigid target's `pose` frame, a free-floating
+  /// target's base frame): `robot.grasp.target_frame` with `robot.place: grasp`, or
+  /// `approach.grasp`; unset without either (what the pictures draw as the grasp frame).
+  std::optional<KDL::Frame> grasp_frame;
 };
 
 /// \brief Reads and checks a scenario file; URDF paths are relative to the scenario's folder.
