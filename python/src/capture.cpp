@@ -7,12 +7,14 @@
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/impact/capture.hpp"
+#include "kdl_space/operation/overlap_check.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::python {
 namespace {
 
-PyResult solve(const CaptureProblem& p) {
+/// `robot_urdf`: the robot's visuals for the overlap check ("" for its boxes of inertia).
+PyResult solve(const CaptureProblem& p, const std::string& robot_urdf) {
   CaptureResult r;
   {
     py::gil_scoped_release nogil;
@@ -23,6 +25,7 @@ PyResult solve(const CaptureProblem& p) {
     out.floating_target = PySide{*r.floating_target, std::get<FloatingSystem>(p.target).model->jointNames()};
   Conditioning c;  // a state the solver refused has failed the capture above: only the limits then
   checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, out.warnings);
+  for (Diagnostic& d : overlapWarnings(p, robot_urdf, "capture")) out.warnings.push_back(std::move(d));
   return out;
 }
 
@@ -130,11 +133,18 @@ void bindCapture(py::module_& m) {
       .def_readonly("floating_target", &PyResult::floating_target, "The free-floating target's SideResult, or None.")
       .def_property_readonly("warnings", [](const PyResult& x) {
         py::list l;
-        for (const Diagnostic& w : x.warnings) l.append(py::dict(py::arg("kind") = w.kind, py::arg("element") = w.element,
-                                                                 py::arg("message") = w.message));
+        for (const Diagnostic& w : x.warnings) {
+          py::dict d(py::arg("kind") = w.kind, py::arg("element") = w.element, py::arg("message") = w.message);
+          for (const auto& [key, value] : w.details)
+            std::visit([&d, &key](const auto& v) { d[py::str(key)] = v; }, value);
+          l.append(d);
+        }
         return l;
       }, "The robot's configuration at the capture: list of {kind, element, message} (joint_outside_limits, "
-         "near_singular), as `kdl_space capture --json`'s `warnings`.")
+         "near_singular; overlap: a link that penetrates the target's box of inertia by more than 1 cm, with "
+         "link, target, depth [m], moment 'capture' and geometry 'visuals' or 'inertia_box'; a CaptureProblem's "
+         "robot is checked by its boxes of inertia, a Scenario's by its URDF visuals), as `kdl_space capture "
+         "--json`'s `warnings`.")
       .def_property_readonly("contact_point", [](const PyResult& x) { return toNumpy(x.r.contact_point, true); }, "(3,) [m].")
       .def_property_readonly("G_robot", [](const PyResult& x) { return toNumpy(x.r.G_robot); }, "The robot's G (6, 6).")
       .def_property_readonly("G_target", [](const PyResult& x) { return toNumpy(x.r.G_target); }, "The target's G (6, 6).")
@@ -160,10 +170,10 @@ void bindCapture(py::module_& m) {
         "that loads no model: the loader's ModelError, with the same 'FILE:LINE: robot.urdf: ' in front).");
   m.def("solve_capture", [](const PyScenario& s) {
     if (!s.scenario.impact) throw py::value_error("scenario: '" + s.scenario.file + "' has no target and no law (a plain motion)");
-    return solve(s.scenario.capture);
+    return solve(s.scenario.capture, s.scenario.robot_urdf);
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
      "the part.");
-  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem); }, py::arg("scenario_or_problem"),
+  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, ""); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
     return Model{attachTarget(p, r.r), source};  // an Error naming the part
