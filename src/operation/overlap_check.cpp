@@ -71,16 +71,36 @@ std::vector<Diagnostic> overlapWarnings(const CaptureProblem& problem, const Lin
   Kinematics kin(*r.model);
   if (obstacles.empty() || forwardKinematics(*r.model, r.state, kin) != E_NOERROR) return {};
   const std::vector<bool> hand = contactBodies(*r.model, r.contact.body);
+  // The link that carries the hand (the wrist) reaches as deep as the grasp point: where that
+  // point lies inside the target's box, the target is smaller there than its box; the wrist's
+  // allowance grows by that depth. Every other link keeps `allowance`.
+  int wrist = -1;
+  for (std::size_t i = 0; i < hand.size(); ++i)
+    if (hand[i] && r.model->bodies()[i].parent >= 0 && !hand[r.model->bodies()[i].parent]) wrist = r.model->bodies()[i].parent;
+  double grasp_depth = 0.0;
+  const OrientedBox grasp{KDL::Frame(toKDL(kin.point(r.contact))), Vector3d::Zero()};
+  for (const OrientedBox& b : obstacles) grasp_depth = std::max(grasp_depth, penetrationDepth(grasp, b));
+  std::vector<bool> skip = hand, only_wrist(hand.size(), true);
+  if (wrist >= 0) skip[wrist] = true, only_wrist[wrist] = false;
+  std::vector<BoxPenetration> found = penetrations(kin, robot.boxes, obstacles, skip, allowance);
+  if (wrist >= 0)
+    for (const BoxPenetration& p : penetrations(kin, robot.boxes, obstacles, only_wrist, allowance + grasp_depth))
+      found.push_back(p);
+  std::stable_sort(found.begin(), found.end(), [](const BoxPenetration& x, const BoxPenetration& y) { return x.depth > y.depth; });
   std::vector<Diagnostic> out;
-  for (const BoxPenetration& p : penetrations(kin, robot.boxes, obstacles, hand, allowance)) {
+  for (const BoxPenetration& p : found) {
+    const double allowed = p.body == wrist ? allowance + grasp_depth : allowance;
     const std::string& link = r.model->bodies()[p.body].name;
     const bool visuals = p.body < static_cast<int>(robot.from_visuals.size()) && robot.from_visuals[p.body];
     std::ostringstream s;
     if (moment == "capture") s << "at the capture: ";
     s << "link '" << link << "' (" << (visuals ? "its visuals' bounding boxes" : "its box of inertia")
       << ") penetrates the " << names[p.obstacle] << "'s box of inertia by " << detail::number(p.depth)
-      << " m (more than " << detail::number(allowance)
-      << " m): check the target's pose and the grasp (the robot's placing, the target's pose and com)"
+      << " m (more than " << detail::number(allowed) << " m"
+      << (p.body == wrist && grasp_depth > 0.0 ? ": the hand's link may reach as deep as the grasp point, " +
+                                                     detail::number(grasp_depth) + " m inside the box, plus " + detail::number(allowance) + " m"
+                                               : std::string())
+      << "): check the target's pose and the grasp (the robot's placing, the target's pose and com)"
       << (visuals ? "" : "; a box of inertia only bounds a link's geometry: give the link a <visual> box, cylinder "
                          "or sphere in its URDF for a closer one");
     Diagnostic d{link, s.str(), "overlap", Severity::Warning};

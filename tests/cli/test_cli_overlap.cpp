@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "cli_runner.hpp"
 
@@ -99,26 +100,38 @@ TEST(OverlapWarning, TheTargetMovedAwayWarnsNoMore) {
 }
 
 TEST(OverlapWarning, AnApproachWarnsOfItsStartPoseBeforeItRuns) {
-  // The approach cannot reach (0.05 s): what it started from is warned of all the same.
+  // The start pose, warned of before the approach runs (its grasp is where the hand starts).
   const std::string sc = swallowed("overlap_approach.yaml",
                                    "approach:\n  grasp: {position: [0, 0, 0.4]}\n  track: position\n  gain: 1.0\n"
                                    "  tolerance: {position: 0.001}\n  max_duration: 0.05\n");
   const ToolRun run = kdlSpace("simulate " + sc);
-  EXPECT_NE(run.rc, 0);
   EXPECT_EQ(count(run.err, "kdl_space: warning: link1: at the start of the approach: link 'link1' (its visuals' "
                            "bounding boxes) penetrates the target's box of inertia by 0.9 m"), 1u) << run.err;
 }
 
-TEST(OverlapWarning, NoShippedScenarioWarns) {
+TEST(OverlapWarning, NoShippedScenarioWarnsButTheTwoSatellitesThatOverlap) {
+  // dual_arm_captures_robot.yaml places the target robot so that its hand touches the tool: the
+  // two satellites' boxes of inertia then overlap (0.34 m), as do the camera mast and the target's
+  // link1, and left_link4 and its link2 (no URDF there has visuals: a finding of the scenario).
   const std::string dir = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
+  int runs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".yaml" || entry.path().filename().string().rfind("study_", 0) == 0) continue;
     SCOPED_TRACE(entry.path().string());
     const ToolRun run = kdlSpace("simulate " + entry.path().string() + " --duration 0.05 --json");
     ASSERT_EQ(run.rc, 0) << run.err;
-    for (const nlohmann::json& w : nlohmann::json::parse(run.out).at("warnings"))
-      EXPECT_NE(w.at("kind"), "overlap") << w.dump();
+    ++runs;
+    const nlohmann::json j = nlohmann::json::parse(run.out);
+    std::vector<std::string> overlapping;
+    for (const nlohmann::json& w : j.at("warnings"))
+      if (w.at("kind") == "overlap") overlapping.push_back(w.at("link").get<std::string>() + " in " + w.at("target").get<std::string>());
+    if (entry.path().filename() == "dual_arm_captures_robot.yaml")
+      EXPECT_EQ(overlapping, (std::vector<std::string>{"satellite in target link 'base'", "camera_mast in target link 'link1'",
+                                                       "left_link4 in target link 'link2'"}));
+    else
+      EXPECT_TRUE(overlapping.empty()) << j.at("warnings").dump();
   }
+  EXPECT_GE(runs, 14);
 }
 
 }  // namespace

@@ -40,7 +40,9 @@ KDL_SPACE_EXPORT LinkGeometry linkGeometry(const FloatingModel& model,
 /// robot link that penetrates deeper than `allowance` [m] (penetrations; deepest first), element
 /// the link, details {link, target, depth [m], moment, geometry: "visuals" or "inertia_box"}.
 /// The bodies that carry the contact (contactBodies: the hand touches the target by design) are
-/// not checked. `moment`: "start" or "capture" (the message begins "at the capture: " for the
+/// not checked; the link that carries them (the wrist) may reach as deep as the grasp point lies
+/// inside the target's boxes (a grasp inside a box says the target is smaller there), plus
+/// `allowance`. `moment`: "start" or "capture" (the message begins "at the capture: " for the
 /// latter; the start's is the caller's to say: approachStartWarnings). Pure; no warning where the
 /// kinematics cannot be computed (the run fails there on its own).
 KDL_SPACE_EXPORT std::vector<Diagnostic> overlapWarnings(const CaptureProblem& problem, const LinkGeometry& robot,
