@@ -13,6 +13,7 @@
 #include "inspect.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/operation/overlap_check.hpp"
 #include "scene_writer.hpp"
 
 namespace kdl_space::cli {
@@ -124,11 +125,12 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
   return j;
 }
 
-std::vector<Diagnostic> captureWarnings(const CaptureProblem& p) {
+std::vector<Diagnostic> captureWarnings(const Scenario& sc, const CaptureProblem& p) {
   Conditioning c;
   std::vector<Diagnostic> warnings;
   // A state the solver refuses has failed the capture already; the limit warnings stand alone then.
   checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, warnings);
+  for (Diagnostic& d : overlapWarnings(sc, p, "capture")) warnings.push_back(std::move(d));
   return warnings;
 }
 
@@ -262,7 +264,7 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     writeCaptureHtml(page, sc, result, "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
     page.commit();
   }
-  const std::vector<Diagnostic> warnings = captureWarnings(sc.capture);
+  const std::vector<Diagnostic> warnings = captureWarnings(sc, sc.capture);
   if (!o.json) warnOnStderr(warnings);  // the JSON carries them; its runs keep stderr for errors
   if (o.json) {
     Json j = captureJson(sc, result);

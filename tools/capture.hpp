@@ -44,8 +44,9 @@ Json graspJson(const Scenario& scenario);
 /// The capture JSON object (the keys are a contract: see the README).
 Json captureJson(const Scenario& scenario, const CaptureResult& result);
 /// \brief The warnings about the robot's configuration at the capture (`problem`'s state and
-/// contact): a joint outside its limits, J* near a singularity (checkConfiguration).
-std::vector<Diagnostic> captureWarnings(const CaptureProblem& problem);
+/// contact): a joint outside its limits, J* near a singularity (checkConfiguration), and a robot
+/// link that penetrates the target (overlapWarnings, moment "capture": the scenario's visuals).
+std::vector<Diagnostic> captureWarnings(const Scenario& scenario, const CaptureProblem& problem);
 /// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
 void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
 /// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr (the text runs'

@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <variant>
 
 #include "capture.hpp"  // warnOnStderr
 #include "cli_common.hpp"
@@ -88,7 +89,12 @@ Json jointMarginsJson(const FloatingModel& model, const std::vector<JointMargin>
 
 Json warningsJson(const std::vector<Diagnostic>& warnings) {
   Json j = Json::array();
-  for (const Diagnostic& d : warnings) j.push_back(Json{{"kind", d.kind}, {"element", d.element}, {"message", d.message}});
+  for (const Diagnostic& d : warnings) {
+    Json w{{"kind", d.kind}, {"element", d.element}, {"message", d.message}};
+    for (const auto& [key, value] : d.details)  // an overlap's depth and moment, ...
+      w[key] = std::holds_alternative<double>(value) ? Json(std::get<double>(value)) : Json(std::get<std::string>(value));
+    j.push_back(std::move(w));
+  }
   return j;
 }
 

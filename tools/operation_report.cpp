@@ -122,7 +122,7 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   // motion found (a sampled controller's gains, a stiff servo).
   std::vector<Diagnostic> warnings = r.approach ? r.approach->start_warnings : std::vector<Diagnostic>{};
   if (r.capture)
-    for (Diagnostic& d : captureWarnings(r.at_contact)) warnings.push_back(std::move(d));
+    for (Diagnostic& d : captureWarnings(sc, r.at_contact)) warnings.push_back(std::move(d));
   warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());
   j["warnings"] = warningsJson(warnings);
   j["base_control"] = baseControlPhasesJson(sc, r);
@@ -180,7 +180,7 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   }
   if (r.capture) {
     printCaptureSummary(out, sc, *r.capture);
-    printWarnings(out, captureWarnings(r.at_contact));
+    printWarnings(out, captureWarnings(sc, r.at_contact));
   }
   if (sc.simulation.base_control.on()) {
     const BaseControl& c = sc.simulation.base_control;

@@ -19,6 +19,7 @@
 #include "cli_common.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/multibody/model.hpp"
+#include "kdl_space/multibody/overlap.hpp"
 #include "kdl_space/spatial/spatial.hpp"
 #include "kdl_space/multibody/state.hpp"
 
@@ -48,30 +49,18 @@ struct SceneSnapshot {
 };
 
 /// \brief The edges of the uniform box with the given mass and principal moments of inertia
-/// (about its centre): edge k = sqrt(6 (I_i + I_j - I_k) / m), {i, j, k} = {0, 1, 2}; an edge is 0
-/// where the moments break the triangle inequality by round-off (a flat or thin body).
+/// (inertiaBoxEdges: the library's, which the overlap check uses too).
 inline Vector3d equivalentBoxEdges(double mass, const Vector3d& principal_moments) {
-  Vector3d edges = Vector3d::Zero();
-  if (!(mass > 0.0)) return edges;
-  const double sum = principal_moments.sum();
-  for (int k = 0; k < 3; ++k) edges(k) = std::sqrt(std::max(0.0, 6.0 * (sum - 2.0 * principal_moments(k)) / mass));
-  return edges;
+  return inertiaBoxEdges(mass, principal_moments);
 }
 
-/// \brief The equivalent box of inertia of a body: the box of uniform density with the body's
-/// mass and principal moments, centred at its CoM, its edges along the principal axes.
+/// \brief The equivalent box of inertia of a body (inertiaBox): the box of uniform density with
+/// the body's mass and principal moments, centred at its CoM, its edges along the principal axes.
 /// `I_com`: inertia about the CoM in world axes; `com`: world. The box's axes are a right-handed
 /// frame of eigenvectors (ascending moments: the first edge is the longest).
 inline SceneBox equivalentBox(double mass, const Matrix3d& I_com, const Vector3d& com) {
-  const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(0.5 * (I_com + I_com.transpose()));
-  Matrix3d axes = eig.eigenvectors();
-  if (axes.determinant() < 0) axes.col(2) = -axes.col(2);
-  SceneBox box;
-  box.pose.p = toKDL(com);
-  box.pose.M = KDL::Rotation(axes(0, 0), axes(0, 1), axes(0, 2), axes(1, 0), axes(1, 1), axes(1, 2), axes(2, 0),
-                             axes(2, 1), axes(2, 2));
-  box.size = equivalentBoxEdges(mass, eig.eigenvalues());
-  return box;
+  const OrientedBox box = inertiaBox(mass, I_com, com);
+  return SceneBox{box.pose, box.size};
 }
 
 /// The gnuplot terminal for a scene file name and its number of panels (side by side); throws

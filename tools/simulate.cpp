@@ -207,7 +207,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);
-  if (r.capture && !o.json) warnOnStderr(captureWarnings(r.at_contact));
+  if (r.capture && !o.json) warnOnStderr(captureWarnings(sc, r.at_contact));
   // What the motion found (a sampled controller's gains, a stiff servo): on stderr whatever the
   // format of stdout (they may explain a motion that then went wrong).
   warnOnStderr(r.warnings);

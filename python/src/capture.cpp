@@ -8,12 +8,14 @@
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/impact/capture.hpp"
+#include "kdl_space/operation/overlap_check.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space::python {
 namespace {
 
-PyResult solve(const CaptureProblem& p, std::shared_ptr<const Scenario> scenario) {
+/// `robot_urdf`: the robot's visuals for the overlap check ("" for its boxes of inertia).
+PyResult solve(const CaptureProblem& p, std::shared_ptr<const Scenario> scenario, const std::string& robot_urdf) {
   CaptureResult r;
   {
     py::gil_scoped_release nogil;
@@ -24,6 +26,7 @@ PyResult solve(const CaptureProblem& p, std::shared_ptr<const Scenario> scenario
     out.floating_target = PySide{*r.floating_target, std::get<FloatingSystem>(p.target).model->jointNames()};
   Conditioning c;  // a state the solver refused has failed the capture above: only the limits then
   checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, out.warnings);
+  for (Diagnostic& d : overlapWarnings(p, robot_urdf, "capture")) out.warnings.push_back(std::move(d));
   return out;
 }
 
@@ -71,9 +74,7 @@ void vec6Property(C& cls, const char* name, Get get, const char* doc) {
   cls.def_property_readonly(name, [get](const typename C::type& x) { return toNumpy6(get(x)); }, doc);
 }
 
-}  // namespace
-
-void bindCapture(py::module_& m) {
+void bindRigidTarget(py::module_& m) {
   py::class_<RigidTarget>(m, "RigidTarget", "A rigid target in a scenario's terms.")
       .def(py::init(&makeTarget), py::arg("mass"), py::arg("inertia"), py::arg("pose") = py::none(),
            py::arg("com") = py::none(), py::arg("twist") = py::none(),
@@ -84,6 +85,12 @@ void bindCapture(py::module_& m) {
       .def_property_readonly("pose", [](const RigidTarget& t) { return frameToNumpy(t.pose); }, "(4, 4).")
       .def_property_readonly("com", [](const RigidTarget& t) { return toNumpy(t.com, true); }, "(3,), target frame.")
       .def_property_readonly("twist", [](const RigidTarget& t) { return toNumpy6(t.twist); }, "(6,) at the CoM.");
+}
+
+}  // namespace
+
+void bindCapture(py::module_& m) {
+  bindRigidTarget(m);
 
   py::class_<PyProblem>(m, "CaptureProblem", "A capture (or any impact) to solve: the robot at one instant, a target, a law.")
       .def(py::init(&makeProblem), py::arg("state"), py::arg("contact"), py::arg("target"), py::arg("law"),
@@ -139,11 +146,18 @@ void bindCapture(py::module_& m) {
       .def_readonly("floating_target", &PyResult::floating_target, "The free-floating target's SideResult, or None.")
       .def_property_readonly("warnings", [](const PyResult& x) {
         py::list l;
-        for (const Diagnostic& w : x.warnings) l.append(py::dict(py::arg("kind") = w.kind, py::arg("element") = w.element,
-                                                                 py::arg("message") = w.message));
+        for (const Diagnostic& w : x.warnings) {
+          py::dict d(py::arg("kind") = w.kind, py::arg("element") = w.element, py::arg("message") = w.message);
+          for (const auto& [key, value] : w.details)
+            std::visit([&d, &key](const auto& v) { d[py::str(key)] = v; }, value);
+          l.append(d);
+        }
         return l;
       }, "The robot's configuration at the capture: list of {kind, element, message} (joint_outside_limits, "
-         "near_singular), as `kdl_space capture --json`'s `warnings`.")
+         "near_singular; overlap: a link that penetrates the target's box of inertia by more than 1 cm, with "
+         "link, target, depth [m], moment 'capture' and geometry 'visuals' or 'inertia_box'; a CaptureProblem's "
+         "robot is checked by its boxes of inertia, a Scenario's by its URDF visuals), as `kdl_space capture "
+         "--json`'s `warnings`.")
       .def_property_readonly("contact_point", [](const PyResult& x) { return toNumpy(x.r.contact_point, true); }, "(3,) [m].")
       .def_property_readonly("G_robot", [](const PyResult& x) { return toNumpy(x.r.G_robot); }, "The robot's G (6, 6).")
       .def_property_readonly("G_target", [](const PyResult& x) { return toNumpy(x.r.G_target); }, "The target's G (6, 6).")
@@ -174,10 +188,10 @@ void bindCapture(py::module_& m) {
         "that loads no model: the loader's ModelError, with the same 'FILE:LINE: robot.urdf: ' in front).");
   m.def("solve_capture", [](const PyScenario& s) {
     if (!s.scenario.impact) throw py::value_error("scenario: '" + s.scenario.file + "' has no target and no law (a plain motion)");
-    return solve(s.scenario.capture, std::make_shared<const Scenario>(s.scenario));
+    return solve(s.scenario.capture, std::make_shared<const Scenario>(s.scenario), s.scenario.robot_urdf);
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
      "the part.");
-  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, scenarioOf(p)); }, py::arg("scenario_or_problem"),
+  m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, scenarioOf(p), ""); }, py::arg("scenario_or_problem"),
         "Solves a CaptureProblem (GIL released).");
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
     return Model{attachTarget(p, r.r), source};  // an Error naming the part

@@ -5,6 +5,7 @@
 
 #include "detail/text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
+#include "kdl_space/operation/overlap_check.hpp"
 
 namespace kdl_space::operation {
 
@@ -149,6 +150,7 @@ std::vector<Diagnostic> approachStartWarnings(const Scenario& sc) {
   std::vector<Diagnostic> warnings;
   // A state the solver refuses fails the approach itself; the limit warnings stand alone then.
   checkConfiguration(robot.model, robot.state, robot.contact, c, warnings);
+  for (Diagnostic& d : overlapWarnings(sc, sc.capture, "start")) warnings.push_back(std::move(d));
   for (Diagnostic& d : warnings) d.message = "at the start of the approach: " + d.message;
   return warnings;
 }

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <variant>
+#include <vector>
 
 #include "kdl_space/export.hpp"
 
@@ -52,6 +55,10 @@ struct Diagnostic {
   std::string message;  ///< what was found and what the model does about it
   std::string kind;     ///< the Finding kind when it comes from a rule ("" otherwise)
   Severity severity = Severity::Warning;  ///< Warning or Note
+  /// What the message states, as data for a program (the tool's JSON and Python add each as a key
+  /// of the warning beside kind, element and message): an overlap's "depth" [m], "moment", ...
+  /// Empty for most.
+  std::vector<std::pair<std::string, std::variant<double, std::string>>> details = {};
 };
 
 }  // namespace kdl_space
