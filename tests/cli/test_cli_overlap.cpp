@@ -109,10 +109,10 @@ TEST(OverlapWarning, AnApproachWarnsOfItsStartPoseBeforeItRuns) {
                            "bounding boxes) penetrates the target's box of inertia by 0.9 m"), 1u) << run.err;
 }
 
-TEST(OverlapWarning, NoShippedScenarioWarnsButTheTwoSatellitesThatOverlap) {
-  // dual_arm_captures_robot.yaml places the target robot so that its hand touches the tool: the
-  // two satellites' boxes of inertia then overlap (0.34 m), as do the camera mast and the target's
-  // link1, and left_link4 and its link2 (no URDF there has visuals: a finding of the scenario).
+TEST(OverlapWarning, NoShippedScenarioWarns) {
+  // dual_arm_captures_robot.yaml places the target robot so that its hand touches the tool; its
+  // base's yaw turns the target robot away from the servicer (at yaw 0 the two satellites' boxes of
+  // inertia overlapped by 0.34 m: this check found it).
   const std::string dir = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
   int runs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
@@ -122,14 +122,7 @@ TEST(OverlapWarning, NoShippedScenarioWarnsButTheTwoSatellitesThatOverlap) {
     ASSERT_EQ(run.rc, 0) << run.err;
     ++runs;
     const nlohmann::json j = nlohmann::json::parse(run.out);
-    std::vector<std::string> overlapping;
-    for (const nlohmann::json& w : j.at("warnings"))
-      if (w.at("kind") == "overlap") overlapping.push_back(w.at("link").get<std::string>() + " in " + w.at("target").get<std::string>());
-    if (entry.path().filename() == "dual_arm_captures_robot.yaml")
-      EXPECT_EQ(overlapping, (std::vector<std::string>{"satellite in target link 'base'", "camera_mast in target link 'link1'",
-                                                       "left_link4 in target link 'link2'"}));
-    else
-      EXPECT_TRUE(overlapping.empty()) << j.at("warnings").dump();
+    for (const nlohmann::json& w : j.at("warnings")) EXPECT_NE(w.at("kind"), "overlap") << w.dump();
   }
   EXPECT_GE(runs, 14);
 }
