@@ -75,6 +75,7 @@ CLI::App* addCapture(CLI::App& app, CaptureOptions& o) {
                   "Write the impact as an interactive 3-D page (one self-contained HTML file: the robot's URDF visuals "
                   "at the impact, the target, the contact point, the grasp frame, the impulse as an arrow; before and after)")
       ->type_name("FILE")->check(file_name);
+  addMeshPathOption(cmd, o.mesh_path);
   cmd->add_flag("--json", o.json, "Print one JSON object instead of the summary");
   return cmd;
 }
@@ -244,8 +245,12 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
       throw UsageError("--html and --scene name the same file " + o.html);
   }
   const Scenario sc = loadScenario(o.scenario);
-  refuseOverwritingInputs("--scene", o.scene, scenarioInputs(sc));
-  refuseOverwritingInputs("--html", o.html, scenarioInputs(sc));  // the URDFs it names too
+  std::vector<InputFile> inputs = scenarioInputs(sc);  // the URDFs it names too
+  const std::vector<std::string> mesh_search_path = meshSearchPath(o.mesh_path);
+  if (!o.html.empty())  // and the meshes the page embeds
+    for (InputFile& mesh : meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));
+  refuseOverwritingInputs("--scene", o.scene, inputs);
+  refuseOverwritingInputs("--html", o.html, inputs);
   if (!sc.impact)
     throw InputError(sc.file + ": a plain motion (no target, no law): there is no impact to solve; run kdl_space simulate");
   if (sc.approach)
@@ -259,9 +264,11 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
                "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
     scene.commit();
   }
+  std::vector<Diagnostic> mesh_warnings;  // the page's meshes drawn as boxes (on stderr already)
   if (!o.html.empty()) {
     AtomicFile page(o.html, "--html");
-    writeCaptureHtml(page, sc, result, "kdl_space capture " + std::filesystem::path(sc.file).filename().string());
+    mesh_warnings = writeCaptureHtml(page, sc, result, "kdl_space capture " + std::filesystem::path(sc.file).filename().string(),
+                     mesh_search_path);
     page.commit();
   }
   const std::vector<Diagnostic> warnings = captureWarnings(sc, sc.capture);
@@ -270,7 +277,9 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     Json j = captureJson(sc, result);
     j["scene"] = o.scene.empty() ? Json(nullptr) : Json(o.scene);
     j["html"] = o.html.empty() ? Json(nullptr) : Json(o.html);  // the page (--html), or null
-    j["warnings"] = warningsJson(warnings);
+    std::vector<Diagnostic> all = warnings;
+    all.insert(all.end(), mesh_warnings.begin(), mesh_warnings.end());
+    j["warnings"] = warningsJson(all);
     out << j.dump(2) << "\n";
   } else {
     printCaptureSummary(out, sc, result);

@@ -1,4 +1,4 @@
-// `kdl_space capture SCENARIO [--scene FILE] [--html FILE] [--json]`: the impact of the robot with its target,
+// `kdl_space capture SCENARIO [--scene FILE] [--html FILE [--mesh-path DIR]...] [--json]`: the impact of the robot with its target,
 // everything before and after (the library's loadScenario and solveCapture, printed), and a
 // picture of the impact instant (--scene), or an interactive 3-D page of it (--html).
 #pragma once
@@ -7,6 +7,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "scene_writer.hpp"
@@ -18,6 +19,7 @@ struct CaptureOptions {
   std::string scenario;
   std::string scene;  ///< --scene FILE (.svg or .png); empty: none
   std::string html;   ///< --html FILE: the instant as an interactive 3-D page; empty: none
+  std::vector<std::string> mesh_path;  ///< --mesh-path DIR...: where the page's package:// meshes are found
   bool json = false;
 };
 

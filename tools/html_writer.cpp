@@ -168,6 +168,20 @@ void HtmlWriter::readMeshes() {
     }
 }
 
+// --- The meshes a page reads, as inputs no output may replace (issue 25's rule) ----------------
+std::vector<InputFile> meshInputs(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
+  std::vector<InputFile> inputs;
+  const std::pair<const std::string&, const char*> urdfs[] = {{sc.robot_urdf, "link "}, {sc.target_urdf, "the target's link "}};
+  for (const auto& [urdf, whose] : urdfs) {
+    if (urdf.empty()) continue;
+    for (const auto& [link, list] : readUrdfVisuals(urdf, mesh_search_path))
+      for (const LinkVisual& v : list)
+        if (v.shape == LinkVisual::Shape::Mesh && !v.mesh_path.empty())
+          inputs.push_back({"the mesh " + v.mesh_file + " of " + whose + link, v.mesh_path});
+  }
+  return inputs;
+}
+
 void checkHtmlLibrary(const std::string& option, const std::string& path) {
   for (const char* file : {kThreeJs, kOrbitControlsJs})
     if (std::ifstream(file).fail())
@@ -509,7 +523,8 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
   if (r.approach && !r.approach->record.reached) data["tCapture"] = nullptr;  // no contact: no impact to step to
 }
 
-void writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureResult& result, const std::string& title) {
+std::vector<Diagnostic> writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureResult& result,
+                                         const std::string& title, const std::vector<std::string>& mesh_search_path) {
   OperationResult instant;  // the capture at the scenario's states, as the operation would have it at t = 0
   instant.at_contact = sc.capture;
   instant.capture = result;
@@ -519,7 +534,7 @@ void writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureR
   x.p = toEigen(s.world_T_base.p);
   s.world_T_base.M.GetQuaternion(x.quat(0), x.quat(1), x.quat(2), x.quat(3));
   x.q = s.q.data;
-  HtmlWriter writer(sc);
+  HtmlWriter writer(sc, mesh_search_path);
   OperationResult before = instant;  // the first frame: before the impact
   before.capture.reset();
   x.phase = Phase::Capture;
@@ -527,6 +542,7 @@ void writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureR
   x.phase = Phase::Post;
   writer.addKept(instant, x);
   writer.write(file, instant, title);
+  return writer.warnings();
 }
 
 }  // namespace kdl_space::cli

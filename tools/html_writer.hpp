@@ -40,6 +40,14 @@ CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
 /// tool reads the environment; the library is given the list (resolveMeshFile).
 std::vector<std::string> meshSearchPath(const std::vector<std::string>& mesh_path_options);
 
+/// \brief The mesh files a page of `sc` embeds (issue 25's rule: no output replaces what the run
+/// reads): every mesh visual of the robot's URDF and, when the scenario names one, the target's,
+/// resolved through `mesh_search_path` as HtmlWriter resolves them (a mesh not found is not read,
+/// so not listed; one of a format the page does not draw is listed all the same: the URDF names
+/// it as the link's shape). Each is named "the mesh FILE of link L" ("of the target's link L"), FILE as
+/// the URDF writes it. Given to refuseOverwritingInputs with every output of a run that has --html.
+std::vector<InputFile> meshInputs(const Scenario& sc, const std::vector<std::string>& mesh_search_path);
+
 /// Throws InputError naming `option` and `path` when three.js is not installed.
 void checkHtmlLibrary(const std::string& option, const std::string& path);
 
@@ -125,7 +133,9 @@ class HtmlWriter {
 /// CaptureResult.to_html): the instant as two frames at t = 0, before and after the impact (the
 /// configuration does not change at an impact; the impulse's arrow shows from the first).
 /// Writes into file.tmp() (the caller commits it).
-void writeCaptureHtml(const AtomicFile& file, const Scenario& scenario, const CaptureResult& result,
-                      const std::string& title);
+/// `mesh_search_path`: where package:// meshes are found (meshSearchPath), as for HtmlWriter;
+/// returns its warnings (the meshes drawn as boxes, on stderr already) for a run's JSON.
+std::vector<Diagnostic> writeCaptureHtml(const AtomicFile& file, const Scenario& scenario, const CaptureResult& result,
+                      const std::string& title, const std::vector<std::string>& mesh_search_path = {});
 
 }  // namespace kdl_space::cli

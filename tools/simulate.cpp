@@ -181,8 +181,11 @@ CLI::App* addSimulate(CLI::App& app, SimulateOptions& o) {
 void runSimulate(const SimulateOptions& o, std::ostream& out) {
   checkOutputs(o);
   const Scenario sc = loadScenario(o.scenario);
+  std::vector<InputFile> inputs = scenarioInputs(sc);  // the URDFs it names too
+  if (!o.html.empty())  // and the meshes the page embeds
+    for (InputFile& mesh : meshInputs(sc, meshSearchPath(o.mesh_path))) inputs.push_back(std::move(mesh));
   for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}, {"--html", o.html}})
-    refuseOverwritingInputs(option, path, scenarioInputs(sc));  // the URDFs it names too
+    refuseOverwritingInputs(option, path, inputs);
   OperationOptions options;
   options.duration = o.duration;
   checkOutputSize(o, sc, options);

@@ -43,6 +43,7 @@ CLI::App* addStudy(CLI::App& app, StudyOptions& o) {
                   "Write the study's nominal sample (its scenario as written: the capture, and the study's motion "
                   "after it) as an interactive 3-D page (one self-contained HTML file)")
       ->type_name("FILE");
+  addMeshPathOption(cmd, o.mesh_path);
   cmd->add_flag("--json", o.json, "Print the summary as one JSON object instead of text");
   return cmd;
 }
@@ -54,16 +55,17 @@ namespace {
 /// the capture configuration). Written under a temporary name before the study runs (a page
 /// that cannot be drawn is refused before the long work); the caller commits it. A motion that
 /// fails still gives its page, noted, with a warning: the study's samples may fail too.
-std::unique_ptr<AtomicFile> nominalSamplePage(const Study& st, const std::string& path) {
+std::unique_ptr<AtomicFile> nominalSamplePage(const Study& st, const std::string& path,
+                                              const std::vector<std::string>& mesh_search_path) {
   auto file = std::make_unique<AtomicFile>(path, "--html");
   const Scenario& sc = st.scenario;
   const std::string title = "kdl_space study " + fs::path(st.file).filename().string() + ": the nominal sample";
   if (!(st.motion_duration > 0.0)) {
     const CaptureResult r = inScenario(sc, [&] { return solveCapture(sc.capture); });
-    writeCaptureHtml(*file, sc, r, title);
+    writeCaptureHtml(*file, sc, r, title, mesh_search_path);
     return file;
   }
-  HtmlWriter page(sc);
+  HtmlWriter page(sc, mesh_search_path);
   OperationOptions o;  // what a sample's motion runs (StudyEvaluator's motionPeaks)
   o.approach = false;
   o.duration = st.motion_duration;
@@ -406,6 +408,9 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   std::vector<InputFile> inputs = scenarioInputs(st.scenario);  // no output replaces what the run reads
   inputs.push_back({"the study file", o.study});
   for (const std::string& part : o.merge) inputs.push_back({"one of the parts merged", part});
+  const std::vector<std::string> mesh_search_path = meshSearchPath(o.mesh_path);
+  if (!o.html.empty())  // the meshes the page embeds
+    for (InputFile& mesh : meshInputs(st.scenario, mesh_search_path)) inputs.push_back(std::move(mesh));
   for (const auto& [option, path] : outputs) {
     if (path.empty()) continue;
     checkOutputFile(path, option);
@@ -421,7 +426,7 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
     if (!o.shard.empty() || !o.merge.empty())
       throw UsageError("--html " + o.html + ": the nominal sample's page is drawn by the whole study's run (not with --shard or --merge)");
     checkHtmlLibrary("--html", o.html);
-    page = nominalSamplePage(st, o.html);
+    page = nominalSamplePage(st, o.html, mesh_search_path);
   }
 
   // The summary from the rows as the table is written, a block at a time: never the whole table.

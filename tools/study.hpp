@@ -1,5 +1,5 @@
 // `kdl_space study STUDY [-o TABLE.csv] [--threads N] [--shard i/N] [--merge PART...] [--plot FILE]
-// [--heat-map FILE] [--summary FILE] [--html FILE] [--json]`: a capture study (the library's loadStudy and
+// [--heat-map FILE] [--summary FILE] [--html FILE [--mesh-path DIR]...] [--json]`: a capture study (the library's loadStudy and
 // runStudy) on this machine's cores, or one shard of it, or its shards merged; the table, its
 // summary and plots. A run keeps each finished chunk in TABLE.csv.parts/ until the table is
 // whole, so an interrupted run resumes where it stopped.
@@ -26,6 +26,7 @@ struct StudyOptions {
   std::string plot, heat_map, summary;
   std::string groups;             ///< --groups: the per-grid-point aggregates as CSV
   std::string html;               ///< --html: the nominal sample (the scenario as written) as a 3-D page
+  std::vector<std::string> mesh_path;  ///< --mesh-path DIR...: where the page's package:// meshes are found
   bool json = false;
 };
 

@@ -196,10 +196,10 @@ class CaptureResult:
     virtual_mass: Optional[float]
     contact_body_pose: Array
     warnings: list[dict[str, str]]  # the robot's configuration at the capture: {kind, element, message}
-    def to_html(self, path: str) -> None: ...  # the instant as `kdl_space capture --html` draws it
+    def to_html(self, path: str, mesh_path: Union[None, str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]] = None) -> None: ...  # the instant as `kdl_space capture --html` draws it; mesh_path: --mesh-path's folders
 
 class OperationResult(dict[str, Any]):  # run_operation's dict (`simulate --json`'s keys, 'samples')
-    def to_html(self, path: str) -> None: ...  # the run as `kdl_space simulate --html` draws it
+    def to_html(self, path: str, mesh_path: Union[None, str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]] = None) -> None: ...  # the run as `kdl_space simulate --html` draws it; mesh_path: --mesh-path's folders
 
 def load_scenario(path: str) -> Scenario: ...
 def run_operation(scenario: Scenario, *, duration: Optional[float] = None, output_step: Optional[float] = None,

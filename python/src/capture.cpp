@@ -172,11 +172,13 @@ void bindCapture(py::module_& m) {
   vec6Property(result, "target_twist_after", [](const PyResult& x) { return x.r.target_twist_after; }, "(6,).");
   vec6Property(result, "momentum_before", [](const PyResult& x) { return x.r.momentum_before; }, "(P; L about the origin), both sides, (6,).");
   vec6Property(result, "momentum_after", [](const PyResult& x) { return x.r.momentum_after; }, "(6,).");
-  result.def("to_html", &captureToHtml, py::arg("path"),
+  result.def("to_html", &captureToHtml, py::arg("path"), py::arg("mesh_path") = py::none(),
              "Writes the capture's instant as the interactive 3-D page of `kdl_space capture --html` (one "
              "self-contained HTML file, the same writer): the robot at the impact, the target, the contact point, "
-             "the grasp frame, the impulse's arrow; before and after. ValueError for a path that is one of the "
-             "scenario's inputs, OSError for a folder that cannot hold it or three.js missing; each names the path.");
+             "the grasp frame, the impulse's arrow; before and after. mesh_path: a folder or a list of folders where "
+             "the URDFs' package:// meshes are found (the tool's --mesh-path), before ROS_PACKAGE_PATH's. ValueError "
+             "for a path that is one of the scenario's inputs (its URDFs' meshes the page embeds too) or a mesh_path "
+             "that is not a folder, OSError for a folder that cannot hold it or three.js missing; each names the path.");
   result.def("__repr__", [](const PyResult& x) {
     std::ostringstream s;
     s << "<kdl_space.CaptureResult F=[" << x.r.impulse.F.transpose() << "], energy lost " << x.r.energyLost() << " J>";

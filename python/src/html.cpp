@@ -23,13 +23,15 @@ py::handle operation_result_type;  // kdl_space.OperationResult (kept alive by t
 /// Refused as the tool refuses --html (three.js missing, a folder that cannot hold the file: OSError;
 /// a path that is one of the run's inputs: ValueError), then written under a temporary name and
 /// renamed: a failed call leaves no file. Every message names the path.
-void writePage(const std::string& path, const Scenario& sc, const std::function<void(const cli::AtomicFile&)>& draw) {
+void writePage(const std::string& path, const Scenario& sc, const std::vector<std::string>& mesh_search_path,
+               const std::function<void(const cli::AtomicFile&)>& draw) {
   try {
     if (path.empty()) throw cli::UsageError("to_html: the file name is empty");
     cli::checkHtmlLibrary("to_html", path);
     cli::checkOutputFile(path, "to_html");
     std::vector<cli::InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
                                           {"the target's URDF", sc.target_urdf}};
+    for (cli::InputFile& mesh : cli::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
     cli::refuseOverwritingInputs("to_html", path, inputs);
     cli::AtomicFile file(path, "to_html");
     draw(file);
@@ -40,6 +42,23 @@ void writePage(const std::string& path, const Scenario& sc, const std::function<
     PyErr_SetString(PyExc_OSError, e.what());
     throw py::error_already_set();
   }
+}
+
+/// to_html's `mesh_path` (None, one folder, or a list of folders; str or os.PathLike) as the
+/// tool's --mesh-path: each must be a folder (ValueError naming it); ROS_PACKAGE_PATH's come after.
+std::vector<std::string> meshSearchPathOf(const py::object& mesh_path) {
+  std::vector<std::string> dirs;
+  if (mesh_path.is_none()) return cli::meshSearchPath(dirs);
+  const py::object fspath = py::module_::import("os").attr("fspath");
+  const bool one = py::isinstance<py::str>(mesh_path) || py::hasattr(mesh_path, "__fspath__");
+  for (const py::handle dir : one ? py::list(py::make_tuple(mesh_path)) : py::list(mesh_path)) {
+    const std::string d = py::cast<std::string>(fspath(dir));
+    std::error_code ec;
+    if (!std::filesystem::is_directory(d, ec))
+      throw py::value_error("to_html: mesh_path " + d + " is not a folder (give the folder that holds the package folders)");
+    dirs.push_back(d);
+  }
+  return cli::meshSearchPath(dirs);
 }
 
 Phase phaseOf(const std::string& name) {
@@ -54,7 +73,7 @@ using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 /// The result's samples (its 'samples' arrays: t, phase, base_position, base_quaternion, q), one
 /// at a time into the writer, as the tool's observer gives them.
-void operationToHtml(py::object self, const std::string& path) {
+void operationToHtml(py::object self, const std::string& path, const py::object& mesh_path) {
   const PyOperationRun& run = py::cast<const PyOperationRun&>(self.attr("_run"));
   const py::dict samples = self["samples"];
   const auto t = samples["t"].cast<Rows>(), p = samples["base_position"].cast<Rows>(),
@@ -67,8 +86,9 @@ void operationToHtml(py::object self, const std::string& path) {
     throw py::value_error("to_html " + path + ": the result's samples (t, phase, base_position, base_quaternion, q) are "
                           "not those run_operation returned");
   const std::string title = "kdl_space.run_operation " + std::filesystem::path(run.scenario->file).filename().string();
-  writePage(path, *run.scenario, [&](const cli::AtomicFile& file) {
-    cli::HtmlWriter page(*run.scenario);
+  const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
+  writePage(path, *run.scenario, search_path, [&](const cli::AtomicFile& file) {
+    cli::HtmlWriter page(*run.scenario, search_path);
     MotionSample x;
     x.q.resize(n);
     for (py::ssize_t i = 0; i < k; ++i) {
@@ -85,9 +105,11 @@ void operationToHtml(py::object self, const std::string& path) {
 
 }  // namespace
 
-void captureToHtml(const PyResult& x, const std::string& path) {
+void captureToHtml(const PyResult& x, const std::string& path, const py::object& mesh_path) {
   const std::string title = "kdl_space.solve_capture " + std::filesystem::path(x.scenario->file).filename().string();
-  writePage(path, *x.scenario, [&](const cli::AtomicFile& file) { cli::writeCaptureHtml(file, *x.scenario, x.r, title); });
+  const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
+  writePage(path, *x.scenario, search_path,
+            [&](const cli::AtomicFile& file) { cli::writeCaptureHtml(file, *x.scenario, x.r, title, search_path); });
 }
 
 py::object operationResultOf(py::dict d, std::shared_ptr<const Scenario> scenario, OperationResult result) {
@@ -107,10 +129,12 @@ void bindHtml(py::module_& m) {
                   "to_html(path).";
   py::object cls = builtins.attr("type")("OperationResult", py::make_tuple(builtins.attr("dict")), ns);
   cls.attr("to_html") = py::cpp_function(
-      &operationToHtml, py::name("to_html"), py::is_method(cls), py::arg("path"),
+      &operationToHtml, py::name("to_html"), py::is_method(cls), py::arg("path"), py::arg("mesh_path") = py::none(),
       "Writes the run as the interactive 3-D page of `kdl_space simulate --html` (one self-contained HTML file; "
-      "the same writer), drawn from this result's 'samples'. ValueError for a path that is one of the run's "
-      "inputs (the scenario, its URDFs), OSError for a folder that cannot hold it or three.js missing (Debian's "
+      "the same writer), drawn from this result's 'samples'. mesh_path: a folder or a list of folders where the "
+      "URDFs' package:// meshes are found (the tool's --mesh-path), searched before ROS_PACKAGE_PATH's. ValueError "
+      "for a path that is one of the run's inputs (the scenario, its URDFs, the meshes the page embeds) or a "
+      "mesh_path that is not a folder, OSError for a folder that cannot hold it or three.js missing (Debian's "
       "libjs-three); each names the path.");
   const py::object dict_type = builtins.attr("dict");
   cls.attr("__reduce__") = py::cpp_function([dict_type](py::object self) { return py::make_tuple(dict_type, py::make_tuple(dict_type(self))); },

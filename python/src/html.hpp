@@ -11,8 +11,9 @@
 
 namespace kdl_space::python {
 
-/// CaptureResult.to_html: the capture's instant (cli::writeCaptureHtml) into `path`.
-void captureToHtml(const PyResult& result, const std::string& path);
+/// CaptureResult.to_html: the capture's instant (cli::writeCaptureHtml) into `path`; `mesh_path`
+/// (None, a folder, or a list of folders) as the tool's --mesh-path, ROS_PACKAGE_PATH's after it.
+void captureToHtml(const PyResult& result, const std::string& path, const py::object& mesh_path);
 
 /// \brief run_operation's dict as a kdl_space.OperationResult (a dict, with to_html): `result`
 /// keeps the operation's result without its samples (the page reads them from d["samples"]).

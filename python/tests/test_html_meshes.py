@@ -199,3 +199,53 @@ def test_mesh_path_must_be_a_folder(cli, tree):
     done = subprocess.run([cli, "simulate", str(tree["scenario"]), "--html", str(tree["dir"] / "x.html"),
                            "--mesh-path", str(tree["dir"] / "nowhere")], capture_output=True, text=True)
     assert done.returncode == 2 and "--mesh-path" in done.stderr and "nowhere" in done.stderr, done.stderr
+
+
+# --- to_html(path, mesh_path=...): Python's --mesh-path; no page replaces a mesh it embeds -------
+
+def embedded_files(page):
+    """The embedded meshes: basename -> bytes (decoded from the page's base64)."""
+    import base64
+    return {os.path.basename(m["file"]): base64.b64decode(m["data"]) for m in page_data(page)["meshes"]}
+
+
+@pytest.fixture
+def no_ros_package_path(monkeypatch):
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+
+
+@pytest.mark.parametrize("as_list", [True, False])
+def test_to_html_finds_meshes_through_mesh_path(tree, tmp_path, no_ros_package_path, as_list):
+    import kdl_space
+    sc = kdl_space.load_scenario(str(tree["scenario"]))
+    share = tree["share"] / "pkg" / "meshes"
+    expected = {name: (share / name).read_bytes() for name in ["box_binary.stl", "tet_ascii.stl", "box.dae"]}
+    mesh_path = [str(tree["dir"] / "robot"), tree["share"]] if as_list else str(tree["share"])
+    capture = tmp_path / "capture.html"
+    kdl_space.solve_capture(sc).to_html(str(capture), mesh_path=mesh_path)
+    assert embedded_files(capture) == expected
+    run = tmp_path / "run.html"
+    kdl_space.run_operation(sc, duration=0.1).to_html(str(run), mesh_path=mesh_path)
+    assert embedded_files(run) == expected
+    # Without it (and no ROS_PACKAGE_PATH), the boxes of inertia: no mesh embedded.
+    kdl_space.solve_capture(sc).to_html(str(capture))
+    assert embedded_files(capture) == {}
+
+
+def test_to_html_never_replaces_a_mesh_it_embeds(tree, tmp_path, no_ros_package_path):
+    import kdl_space
+    sc = kdl_space.load_scenario(str(tree["scenario"]))
+    mesh = tree["share"] / "pkg" / "meshes" / "box_binary.stl"
+    before = mesh.read_bytes()
+    (tmp_path / "alias.html").symlink_to(mesh)  # the same file by inode, under another name
+    capture, run = kdl_space.solve_capture(sc), kdl_space.run_operation(sc, duration=0.1)
+    for result in [capture, run]:
+        for path in [str(mesh), str(tmp_path / "alias.html")]:
+            with pytest.raises(ValueError) as e:
+                result.to_html(path, mesh_path=[tree["share"]])
+            assert path in str(e.value) and "the mesh package://pkg/meshes/box_binary.stl of link link" in str(e.value), e.value
+            assert mesh.read_bytes() == before
+    assert (tmp_path / "alias.html").is_symlink()
+    with pytest.raises(ValueError, match="mesh_path .*nowhere is not a folder"):
+        capture.to_html(str(tmp_path / "p.html"), mesh_path=[tree["dir"] / "nowhere"])
+    assert not (tmp_path / "p.html").exists()

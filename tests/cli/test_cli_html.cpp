@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -162,6 +164,125 @@ TEST_F(Html, StudyRefusesAPageOverItsInputsOrOutputs) {
   EXPECT_EQ(shard.rc, 2);
   EXPECT_NE(shard.err.find("--html " + path("p.html")), std::string::npos) << shard.err;
   EXPECT_EQ(files(), std::vector<std::string>{"study.yaml"}) << "nothing written";
+}
+
+
+// --- --mesh-path on capture and study; no output replaces a mesh the page embeds (issue 25's rule)
+
+/// Standard base64 (what the page embeds a mesh's bytes as), to find a file's bytes in KDL_DATA.
+std::string base64(const std::string& bytes) {
+  static const char* const kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    unsigned v = 0;
+    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? kDigits[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+/// The tumbling box's capture with the arm's link2 drawn by a binary STL (one triangle) named
+/// package://pkg/meshes/hand.stl, under DIR/share (what --mesh-path gives); ROS_PACKAGE_PATH unset.
+class HtmlMeshes : public Html {
+ protected:
+  void SetUp() override {
+    Html::SetUp();
+    unsetenv("ROS_PACKAGE_PATH");  // the tool's children search --mesh-path only
+    share = (dir / "share").string();
+    fs::create_directories(dir / "share" / "pkg" / "meshes");
+    mesh = (dir / "share" / "pkg" / "meshes" / "hand.stl").string();
+    std::string stl(80, ' ');
+    const auto put = [&](const void* p, std::size_t n) { stl.append(static_cast<const char*>(p), n); };
+    const std::uint32_t count = 1;
+    put(&count, 4);
+    const float t[12] = {0, 0, 1, 0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0};  // normal, 3 vertices
+    put(t, sizeof t);
+    put("\0\0", 2);
+    spit(mesh, stl);
+    std::string urdf = slurp(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/space_arm7.urdf");
+    const std::string link2 = "<link name=\"link2\">";
+    urdf.insert(urdf.find(link2) + link2.size(),
+                "<visual><geometry><mesh filename=\"package://pkg/meshes/hand.stl\"/></geometry></visual>");
+    spit(path("arm.urdf"), urdf);
+    std::string yaml = slurp(kScenarios + "tumbling_box_capture.yaml");
+    yaml.replace(yaml.find("../urdf/space_arm7.urdf"), std::string("../urdf/space_arm7.urdf").size(), path("arm.urdf"));
+    scenario = path("scenario.yaml");
+    spit(scenario, yaml);
+    bytes = slurp(mesh);
+  }
+  /// The files of the page's KDL_DATA.meshes whose bytes are the mesh's.
+  std::size_t embedded(const std::string& page) const {
+    const nlohmann::json data = pageData(page);
+    if (data.is_null()) return 0;
+    return std::count_if(data.at("meshes").begin(), data.at("meshes").end(),
+                         [&](const nlohmann::json& m) { return m.at("data") == base64(bytes); });
+  }
+  std::string share, mesh, scenario, bytes;
+};
+
+TEST_F(HtmlMeshes, CaptureAndStudyFindMeshesThroughMeshPath) {
+  const std::string page = path("capture.html");
+  const ToolRun r = kdlSpace("capture " + scenario + " --html " + page + " --mesh-path " + share + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(embedded(page), 1u) << "the page embeds hand.stl once";
+  EXPECT_EQ(pageData(page).at("meshes").size(), 1u);
+  // Without it: the link's box, and the warning in the JSON as simulate gives it.
+  const ToolRun without = kdlSpace("capture " + scenario + " --html " + page + " --json");
+  ASSERT_EQ(without.rc, 0) << without.err;
+  EXPECT_EQ(embedded(page), 0u);
+  const nlohmann::json warnings = nlohmann::json::parse(without.out).at("warnings");
+  EXPECT_TRUE(std::any_of(warnings.begin(), warnings.end(), [](const nlohmann::json& w) {
+    return w.at("kind") == "mesh_not_drawn" && w.at("element") == "link2";
+  })) << warnings.dump();
+
+  for (const std::string motion : {"", "motion: {duration: 0.2, output_step: 0.05}\n"}) {
+    const std::string study = path("study.yaml");
+    spit(study, "scenario: " + scenario + "\nsamples: 2\nseed: 3\ninputs: {robot.q.joint7: {uniform: [-0.2, 0.2]}}\n" + motion);
+    const std::string nominal = path("nominal.html");
+    const ToolRun s = kdlSpace("study " + study + " -o " + path("t.csv") + " --html " + nominal + " --mesh-path " + share +
+                               " --threads 1");
+    ASSERT_EQ(s.rc, 0) << s.err;
+    EXPECT_EQ(embedded(nominal), 1u) << motion;
+  }
+  EXPECT_EQ(slurp(mesh), bytes);
+}
+
+TEST_F(HtmlMeshes, NoOutputReplacesAMeshThePageEmbeds) {
+  const std::string tail = "; it would be overwritten: give the output another name\n";
+  const std::string what = ": is the mesh package://pkg/meshes/hand.stl of link link2";
+  const std::string page = path("page.html");
+  // The mesh itself, and a symbolic link to it (the same file, by inode) with the scene's extension.
+  fs::create_symlink(mesh, dir / "mesh.svg");
+  fs::create_symlink(mesh, dir / "mesh.csv");
+  const std::string svg = path("mesh.svg"), csv = path("mesh.csv");
+  struct Case {
+    std::string args, option, output;
+  };
+  const std::vector<Case> cases = {
+      {"simulate " + scenario + " --duration 0.1 --html " + page + " --csv " + mesh, "--csv", mesh},
+      {"simulate " + scenario + " --duration 0.1 --html " + page + " --scene " + svg, "--scene", svg},
+      {"simulate " + scenario + " --duration 0.1 --html " + mesh, "--html", mesh},
+      {"capture " + scenario + " --html " + page + " --scene " + svg, "--scene", svg},
+      {"capture " + scenario + " --html " + mesh, "--html", mesh},
+  };
+  for (const Case& c : cases) {
+    const ToolRun r = kdlSpace(c.args + " --mesh-path " + share);
+    EXPECT_EQ(r.rc, 2) << c.args;
+    EXPECT_EQ(r.err.rfind("kdl_space: " + c.option + " " + c.output + what, 0), 0u) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(tail), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+    EXPECT_EQ(slurp(mesh), bytes) << c.args << ": the mesh is as it was";
+    EXPECT_FALSE(fs::exists(page)) << c.args << ": nothing written";
+  }
+  const std::string study = path("study.yaml");
+  spit(study, "scenario: " + scenario + "\nsamples: 2\nseed: 3\ninputs: {robot.q.joint7: {uniform: [-0.2, 0.2]}}\n");
+  const ToolRun s = kdlSpace("study " + study + " -o " + csv + " --html " + page + " --mesh-path " + share);
+  EXPECT_EQ(s.rc, 2) << s.err;
+  EXPECT_EQ(s.err.rfind("kdl_space: --table " + csv + what, 0), 0u) << s.err;
+  EXPECT_EQ(slurp(mesh), bytes);
+  EXPECT_TRUE(fs::is_symlink(dir / "mesh.csv"));
+  EXPECT_FALSE(fs::exists(page));
 }
 
 }  // namespace
