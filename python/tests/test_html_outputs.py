@@ -18,6 +18,7 @@ import pytest
 
 from conftest import ARM, SOURCE_DIR
 from test_html import csv_rows, needs_browser, page_data, selftest
+from urdf_numpy import urdf_fk
 
 SCENARIOS = SOURCE_DIR / "scenarios"
 
@@ -358,7 +359,7 @@ def test_a_rigid_target_from_a_urdf_is_drawn_with_its_visuals(rigid_urdf_target,
         assert np.allclose(drawn, [*corners[:, :3].min(0), *corners[:, :3].max(0)], atol=2e-6), link
     # The claw: the STL's triangles, three vertices each.
     assert [m["vertices"] for m in got["targetMeshes"]] == [3 * CLAW_TRIANGLES]
-    assert "mesh" not in rigid_urdf_target["stderr"]
+    assert "claw.stl" not in rigid_urdf_target["stderr"]  # found, read, drawn: no warning
 
 
 def test_a_rigid_target_without_visuals_keeps_its_box_of_inertia(tmp_path, cli):
