@@ -345,13 +345,17 @@ function kdlSpaceMain() {
  });
  var axes = new THREE.AxesHelper(0.25 * size);
  if (links.length) { links[0].add(axes); objects.push(axes); axes.name = 'base frame'; }
- var target = null;
+ var target = null, targetVisuals = [];
  if (D.target) {
    target = new THREE.Group();
-   var box = new THREE.Mesh(new THREE.BoxBufferGeometry(D.target.size[0], D.target.size[1], D.target.size[2]),
-                            material([1.0, 0.5, 0.05, 0.55]));
-   place(box, D.target.origin);
-   target.add(box);
+   // A rigid target read from a URDF: its links' visuals, given in the target's frame.
+   targetVisuals = (D.target.visuals || []).map(function (v) { var o = visualMesh(v); target.add(o); return o; });
+   if (!targetVisuals.length) {  // its box of inertia
+     var box = new THREE.Mesh(new THREE.BoxBufferGeometry(D.target.size[0], D.target.size[1], D.target.size[2]),
+                              material([1.0, 0.5, 0.05, 0.55]));
+     place(box, D.target.origin);
+     target.add(box);
+   }
    target.add(new THREE.AxesHelper(0.5 * Math.max(D.target.size[0], D.target.size[1], D.target.size[2])));
    add(target, 'target');
  }
@@ -436,6 +440,48 @@ function kdlSpaceMain() {
    return [p.x, p.y, p.z, q.x, q.y, q.z, q.w];
  };
  K.targetLinkCount = targetLinks.length;
+ // --- The target's URDF visuals (issue 27, item 2), for the tests: a rigid target's visuals (their
+ // world pose and box at frame k) and the target's meshes as drawn (rigid or free-floating).
+ if (targetVisuals.length)
+   document.getElementById('legend').textContent += '; orange: the rigid target drawn with its URDF visuals';
+ if (D.targetDrift)
+   document.getElementById('legend').textContent += '; after the point impact the free-floating target is drawn as one ' +
+       'rigid body, its joints frozen, drifting torque-free from its base twist after the impact (the run does not ' +
+       'compute its own motion)';
+ K.targetDrift = !!D.targetDrift;
+ K.targetVisualCount = targetVisuals.length;
+ K.targetPose = function (k) { return target ? poseArray(k * stride + 3 + 7 * N) : null; };
+ K.targetVisualPose = function (k, i) {
+   var t = K.targetPose(k), v = D.target.visuals[i].origin;
+   if (!t) return null;
+   var m = new THREE.Matrix4().compose(new THREE.Vector3(t[0], t[1], t[2]), new THREE.Quaternion(t[3], t[4], t[5], t[6]),
+                                       new THREE.Vector3(1, 1, 1));
+   m.multiply(new THREE.Matrix4().compose(new THREE.Vector3(v[0], v[1], v[2]), new THREE.Quaternion(v[3], v[4], v[5], v[6]),
+                                          new THREE.Vector3(1, 1, 1)));
+   var p = new THREE.Vector3(), q = new THREE.Quaternion(), s = new THREE.Vector3();
+   m.decompose(p, q, s);
+   return [p.x, p.y, p.z, q.x, q.y, q.z, q.w];
+ };
+ // The world boxes [min x y z, max x y z] of the visuals as drawn at the current frame (setFrame).
+ K.targetVisualBoxes = function () {
+   return targetVisuals.map(function (o) {
+     o.updateMatrixWorld(true);
+     var b = new THREE.Box3().setFromObject(o);
+     return b.isEmpty() ? null : [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+   });
+ };
+ K.targetMeshes = [];
+ function countTargetMeshes(visuals, objects, link) {
+   visuals.forEach(function (v, j) {
+     if (v.shape !== 'mesh') return;
+     var count = 0;
+     objects[j].traverse(function (o) { if (o.isMesh) count += o.geometry.attributes.position.count; });
+     K.targetMeshes.push({ link: link || v.link, file: v.file, vertices: count });
+   });
+ }
+ if (targetVisuals.length) countTargetMeshes(D.target.visuals, targetVisuals, null);
+ targetLinks.forEach(function (group, i) { countTargetMeshes(D.targetLinks[i].visuals, group.children, D.targetLinks[i].name); });
+ // --- end of the target's URDF visuals
  K.targetLinkPose = function (k, i) { return poseArray(k * stride + targetLinksAt + 7 * i); };
  // A failed approach: how close the hand came, when, and the frame nearest that instant.
  K.closest = null;
@@ -561,6 +607,10 @@ function kdlSpaceMain() {
    meshes: K.meshes || [],
    graspFrame: ok && K.graspFrame ? K.graspFrame(k) : null, closest: ok ? K.closest : null,
    note: document.getElementById('note').textContent, readyMs: K.readyMs,
+   targetVisualCount: K.targetVisualCount || 0, targetMeshes: K.targetMeshes || [],
+   targetPose: ok && K.targetPose ? K.targetPose(k) : null,
+   targetVisualPoses: ok && K.targetVisualPose ? Array.apply(null, Array(K.targetVisualCount)).map(function (_, i) { return K.targetVisualPose(k, i); }) : [],
+   targetVisualBoxes: ok && K.targetVisualBoxes ? K.targetVisualBoxes() : [],
    targetLinkPoses: ok && K.targetLinkPose ? Array.apply(null, Array(K.targetLinkCount)).map(function (_, i) { return K.targetLinkPose(k, i); }) : [] });
 })();
 </script>

@@ -141,31 +141,35 @@ int HtmlWriter::meshIndex(const std::string& path) const {
 /// mesh_path cleared) with a warning that says why and what to do.
 void HtmlWriter::readMeshes() {
   for (auto& [link, list] : visuals_)
-    for (LinkVisual& v : list) {
-      if (v.shape != LinkVisual::Shape::Mesh) continue;
-      const std::string format = meshFormat(v.mesh_path.empty() ? v.mesh_file : v.mesh_path);
-      std::string why;
-      if (v.mesh_path.empty()) {
-        why = "was not found (" + v.mesh_problem +
-              "): give --mesh-path DIR (the folder holding the package's folder) or set ROS_PACKAGE_PATH";
-      } else if (format.empty()) {
-        why = "(" + v.mesh_path + ") is not drawn: only STL and COLLADA (.dae) meshes are read; convert it to one of them";
-      } else if (std::ifstream(format == "stl" ? kStlLoaderJs : kColladaLoaderJs).fail()) {
-        why = "is not drawn: three.js's loader is not installed (Debian package libjs-three; tools/deps.sh installs it)";
-      } else if (meshIndex(v.mesh_path) < 0) {
-        std::ifstream in(v.mesh_path, std::ios::binary);
-        std::ostringstream bytes;
-        bytes << in.rdbuf();
-        if (!in || bytes.str().empty())
-          why = "(" + v.mesh_path + ") cannot be read or is empty: check the file";
-        else
-          meshes_.push_back({v.mesh_path, format, bytes.str()});
-      }
-      if (why.empty()) continue;
-      warnings_.push_back({link, "--html: the mesh " + v.mesh_file + " " + why + "; the page draws the link's box of inertia",
-                           "mesh_not_drawn", Severity::Warning});
-      v.mesh_path.clear();
-    }
+    for (LinkVisual& v : list) readMesh(link, v);
+}
+
+/// One mesh visual of `link` (a name for the warning): read into meshes_ once per file, or its
+/// mesh_path cleared with a warning.
+void HtmlWriter::readMesh(const std::string& link, LinkVisual& v) {
+  if (v.shape != LinkVisual::Shape::Mesh) return;
+  const std::string format = meshFormat(v.mesh_path.empty() ? v.mesh_file : v.mesh_path);
+  std::string why;
+  if (v.mesh_path.empty()) {
+    why = "was not found (" + v.mesh_problem +
+          "): give --mesh-path DIR (the folder holding the package's folder) or set ROS_PACKAGE_PATH";
+  } else if (format.empty()) {
+    why = "(" + v.mesh_path + ") is not drawn: only STL and COLLADA (.dae) meshes are read; convert it to one of them";
+  } else if (std::ifstream(format == "stl" ? kStlLoaderJs : kColladaLoaderJs).fail()) {
+    why = "is not drawn: three.js's loader is not installed (Debian package libjs-three; tools/deps.sh installs it)";
+  } else if (meshIndex(v.mesh_path) < 0) {
+    std::ifstream in(v.mesh_path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    if (!in || bytes.str().empty())
+      why = "(" + v.mesh_path + ") cannot be read or is empty: check the file";
+    else
+      meshes_.push_back({v.mesh_path, format, bytes.str()});
+  }
+  if (why.empty()) return;
+  warnings_.push_back({link, "--html: the mesh " + v.mesh_file + " " + why + "; the page draws the link's box of inertia",
+                       "mesh_not_drawn", Severity::Warning});
+  v.mesh_path.clear();
 }
 
 // --- The meshes a page reads, as inputs no output may replace (issue 25's rule) ----------------
@@ -196,6 +200,7 @@ HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_
   for (const Body& b : robot.bodies()) links_.push_back(b.name);
   if (!sc.robot_urdf.empty()) visuals_ = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
   readMeshes();
+  readTargetVisuals(mesh_search_path);
   warnOnStderr(warnings_);
   if (sc.impact)
     if (const auto* rigid = std::get_if<RigidTarget>(&sc.capture.target)) {
@@ -205,16 +210,7 @@ HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_
   // A free-floating target: its links, drawn from its URDF's visuals (or their boxes of inertia).
   if (sc.impact)
     if (const auto* other = std::get_if<FloatingSystem>(&sc.capture.target)) {
-      target_model_ = other->model;
-      if (!sc.target_urdf.empty()) target_visuals_ = readUrdfVisuals(sc.target_urdf);
-      std::vector<Diagnostic> target_warnings;
-      for (const auto& [link, list] : target_visuals_)
-        for (const LinkVisual& v : list)
-          if (v.shape == LinkVisual::Shape::Mesh)
-            target_warnings.push_back({"target " + link, "--html: the mesh " + v.mesh_file +
-                                           " is drawn as the link's box of inertia (meshes are not read yet)",
-                                       "", Severity::Warning});
-      warnOnStderr(target_warnings);
+      target_model_ = other->model;  // its visuals: readTargetVisuals
     }
 }
 
@@ -480,7 +476,7 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
     return;
   }
   // Not part of the system that moves: at the contact instant where the capture problem has it;
-  // after a point impact it drifts on by itself, which the page does not draw.
+  // after a point impact it drifts on by itself (driftingTargetBase).
   const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
   if (target_at_contact_.empty() && other) {
     Kinematics target_kin(*other->model);
@@ -488,8 +484,33 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
       for (std::size_t i = 0; i < links.size(); ++i) target_at_contact_.push_back(target_kin.pose(static_cast<int>(i)));
   }
   const bool at_contact = x.t <= so_far.t_capture && target_at_contact_.size() == links.size();
+  const std::optional<KDL::Frame> moved = at_contact ? std::nullopt : driftingTargetBase(so_far, x.t);
   for (std::size_t i = 0; i < links.size(); ++i)
-    if (at_contact) pushPose(f, target_at_contact_[i]); else pushHidden(f);
+    if (at_contact) pushPose(f, target_at_contact_[i]);
+    else if (moved) pushPose(f, *moved * target_at_contact_[i]);
+    else pushHidden(f);
+}
+
+/// The operation's result does not carry a separated free-floating target's own motion after a
+/// point impact: the page draws it as one rigid body (its joints frozen where the impact found
+/// them, rigidSubtree) moving torque-free from its base twist after the impact (FreeRigidMotion:
+/// its momentum kept). Returns world_new_T_world_at_contact at time t, or none (not drawn).
+std::optional<KDL::Frame> HtmlWriter::driftingTargetBase(const OperationResult& so_far, double t) {
+  const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
+  if (!other || !so_far.capture || !so_far.capture->floating_target || so_far.joined || t < so_far.t_capture)
+    return std::nullopt;
+  if (!drift_) {
+    try {
+      const RigidTarget whole = rigidSubtree(*other->model, other->state, 0, so_far.capture->floating_target->after.base_twist);
+      drift_.emplace(whole);
+      drift_start_ = whole.pose;
+    } catch (const Error&) {
+      return std::nullopt;  // no mass to move: not drawn
+    }
+  }
+  RigidTarget now;
+  if (drift_->at(t - so_far.t_capture, now) != E_NOERROR) return std::nullopt;
+  return now.pose * drift_start_.Inverse();
 }
 
 void HtmlWriter::addKept(const OperationResult& so_far, const MotionSample& x) {
@@ -505,7 +526,9 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
       Json visuals = Json::array();
       if (const auto it = target_visuals_.find(b.name); it != target_visuals_.end())
         for (const LinkVisual& v : it->second)
-          visuals.push_back(v.shape == LinkVisual::Shape::Mesh ? inertiaBoxJson(b) : visualJson(v));
+          visuals.push_back(v.shape != LinkVisual::Shape::Mesh ? visualJson(v)
+                            : v.mesh_path.empty() ? inertiaBoxJson(b)  // warned about
+                                                  : meshVisualJson(v, meshIndex(v.mesh_path)));
       if (visuals.empty()) visuals.push_back(inertiaBoxJson(b));
       for (Json& v : visuals)
         if (!v.contains("rgba") || v.value("inertia_box", false)) v["rgba"] = {1.0, 0.5, 0.05, 0.55};  // the target's orange
@@ -513,6 +536,8 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
     }
     data["targetLinks"] = links;
   }
+  if (target_ && data["target"].is_object()) data["target"]["visuals"] = rigidTargetVisualsJson();
+  data["targetDrift"] = drift_.has_value();  // drawn after a point impact as a rigid body (driftingTargetBase)
   // The grasp frame rides on the target's frame (a rigid target's, a free-floating one's base).
   data["grasp"] = nullptr;
   if (sc_.grasp_frame && (target_ || target_model_)) data["grasp"] = {{"pose", poseJson(*sc_.grasp_frame)}};
@@ -521,6 +546,60 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
   if (r.approach && !r.approach->record.reached && std::isfinite(r.approach->record.closest_distance))
     data["closest"] = {{"distance", r.approach->record.closest_distance}, {"time", r.approach->record.closest_time}};
   if (r.approach && !r.approach->record.reached) data["tCapture"] = nullptr;  // no contact: no impact to step to
+}
+
+// --- The target's URDF visuals (issue 27, item 2) ------------------------------------------------
+
+void HtmlWriter::readTargetVisuals(const std::vector<std::string>& mesh_search_path) {
+  if (!sc_.impact || sc_.target_urdf.empty()) return;
+  if (!sc_.rigid_target_system && !std::holds_alternative<FloatingSystem>(sc_.capture.target)) return;
+  target_visuals_ = readUrdfVisuals(sc_.target_urdf, mesh_search_path);
+  for (auto& [link, list] : target_visuals_)
+    for (LinkVisual& v : list) readMesh("target " + link, v);
+}
+
+Json HtmlWriter::rigidTargetVisualsJson() const {
+  Json out = Json::array();
+  if (!sc_.rigid_target_system || target_visuals_.empty()) return out;
+  const FloatingSystem& t = *sc_.rigid_target_system;
+  const std::vector<Body>& bodies = t.model->bodies();
+  Kinematics kin(*t.model);
+  if (forwardKinematics(*t.model, t.state, kin) != E_NOERROR) return out;  // the scenario computed it: not here
+  // The subtree from the target's body (bodies come parents first), each link in the target's
+  // frame at the scenario's state: the visuals then ride on the target's pose per frame.
+  const int root = sc_.rigid_target_body;
+  std::vector<char> in(bodies.size(), 0);
+  in[root] = 1;
+  for (std::size_t j = root + 1; j < bodies.size(); ++j) in[j] = bodies[j].parent >= 0 && in[bodies[j].parent];
+  bool any = false;
+  for (std::size_t j = 0; j < bodies.size(); ++j) {
+    if (!in[j]) continue;
+    const KDL::Frame target_T_link = kin.pose(root).Inverse() * kin.pose(static_cast<int>(j));
+    const auto it = target_visuals_.find(bodies[j].name);
+    const std::vector<LinkVisual> none;
+    const std::vector<LinkVisual>& list = it != target_visuals_.end() ? it->second : none;
+    any = any || !list.empty();
+    std::vector<Json> visuals;
+    for (const LinkVisual& v : list) {
+      Json vj = v.shape != LinkVisual::Shape::Mesh ? visualJson(v)
+               : v.mesh_path.empty()               ? inertiaBoxJson(bodies[j])  // warned about
+                                                   : meshVisualJson(v, meshIndex(v.mesh_path));
+      const bool box = vj.value("inertia_box", false);
+      vj["origin"] = poseJson(target_T_link * (box ? equivalentBox(bodies[j].mass, bodies[j].I_com, bodies[j].com).pose : v.origin));
+      visuals.push_back(vj);
+    }
+    if (list.empty() && bodies[j].mass > 0.0) {  // a link with mass but no visual: its box of inertia
+      Json vj = inertiaBoxJson(bodies[j]);
+      vj["origin"] = poseJson(target_T_link * equivalentBox(bodies[j].mass, bodies[j].I_com, bodies[j].com).pose);
+      visuals.push_back(vj);
+    }
+    for (Json& v : visuals) {
+      if (!v.contains("rgba") || v.value("inertia_box", false)) v["rgba"] = {1.0, 0.5, 0.05, 0.55};  // the target's orange
+      v["link"] = bodies[j].name;
+      out.push_back(v);
+    }
+  }
+  return any ? out : Json::array();
 }
 
 std::vector<Diagnostic> writeCaptureHtml(const AtomicFile& file, const Scenario& sc, const CaptureResult& result,

@@ -92,6 +92,7 @@ class HtmlWriter {
   std::vector<MeshData> meshes_;
   std::vector<Diagnostic> warnings_;
   void readMeshes();
+  void readMesh(const std::string& link, LinkVisual& v);
   int meshIndex(const std::string& path) const;
   std::optional<RigidTarget> target_;     ///< a rigid target at t = 0
   std::optional<FreeRigidMotion> tumble_;  ///< its motion before the capture
@@ -127,6 +128,19 @@ class HtmlWriter {
   std::vector<KDL::Frame> target_at_contact_;  ///< its links (world) at the contact instant
   std::vector<int> target_index_;              ///< its link -> body in model_ when joined (-1: none)
   const FloatingModel* target_index_for_ = nullptr;  ///< the system target_index_ is for
+
+  // --- The target's URDF visuals (a rigid target read from a URDF, a free-floating target) -----
+  /// Reads target_urdf's visuals (its meshes through `mesh_search_path`, into meshes_ as the
+  /// robot's; warnings name the link as "target LINK").
+  void readTargetVisuals(const std::vector<std::string>& mesh_search_path);
+  /// A rigid target read from a URDF: its subtree's links' visuals in the target's frame (a link
+  /// without one: its box of inertia); empty when no link of it has a visual (the page then draws
+  /// the target's box of inertia).
+  Json rigidTargetVisualsJson() const;
+  /// A free-floating target separated by a point impact, drifting as one rigid body (c).
+  std::optional<KDL::Frame> driftingTargetBase(const OperationResult& so_far, double t);
+  std::optional<FreeRigidMotion> drift_;
+  KDL::Frame drift_start_;
 };
 
 /// \brief The page of a capture at the scenario's states (`kdl_space capture --html`, Python's

@@ -18,6 +18,7 @@ import pytest
 
 from conftest import ARM, SOURCE_DIR
 from test_html import csv_rows, needs_browser, page_data, selftest
+from urdf_numpy import urdf_fk
 
 SCENARIOS = SOURCE_DIR / "scenarios"
 
@@ -246,3 +247,207 @@ def test_a_humanoids_20_s_page_is_under_5_mb(tmp_path, cli):
     times = np.frombuffer(base64.b64decode(data["times"]), dtype=np.float64)
     assert abs(times[-1] - 20.0) < 1e-9 and data["frameCount"] <= 20 * 30 + 2
     assert page.stat().st_size < 5e6, page.stat().st_size
+
+
+# --- The target's URDF visuals: a rigid target read from a URDF, a free-floating target's meshes --
+# A hub, a boom on a revolute joint (held at BOOM_Q: the rigid body's shape) and a gripper fixed at
+# its end, each with a box visual (the gripper also with an STL mesh found through --mesh-path);
+# target.link: hub makes the whole tree one rigid body whose frame is the hub's.
+BOOM_Q = 0.6
+TARGET_URDF = """<?xml version="1.0"?>
+<robot name="boom">
+  <link name="hub">
+    <inertial><mass value="100"/><inertia ixx="10" ixy="0" ixz="0" iyy="12" iyz="0" izz="14"/></inertial>
+    <visual><origin xyz="0.1 -0.2 0.05" rpy="0.3 0 0.2"/><geometry><box size="0.8 0.6 0.5"/></geometry></visual>
+  </link>
+  <link name="boom">
+    <inertial><origin xyz="0.5 0 0"/><mass value="2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.2"/></inertial>
+    <visual><origin xyz="0.5 0 0" rpy="0.1 0.2 0.3"/><geometry><box size="1.0 0.1 0.08"/></geometry></visual>
+  </link>
+  <link name="gripper">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <visual><origin xyz="0.05 0 0" rpy="0 0.4 0"/><geometry><box size="0.1 0.2 0.3"/></geometry></visual>
+    <visual><geometry><mesh filename="package://tgt/meshes/claw.stl"/></geometry></visual>
+  </link>
+  <joint name="boom_joint" type="revolute">
+    <parent link="hub"/><child link="boom"/><origin xyz="0 0 0.5" rpy="0.2 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="1"/>
+  </joint>
+  <joint name="gripper_mount" type="fixed">
+    <parent link="boom"/><child link="gripper"/><origin xyz="1 0 0" rpy="0 0 0.5"/>
+  </joint>
+</robot>
+"""
+# The box visuals (link, origin xyz, rpy, size), as written above.
+BOXES = [("hub", [0.1, -0.2, 0.05], [0.3, 0, 0.2], [0.8, 0.6, 0.5]),
+         ("boom", [0.5, 0, 0], [0.1, 0.2, 0.3], [1.0, 0.1, 0.08]),
+         ("gripper", [0.05, 0, 0], [0, 0.4, 0], [0.1, 0.2, 0.3])]
+CLAW_TRIANGLES = 4
+HUB_POSITION, HUB_RPY = [0.4, -2.8, 1.6], [0.2, -0.1, 0.4]
+
+
+def write_stl(path, triangles):
+    """A binary STL of `triangles` small triangles (normals zero, as many exporters write)."""
+    import struct
+    body = b"".join(struct.pack("<12fH", 0, 0, 0, *[0.01 * (i + 1), 0, 0], *[0, 0.02, 0], *[0, 0, 0.03 * (i + 1)], 0)
+                    for i in range(triangles))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(b"\0" * 80 + struct.pack("<I", triangles) + body)
+
+
+@pytest.fixture(scope="module")
+def rigid_urdf_target(tmp_path_factory, cli):
+    """A 1 s run after the capture of the rigid target above (held by the hand), its page with --mesh-path."""
+    d = tmp_path_factory.mktemp("rigid_urdf")
+    (d / "boom.urdf").write_text(TARGET_URDF)
+    write_stl(d / "meshes" / "tgt" / "meshes" / "claw.stl", CLAW_TRIANGLES)
+    scenario = d / "scenario.yaml"
+    scenario.write_text(f"""
+robot:
+  urdf: {ARM}
+  contact: {{link: end_effector, offset: [0, 0, 0.05]}}
+  q: {{joint2: 0.7, joint3: 0.9, joint4: 0.8, joint6: -0.6}}
+target:
+  urdf: {d / "boom.urdf"}
+  link: hub
+  q: {{boom_joint: {BOOM_Q}}}
+  base: {{position: {HUB_POSITION}, rpy: {HUB_RPY}, twist: [0.01, 0.02, 0, 0.05, -0.04, 0.06]}}
+law: {{type: capture}}
+""")
+    page = d / "run.html"
+    done = run_cli(cli, "simulate", scenario, "--duration", "1", "--html", page, "--mesh-path", d / "meshes")
+    assert done.returncode == 0, done.stderr
+    return {"dir": d, "page": page, "stderr": done.stderr}
+
+
+def pose_matrix(pose):
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = quat_matrix(*pose[3:]), pose[:3]
+    return T
+
+
+def rpy_pose(xyz, rpy):
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = rpy_matrix(*rpy), xyz
+    return T
+
+
+@needs_browser
+@pytest.mark.parametrize("which", ["first", "last"])
+def test_a_rigid_target_from_a_urdf_is_drawn_with_its_visuals(rigid_urdf_target, which):
+    data = page_data(rigid_urdf_target["page"])
+    k = 0 if which == "first" else data["frameCount"] - 1
+    got = selftest(rigid_urdf_target["page"], k)
+    assert got["errors"] == [], got["errors"]
+    assert got["targetVisualCount"] == 4  # three boxes and the claw
+    # The target's frame is the hub's: at the start where target.base puts it.
+    target = got["targetPose"]
+    if k == 0:
+        assert np.allclose(pose_matrix(target), rpy_pose(HUB_POSITION, HUB_RPY), atol=2e-6)
+    # Each box: target pose(k) x (hub <- link at boom_joint = BOOM_Q) x the visual's origin.
+    links = urdf_fk(rigid_urdf_target["dir"] / "boom.urdf", {"boom_joint": BOOM_Q}, np.eye(4))
+    box_at = [i for i, v in enumerate(data["target"]["visuals"]) if v["shape"] == "box"]
+    assert len(box_at) == len(BOXES)
+    for i, (link, xyz, rpy, size) in zip(box_at, BOXES):
+        expected = pose_matrix(target) @ links[link] @ rpy_pose(xyz, rpy)
+        pose = got["targetVisualPoses"][i]
+        assert np.allclose(pose_matrix(pose), expected, atol=1e-6), (link, pose, expected)
+        # ... and the box as drawn there: its corners' world bounds.
+        corners = np.array([[sx * size[0] / 2, sy * size[1] / 2, sz * size[2] / 2, 1]
+                            for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) @ expected.T
+        drawn = got["targetVisualBoxes"][i]
+        assert np.allclose(drawn, [*corners[:, :3].min(0), *corners[:, :3].max(0)], atol=2e-6), link
+    # The claw: the STL's triangles, three vertices each.
+    assert [m["vertices"] for m in got["targetMeshes"]] == [3 * CLAW_TRIANGLES]
+    assert "claw.stl" not in rigid_urdf_target["stderr"]  # found, read, drawn: no warning
+
+
+def test_a_rigid_target_without_visuals_keeps_its_box_of_inertia(tmp_path, cli):
+    urdf = tmp_path / "boom.urdf"
+    urdf.write_text(re.sub(r"<visual>.*?</visual>", "", TARGET_URDF))
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(f"""
+robot: {{urdf: {ARM}, contact: {{link: end_effector}}}}
+target: {{urdf: {urdf}, link: hub, q: {{boom_joint: {BOOM_Q}}}}}
+law: {{type: capture}}
+""")
+    page = tmp_path / "p.html"
+    done = run_cli(cli, "capture", scenario, "--html", page)
+    assert done.returncode == 0, done.stderr
+    target = page_data(page)["target"]
+    assert target["visuals"] == [] and len(target["size"]) == 3
+
+
+@needs_browser
+def test_a_free_floating_targets_mesh_is_drawn(tmp_path, cli):
+    tree = (SOURCE_DIR / "urdf" / "spacedyn_twolink.urdf").read_text()
+    claw = '<visual><geometry><mesh filename="package://tgt/meshes/claw.stl"/></geometry></visual>'
+    urdf = tmp_path / "twolink.urdf"
+    urdf.write_text(tree.replace('<link name="hand"/>', f'<link name="hand">{claw}</link>'))
+    assert claw in urdf.read_text()
+    write_stl(tmp_path / "meshes" / "tgt" / "meshes" / "claw.stl", CLAW_TRIANGLES)
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text((SCENARIOS / "robot_to_robot_capture.yaml").read_text()
+                        .replace("../urdf/space_arm7.urdf", str(ARM)).replace("../urdf/spacedyn_twolink.urdf", str(urdf)))
+    page = tmp_path / "p.html"
+    done = run_cli(cli, "simulate", scenario, "--duration", "0.2", "--html", page, "--mesh-path", tmp_path / "meshes")
+    assert done.returncode == 0, done.stderr
+    got = selftest(page, 0)
+    assert got["errors"] == [], got["errors"]
+    assert got["targetMeshes"] == [{"link": "hand", "file": "package://tgt/meshes/claw.stl", "vertices": 3 * CLAW_TRIANGLES}]
+
+
+def urdf_masses(path):
+    """{link: (mass, CoM in the link's frame)} of the URDF's links with an <inertial>."""
+    import xml.etree.ElementTree as ET
+    out = {}
+    for link in ET.parse(path).getroot().findall("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        origin = inertial.find("origin")
+        com = [float(v) for v in origin.get("xyz").split()] if origin is not None and origin.get("xyz") else [0, 0, 0]
+        out[link.get("name")] = (float(inertial.find("mass").get("value")), np.array(com))
+    return out
+
+
+@needs_browser
+def test_a_free_floating_target_drifts_as_a_rigid_body_after_a_point_impact(tmp_path, cli):
+    urdf = SOURCE_DIR / "urdf" / "spacedyn_twolink.urdf"
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text((SCENARIOS / "robot_to_robot_capture.yaml").read_text()
+                        .replace("../urdf/space_arm7.urdf", str(ARM)).replace("../urdf/spacedyn_twolink.urdf", str(urdf))
+                        .replace("type: capture", "type: point\n  normal: [1, 0, 0]\n  restitution: 0.5"))
+    page = tmp_path / "p.html"
+    done = run_cli(cli, "simulate", scenario, "--duration", "2", "--html", page)
+    assert done.returncode == 0, done.stderr
+    data = page_data(page)
+    assert data["targetDrift"] is True
+    names = [link["name"] for link in data["targetLinks"]]
+    masses = urdf_masses(urdf)
+    n = data["frameCount"]
+    frames = [n // 3, 2 * n // 3, n - 1]
+    got = [selftest(page, k) for k in frames]
+    assert got[0]["errors"] == [], got[0]["errors"]
+    assert "rigid body, its joints frozen" in page.read_text()
+    coms, times = [], []
+    for g in got:
+        poses = g["targetLinkPoses"]
+        assert all(p is not None for p in poses), "the separated target is drawn after the impact"
+        # Its joints frozen: each link where it was relative to the base.
+        relative = [np.linalg.inv(pose_matrix(poses[0])) @ pose_matrix(p) for p in poses]
+        if g is got[0]:
+            first = relative
+        for a, b in zip(first, relative):
+            assert np.allclose(a, b, atol=1e-5)
+        # Its CoM, from the links' poses and the URDF's masses.
+        weighted = [m * (pose_matrix(poses[names.index(link)]) @ np.append(c, 1))[:3] for link, (m, c) in masses.items()
+                    if link in names]
+        coms.append(sum(weighted) / sum(m for link, (m, c) in masses.items() if link in names))
+        times.append(g["time"])
+    # Torque-free: the CoM moves on a straight line at a constant speed.
+    v1 = (coms[1] - coms[0]) / (times[1] - times[0])
+    v2 = (coms[2] - coms[1]) / (times[2] - times[1])
+    assert np.linalg.norm(v1) > 1e-4
+    # float32 positions of a few metres (some 3e-7 m each), over the frames' time apart
+    assert np.allclose(v1, v2, atol=2e-6 / min(times[1] - times[0], times[2] - times[1])), (v1, v2)

@@ -25,6 +25,7 @@ TEST(LoadScenario, ARigidTargetInTheFilesTerms) {
   EXPECT_EQ(s.file, kShipped + "tumbling_box_capture.yaml");
   EXPECT_EQ(s.robot_urdf, fs::path(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/space_arm7.urdf").lexically_normal().string());
   EXPECT_EQ(s.target_urdf, "");
+  EXPECT_FALSE(s.rigid_target_system);  // a rigid target by numbers: no file to draw from
   const CaptureProblem& p = s.capture;
   ASSERT_TRUE(p.robot.model);
   EXPECT_EQ(p.robot.model->jointNames().size(), 7u);
@@ -63,6 +64,7 @@ TEST(LoadScenario, ARigidTargetInTheFilesTerms) {
 TEST(LoadScenario, AFreeFloatingTarget) {
   const Scenario s = loadScenario(kShipped + "robot_to_robot_capture.yaml");
   ASSERT_TRUE(std::holds_alternative<FloatingSystem>(s.capture.target));
+  EXPECT_FALSE(s.rigid_target_system);  // only a rigid target read from a URDF
   const FloatingSystem& t = std::get<FloatingSystem>(s.capture.target);
   ASSERT_TRUE(t.model);
   EXPECT_EQ(t.model->jointNames(), (std::vector<std::string>{"joint1", "joint2"}));
@@ -248,10 +250,17 @@ TEST(LoadScenario, ALinkSubtreeOfAUrdfIsOneRigidBodyAtItsJointAngles) {
   EXPECT_TRUE(near(t.inertia, Vector3d(0.02, I, I).asDiagonal().toDenseMatrix(), 1e-12, 1e-14, "inertia"));
   EXPECT_TRUE(near(toEigen(t.pose.M), toEigen(KDL::Rotation::RotZ(0.3)), 1e-14, 1e-14, "the boom's frame"));
   EXPECT_TRUE(near(toEigen(t.pose.p), Vector3d(-0.6, -2.9, 2.2), 1e-14, 1e-14, "at the joint"));
+  // The file's system is kept for the pictures: its state where target.q and target.base put it,
+  // the target's body the boom's.
+  ASSERT_TRUE(s.rigid_target_system);
+  EXPECT_EQ(s.rigid_target_body, s.rigid_target_system->model->bodyIndex("boom"));
+  EXPECT_EQ(s.rigid_target_system->state.q(0), 0.3);
+  EXPECT_EQ(s.rigid_target_system->state.world_T_base.p, KDL::Vector(-0.6, -2.9, 1.7));
   // the links from a fixed one down: the gripper alone
   const Scenario gripper = loadScenario(withTarget(
       "gripper.yaml", "  urdf: " + dataDir() + "/rigid_target/boom.urdf\n  link: gripper\n  q: {boom_joint: 0.3}\n"));
   EXPECT_NEAR(std::get<RigidTarget>(gripper.capture.target).mass, 1.0, 1e-12);
+  EXPECT_EQ(gripper.rigid_target_body, gripper.rigid_target_system->model->bodyIndex("gripper"));
   // a rigid URDF target has no contact of its own; a link that is not in the file is named
   try {
     loadScenario(withTarget("contact.yaml", "  urdf: " + dataDir() + "/rigid_target/satellite_panel.urdf\n  contact: {link: hub}\n"));

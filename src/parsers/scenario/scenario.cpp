@@ -286,6 +286,8 @@ Scenario loadScenario(const std::string& path) {
       FloatingSystem t = system(target, folder, s.target_urdf);
       if (target.has("link") || t.model->nj() == 0) {
         s.capture.target = rigidUrdfTarget(target, t);  // one rigid body: the robot's contact point is hit
+        s.rigid_target_body = target.has("link") ? t.model->bodyIndex(target.at("link").text()) : 0;
+        s.rigid_target_system = std::move(t);
       } else {
         if (!target.has("contact")) target.at("contact");  // reports it missing
         if (target.has("place") && robot.has("place"))

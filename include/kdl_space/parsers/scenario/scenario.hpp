@@ -44,6 +44,12 @@ struct Scenario {
   /// (one without movable joints, or the links from `target.link` down); empty for a rigid target
   /// given by numbers.
   std::string target_urdf;
+  /// A rigid target read from target_urdf: the file's system at the scenario's state (its joints
+  /// held where target.q puts them, its base at target.base) and the body whose frame is the
+  /// target's frame (target.link's, or the root's), whose subtree it is. What a viewer poses the
+  /// links' visuals from; the dynamics uses capture.target. Unset for every other target.
+  std::optional<FloatingSystem> rigid_target_system;
+  int rigid_target_body = 0;
   /// false: a plain motion (no `target`, no `law`): `capture` holds only the robot (whose
   /// `contact` may then be omitted: the base's origin).
   bool impact = true;
