@@ -22,10 +22,12 @@ std::string write(const std::string& name, const std::string& text) {
 }
 
 /// A base (a 1 m cube of visual around its origin), a stick link1 (visual 0.1 x 0.1 x 1, z from
-/// 0.5 to 1.5 at q = 0) and a hand link2 (z from 1.5 to 2).
-std::string stickArm() {
+/// 0.5 to 1.5 at q = 0) and a hand link2 (z from 1.5 to 2). Each test writes its own copy (`name`):
+/// ctest runs the tests of this file side by side, and one copy rewritten while another test reads
+/// it is an empty file.
+std::string stickArm(const std::string& name) {
   const char* inertial = R"(<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>)";
-  return write("overlap_stick_arm.urdf",
+  return write(name + "_stick_arm.urdf",
                std::string(R"(<robot name="stick">
   <link name="base">)") + R"(<inertial><mass value="100"/><inertia ixx="10" iyy="10" izz="10" ixy="0" ixz="0" iyz="0"/></inertial>
     <visual><geometry><box size="1 1 1"/></geometry></visual></link>
@@ -41,7 +43,7 @@ std::string stickArm() {
 /// wide) is in it, 0.9 deep (out downwards: 1.5 - 0.6; sideways 1 + 0.05, upwards 2.6 - 0.5);
 /// the base (up to z 0.5) is 0.1 below it; link2 holds the contact.
 std::string swallowed(const std::string& name, const std::string& extra = "") {
-  return write(name, "robot:\n  urdf: " + stickArm() +
+  return write(name, "robot:\n  urdf: " + stickArm(name) +
                          "\n  contact: {link: link2, offset: [0, 0, 0.5]}\n"
                          "target:\n  mass: 12\n  inertia: [[8, 0, 0], [0, 8, 0], [0, 0, 8]]\n"
                          "  pose: {position: [0, 0, 1.6]}\n  twist: [0.01, 0, 0, 0, 0, 0]\n"

@@ -11,6 +11,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <unistd.h>
 
 #include "kdl_space/study/study.hpp"
 #include "test_util.hpp"
@@ -21,9 +22,13 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
 
+/// This test process's temporary folder: ctest runs the tests of this file side by side, and a file
+/// that two of them rewrite at once is read empty.
+fs::path studyDir() { return fs::path(::testing::TempDir()) / ("kdl_space_study_tests_" + std::to_string(getpid())); }
+
 /// A study file in the test's temporary folder.
 std::string studyFile(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_study_tests";
+  const fs::path dir = studyDir();
   fs::create_directories(dir);
   const std::string path = (dir / name).string();
   std::ofstream(path) << text;
@@ -179,7 +184,7 @@ TEST(Study, SummaryQuantilesProbabilitiesAndRanks) {
 }
 
 /// The path of the failing study's scenario (failingStudy).
-std::string failingScenario() { return (fs::path(::testing::TempDir()) / "kdl_space_study_tests" / "failing_scenario.yaml").string(); }
+std::string failingScenario() { return (studyDir() / "failing_scenario.yaml").string(); }
 
 /// A study of the tumbling box whose samples fail for known reasons: joint2 drawn beyond its
 /// limit (2.967 rad), where the scenario's hard stops refuse to start the motion (an InputError
@@ -320,7 +325,7 @@ std::string copyStudyFolder(const fs::path& dir, const std::string& newline) {
 }
 
 TEST(Study, TheFingerprintDoesNotDependOnLineEndings) {
-  const fs::path root = fs::path(::testing::TempDir()) / "kdl_space_study_tests";
+  const fs::path root = studyDir();
   const Study lf = loadStudy(copyStudyFolder(root / "lf", "\n"));
   const Study crlf = loadStudy(copyStudyFolder(root / "crlf", "\r\n"));
   EXPECT_EQ(crlf.fingerprint, lf.fingerprint);
