@@ -56,7 +56,7 @@ TEST(ApproachRobotTargetTool, CaptureAtTheReportedContactStatesIsTheOperationsCa
   spit(file, scenario.dump());
   const ToolRun cap = kdlSpace("capture " + file + " --json");
   ASSERT_EQ(cap.rc, 0) << cap.err;
-  const nlohmann::json c = nlohmann::json::parse(cap.out).at("capture");
+  const nlohmann::json c = nlohmann::json::parse(cap.out);
   const nlohmann::json& o = j.at("capture");
   expectNumbersNear(o.at("impulse"), c.at("impulse"), 1e-9, "impulse");
   for (const char* side : {"robot", "target"})
