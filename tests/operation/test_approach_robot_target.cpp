@@ -194,6 +194,35 @@ TEST_F(ApproachRobotTargetRun, CaptureAtTheContactInstantAndTheJoinedMotionFollo
   EXPECT_EQ(r.approach_samples.back().phase, Phase::Capture);
 }
 
+TEST(ApproachRobotTarget, TheTargetsBrakesHoldDuringTheApproach) {
+  // approach_robot_target.yaml with the target's elbow braked (target.locked): its own simulator
+  // keeps it braked while it moves; the capture takes it braked.
+  std::ifstream in(scenarioPath("approach_robot_target.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string qdot = "  qdot: {joint1: 0.03, joint2: -0.02}\n";
+  ASSERT_NE(yaml.find(qdot), std::string::npos);
+  yaml.replace(yaml.find(qdot), qdot.size(), "  qdot: {joint1: 0.03}\n  locked: [joint2]\n");
+  for (std::size_t at; (at = yaml.find("../urdf/")) != std::string::npos;) yaml.replace(at, 8, test::urdfDir() + "/");
+  const std::string path = ::testing::TempDir() + "approach_robot_locked_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(path) << yaml;
+  const Scenario sc = loadScenario(path);
+  std::filesystem::remove(path);
+  OperationOptions o;
+  o.duration = 0.1;
+  const OperationResult r = runCaptureOperation(sc, o);
+  ASSERT_TRUE(r.approach && r.approach->record.reached);
+  const FloatingSystem& start = robotTarget(sc);
+  const FloatingSystem& at = std::get<FloatingSystem>(r.at_contact.target);
+  const int elbow = start.model->jointIndex("joint2"), shoulder = start.model->jointIndex("joint1");
+  EXPECT_EQ(at.state.q(elbow), start.state.q(elbow));
+  EXPECT_EQ(at.velocity.qdot(elbow), 0.0);
+  EXPECT_GT(std::abs(at.state.q(shoulder) - start.state.q(shoulder)), 1e-3);  // the free joint moved
+  ASSERT_TRUE(r.capture && r.capture->floating_target);
+  EXPECT_EQ(r.capture->floating_target->after.qdot(elbow), 0.0);  // braked through the capture too
+}
+
 // --- The scenario's refusals -----------------------------------------------------------------
 
 std::string withApproach(const std::string& approach, const std::string& extra_target = "") {
