@@ -103,6 +103,40 @@ Json baseControlPhasesJson(const Scenario& sc, const OperationResult& r) {
   return Json{{"phases", phases}, {"acted_in", r.base_control_phases}};
 }
 
+// --- The states at the contact instant of an approach (issue 28) -------------------------------
+
+/// A system's state (what a `kdl_space capture` scenario takes back: base.position, base.rpy,
+/// base.twist, q and qdot by joint name).
+Json systemStateJson(const FloatingSystem& s) {
+  const std::vector<std::string>& names = s.model->jointNames();
+  Json q = Json::object(), qdot = Json::object();
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    q[names[j]] = s.state.q(static_cast<unsigned int>(j));
+    qdot[names[j]] = s.velocity.qdot(static_cast<unsigned int>(j));
+  }
+  Eigen::Vector4d quat;
+  s.state.world_T_base.M.GetQuaternion(quat(0), quat(1), quat(2), quat(3));
+  double roll, pitch, yaw;
+  s.state.world_T_base.M.GetRPY(roll, pitch, yaw);
+  return Json{{"base_position", toJson(toEigen(s.state.world_T_base.p))},
+              {"base_rpy", Json::array({roll, pitch, yaw})},
+              {"base_quaternion", toJson(quat)},
+              {"base_twist", toJson(toEigen(s.velocity.base_twist))},
+              {"q", q},
+              {"qdot", qdot}};
+}
+
+/// The robot's and a robot target's states at the contact instant (null target: a rigid one,
+/// whose state is approach.target_at_contact).
+Json statesAtContactJson(const OperationResult& r) {
+  const auto* target = std::get_if<FloatingSystem>(&r.at_contact.target);
+  return Json{{"t", r.t_capture},
+              {"robot", systemStateJson(r.at_contact.robot)},
+              {"target", target ? systemStateJson(*target) : Json(nullptr)}};
+}
+
+// -------------------------------------------------------------------------------------------------
+
 }  // namespace
 
 Json operationJson(const Scenario& sc, const OperationResult& r, const OperationFiles& files) {
@@ -116,6 +150,13 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
     j["capture"]["contact_point_in_target"] = in_target ? toJson(*in_target) : Json(nullptr);
   }
   j["approach"] = r.approach ? approachJson(sc, *r.approach) : Json(nullptr);
+  if (r.approach) {
+    j["approach"]["states_at_contact"] = statesAtContactJson(r);
+    if (const auto* target = std::get_if<FloatingSystem>(&r.at_contact.target))  // not a rigid body's
+      j["approach"]["target_at_contact"] = Json{{"position", toJson(toEigen(target->state.world_T_base.p))},
+                                                {"twist", toJson(toEigen(target->velocity.base_twist))},
+                                                {"of", "base"}};
+  }
   j["target_motion"] = targetMotionJson(r);
   // The robot's configuration at the capture (the contact instant of an approach).
   // The pose an approach started from first, then the configuration at the capture, then what the

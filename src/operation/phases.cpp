@@ -33,13 +33,53 @@ std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
 
 }  // namespace
 
+// --- The approach of a free-floating robot target (issue 28) -----------------------------------
+
+std::unique_ptr<Simulator> targetSimulator(const Scenario& sc, const FloatingSystem& target) {
+  SimulationOptions options = sc.simulation.options;
+  options.grounded = target.response == Response::Grounded;
+  auto sim = std::make_unique<Simulator>(target.model, options);
+  JointControl locked;
+  locked.mode = JointControl::Mode::Locked;
+  for (unsigned int j = 0; j < target.model->nj(); ++j)
+    if (target.response == Response::JointsLocked || (!target.locked.empty() && target.locked[j]))
+      sim->setJointControl(j, locked);
+  for (const auto& [j, control] : sc.simulation.target_joints) {  // its own servos act before the contact too
+    try {
+      sim->setJointControl(j, control);
+    } catch (const Error& e) {
+      e.rethrowWithContext("simulation.target_joints: ");
+    }
+  }
+  return sim;
+}
+
+std::shared_ptr<FloatingApproachTarget> approachTarget(const Scenario& sc, const FloatingSystem& target,
+                                                       const std::function<bool()>& cancelled) {
+  std::unique_ptr<Simulator> sim = targetSimulator(sc, target);
+  sim->setCancelPoll(cancelled);
+  SimulationState start;
+  start.state = target.state;
+  start.velocity = target.velocity;
+  if (sim->options().grounded && toEigen(start.velocity.base_twist) != Vector6d::Zero())
+    throw InputError("the target's base is grounded (held still), but target.base.twist is not zero");
+  return std::make_shared<FloatingApproachTarget>(std::move(sim), std::move(start), target.contact.body);
+}
+
+// -------------------------------------------------------------------------------------------------
+
 void approach(const Scenario& sc, double output_step, const std::function<bool()>& cancelled, OperationResult& result,
               SimulationState& s) {
   const FloatingSystem& robot = sc.capture.robot;
   std::unique_ptr<Simulator> sim = simulatorFor(sc, robot.model, true);
   sim->setCancelPoll(cancelled);
+  std::shared_ptr<FloatingApproachTarget> floating_target;  // a robot target, integrated beside the servicer
   const auto controller = inScenario(sc, [&] {
     try {
+      if (const auto* target = std::get_if<FloatingSystem>(&sc.capture.target)) {
+        floating_target = approachTarget(sc, *target, cancelled);
+        return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach, floating_target);
+      }
       return std::make_unique<ApproachController>(robot.model, robot.contact, *sc.approach,
                                                   FreeRigidMotion(std::get<RigidTarget>(sc.capture.target)));
     } catch (const Error& e) {
@@ -69,12 +109,24 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
       why << sc.file << ": the approach failed at t = " << s.t << " s: " << strError(rc ? rc : observer_rc);
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(result));
   }
-  if (const int e = controller->target(s.t, outcome.target_at_contact))
+  if (floating_target) {
+    FloatingSystem target = std::get<FloatingSystem>(sc.capture.target);
+    SimulationState x;
+    if (const int e = floating_target->state(s.t, x))
+      throw OperationError(sc.file + ": approach: the target's motion failed at t = " + detail::number(s.t) +
+                               " s: " + strError(e),
+                           e, std::make_shared<const OperationResult>(result));
+    target.state = x.state;
+    target.velocity = x.velocity;
+    result.at_contact.target = std::move(target);
+  } else if (const int e = controller->target(s.t, outcome.target_at_contact)) {
     throw InputError(sc.file + ": approach: the target's motion: " + strError(e));
+  } else {
+    result.at_contact.target = outcome.target_at_contact;
+  }
   if (outcome.record.reached && !samples.empty()) samples.back().phase = Phase::Capture;
   result.at_contact.robot.state = s.state;
   result.at_contact.robot.velocity = s.velocity;
-  result.at_contact.target = outcome.target_at_contact;
   result.approach = outcome;
   result.t_capture = s.t;
   if (!outcome.record.reached)  // what happened is the caller's to show (the CSV, the plot) with the refusal

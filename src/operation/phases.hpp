@@ -24,6 +24,16 @@ std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CapturePro
                                             const std::optional<CaptureResult>& capture, double t0, double t_end,
                                             double output_step, const std::function<bool()>& cancelled);
 
+/// \brief A free-floating target's own simulator (the scenario's simulation options; its brakes:
+/// target.mode, target.locked; its servos: simulation.target_joints; a grounded target held).
+/// \throws ModelError (a set-up call) for a control the simulator refuses.
+std::unique_ptr<Simulator> targetSimulator(const Scenario& sc, const FloatingSystem& target);
+
+/// \brief A free-floating robot target's motion during the approach, from its scenario state at
+/// t = 0, integrated by targetSimulator (the grasp in its contact link's frame).
+std::shared_ptr<FloatingApproachTarget> approachTarget(const Scenario& sc, const FloatingSystem& target,
+                                                       const std::function<bool()>& cancelled);
+
 /// The simulator as the scenario says, or its refusal in the scenario's words.
 std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                         bool approach);

@@ -31,8 +31,14 @@ std::vector<double> defaultRateLimits(const FloatingModel& model) {
 
 ApproachController::ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand,
                                        ApproachSpec spec, FreeRigidMotion target)
+    : ApproachController(std::move(model), hand, std::move(spec),
+                         std::make_shared<RigidApproachTarget>(std::move(target))) {}
+
+ApproachController::ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand,
+                                       ApproachSpec spec, std::shared_ptr<ApproachTarget> target)
     : model_(std::move(model)), hand_(hand), spec_(std::move(spec)), target_(std::move(target)),
       solver_(model_ ? model_ : throw ModelError("ApproachController: null model")) {
+  if (!target_) refuse("null target");
   const unsigned int n = model_->nj();
   if (hand_.body < 0 || hand_.body >= static_cast<int>(model_->bodies().size())) refuse("the hand is no body of the model");
   if (!allFinite(hand_.offset) || !allFinite(spec_.grasp)) refuse("the hand offset and the grasp frame must be finite");
@@ -53,14 +59,12 @@ ApproachController::ApproachController(std::shared_ptr<const FloatingModel> mode
 }
 
 int ApproachController::grasp(double t, KDL::Frame& frame, Vector6d& twist) {
-  RigidTarget b;
-  if (const int rc = target_.at(t, b)) return rc;
-  const KDL::Frame g = b.pose * spec_.grasp;
-  const Vector3d c = toEigen(b.pose * toKDL(b.com));
-  const Vector3d w = b.twist.tail<3>();
-  twist << b.twist.head<3>() + w.cross(toEigen(g.p) - c), w;  // the grasp point's velocity
-  frame = g;
-  return E_NOERROR;
+  return target_->grasp(t, spec_.grasp, frame, twist);
+}
+
+int ApproachController::target(double t, RigidTarget& out) {
+  auto* rigid = dynamic_cast<RigidApproachTarget*>(target_.get());
+  return rigid ? rigid->at(t, out) : E_BAD_ARGUMENT;
 }
 
 int ApproachController::command(const SimulationState& s, ApproachCommand& out) {

@@ -58,7 +58,9 @@ KDL_SPACE_EXPORT double estimatedOutputRows(const Scenario& scenario, const Oper
 /// What the approach did.
 struct ApproachOutcome {
   ApproachRecord record;
-  RigidTarget target_at_contact;  ///< the target at the end of the approach
+  /// A rigid target at the end of the approach (a free-floating robot target's state then is
+  /// OperationResult::at_contact.target; this stays default).
+  RigidTarget target_at_contact;
   /// The warnings about the pose it started from (approachStartWarnings), found before it ran.
   std::vector<Diagnostic> start_warnings = {};
 };

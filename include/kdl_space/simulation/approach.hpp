@@ -10,6 +10,7 @@
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/simulation/approach_target.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
@@ -67,13 +68,19 @@ class KDL_SPACE_EXPORT ApproachController {
   /// size or not > 0.
   ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand, ApproachSpec spec,
                      FreeRigidMotion target);
+  /// Any target's motion (a rigid one, a free-floating robot integrated beside the servicer):
+  /// spec.grasp is in the frame its grasp() takes it in. 	hrows as above, and for a null target.
+  ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand, ApproachSpec spec,
+                     std::shared_ptr<ApproachTarget> target);
   const ApproachSpec& spec() const { return spec_; }
   /// The grasp frame and the twist (v of the grasp point; w) at time t.
   int grasp(double t, KDL::Frame& frame, Vector6d& twist);
   /// The commanded joint rates at s (and what they came from).
   int command(const SimulationState& s, ApproachCommand& out);
-  /// The target's state at time t.
-  int target(double t, RigidTarget& out) { return target_.at(t, out); }
+  /// A rigid target's state at time t (E_BAD_ARGUMENT for another target: see targetMotion()).
+  int target(double t, RigidTarget& out);
+  /// The target's motion the controller tracks.
+  ApproachTarget& targetMotion() { return *target_; }
   /// A grounded base (held still): the fixed-base J and no drift instead of J* and the momentum's
   /// term (runApproach sets it from the simulator's options); the reaction null space does nothing.
   void setGrounded(bool grounded) { grounded_ = grounded; }
@@ -82,7 +89,7 @@ class KDL_SPACE_EXPORT ApproachController {
   std::shared_ptr<const FloatingModel> model_;
   Contact hand_;
   ApproachSpec spec_;
-  FreeRigidMotion target_;
+  std::shared_ptr<ApproachTarget> target_;
   FreeFloatingSolver solver_;
   KDL::Jacobian J_, J_base_;
   bool grounded_ = false;

@@ -254,6 +254,46 @@ ImpactLaw law(const Field& f, bool& has_normal) {
   return l;
 }
 
+// --- The approach of a free-floating robot target (issue 28) -----------------------------------
+
+/// `approach` for a free-floating robot target: the grasp frame in the frame of the target's
+/// contact link (target.contact.link), its origin the contact point (target.contact.offset: the
+/// capture joins the two contact points, which must touch within the capture's touch tolerance,
+/// so the position tolerance is that tolerance unless a smaller one is given).
+ApproachSpec robotTargetApproach(const Field& approach, const Field& target, const CaptureProblem& capture) {
+  const FloatingSystem& t = std::get<FloatingSystem>(capture.target);
+  if (target.has("place"))
+    target.at("place").fail("puts the target's contact at the robot's hand before anything moves, so the approach "
+                            "would have nothing to reach: remove target.place, or the approach section");
+  const KDL::Vector offset = t.contact.offset;
+  ApproachSpec a = sections::approach(approach, *capture.robot.model, &offset);
+  const Field grasp = approach.at("grasp");
+  if (grasp.has("position") && !((a.grasp.p - offset).Norm() <= 1e-9))
+    grasp.at("position").fail("is where the hand grasps the target, in the frame of target.contact.link '" +
+                              t.model->bodies()[t.contact.body].name +
+                              "': it must be the target's contact point target.contact.offset [" + number(offset.x()) + ", " +
+                              number(offset.y()) + ", " + number(offset.z()) + "]" +
+                              " (the capture joins the two contact points): leave it out or give that");
+  const double touch = capture.touch_tolerance;
+  const bool given = approach.has("tolerance") && approach.at("tolerance").has("position");
+  if (!given) a.position_tolerance = touch;
+  else if (a.position_tolerance > touch)
+    approach.at("tolerance").at("position").fail(
+        "must be at most " + number(touch) + " m for a robot target: the capture joins the hand to the target's "
+        "contact point, which must touch within " + number(touch) + " m, got " + number(a.position_tolerance));
+  return a;
+}
+
+/// The grasp frame (in the contact link's frame) in the target's base frame at its scenario
+/// state: what the pictures draw (Scenario::grasp_frame).
+KDL::Frame graspInBaseFrame(const FloatingSystem& t, const KDL::Frame& grasp) {
+  Kinematics kin(*t.model);
+  if (forwardKinematics(*t.model, t.state, kin) != E_NOERROR) return grasp;  // the state is checked elsewhere
+  return t.state.world_T_base.Inverse() * kin.pose(t.contact.body) * grasp;
+}
+
+// -------------------------------------------------------------------------------------------------
+
 }  // namespace
 
 Scenario loadScenario(const std::string& path) {
@@ -312,10 +352,13 @@ Scenario loadScenario(const std::string& path) {
   if (top.has("approach")) {
     const Field approach = top.at("approach");
     if (!s.impact) approach.fail("an approach reaches a target: give target and law too");
-    if (std::holds_alternative<FloatingSystem>(s.capture.target))
-      approach.fail("the target is a free-floating system (target.urdf): the approach tracks a rigid target only");
-    s.approach = sections::approach(approach, *s.capture.robot.model);
-    s.grasp_frame = s.approach->grasp;
+    if (const auto* floating = std::get_if<FloatingSystem>(&s.capture.target)) {
+      s.approach = robotTargetApproach(approach, top.at("target"), s.capture);
+      s.grasp_frame = graspInBaseFrame(*floating, s.approach->grasp);
+    } else {
+      s.approach = sections::approach(approach, *s.capture.robot.model);
+      s.grasp_frame = s.approach->grasp;
+    }
   }
   if (top.has("simulation")) {
     const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);

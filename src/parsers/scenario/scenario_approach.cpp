@@ -11,7 +11,7 @@ using detail::number;
 using fields::echo;
 using fields::Field;
 
-ApproachSpec approach(const Field& f, const FloatingModel& robot) {
+ApproachSpec approach(const Field& f, const FloatingModel& robot, const KDL::Vector* grasp_position) {
   f.onlyKeys({"grasp", "track", "gain", "damping", "singular_threshold", "rate_limits", "servo_bandwidth", "null_space",
               "tolerance", "max_duration"});
   ApproachSpec a;
@@ -22,7 +22,8 @@ ApproachSpec approach(const Field& f, const FloatingModel& robot) {
   };
   const Field grasp = f.at("grasp");  // required: in the target's frame
   grasp.onlyKeys({"position", "rpy"});
-  const Eigen::VectorXd p = grasp.at("position").vector(3);
+  const Eigen::VectorXd p = grasp_position && !grasp.has("position") ? Eigen::VectorXd(toEigen(*grasp_position))
+                                                                      : grasp.at("position").vector(3);
   const Eigen::VectorXd r = grasp.has("rpy") ? grasp.at("rpy").vector(3) : Eigen::VectorXd::Zero(3);
   a.grasp = KDL::Frame(KDL::Rotation::RPY(r(0), r(1), r(2)), KDL::Vector(p(0), p(1), p(2)));
   if (f.has("track")) {

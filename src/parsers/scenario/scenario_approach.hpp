@@ -8,6 +8,7 @@
 namespace kdl_space::sections {
 
 /// Reads and checks the `approach` section for the robot `robot`; InputError naming the field.
-ApproachSpec approach(const fields::Field& f, const FloatingModel& robot);
+/// `grasp_position`: where approach.grasp.position is when omitted (none: it is required).
+ApproachSpec approach(const fields::Field& f, const FloatingModel& robot, const KDL::Vector* grasp_position = nullptr);
 
 }  // namespace kdl_space::sections

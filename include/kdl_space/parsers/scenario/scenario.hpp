@@ -55,7 +55,9 @@ struct Scenario {
   bool impact = true;
   CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
   /// The `approach` section: the robot starts from its initial state, reaches the grasp point on
-  /// the moving (rigid) target, and the law applies at the contact instant, from the states then.
+  /// the moving target, and the law applies at the contact instant, from the states then. For a
+  /// free-floating robot target its `grasp` is in the frame of target.contact's link, its origin
+  /// the contact point, and its position tolerance at most the capture's touch tolerance.
   std::optional<ApproachSpec> approach;
   SimulationSpec simulation;
   /// `robot.place: grasp`: the inverse kinematics that put the robot's contact frame at the
@@ -64,7 +66,8 @@ struct Scenario {
   std::optional<IkResult> grasp_solution;
   /// The grasp frame in the target's frame (a rigid target's `pose` frame, a free-floating
   /// target's base frame): `robot.grasp.target_frame` with `robot.place: grasp`, or
-  /// `approach.grasp`; unset without either (what the pictures draw as the grasp frame).
+  /// `approach.grasp` (a robot target's: its contact link's pose in its base frame at the
+  /// scenario's state, times the grasp); unset without either (what the pictures draw as the grasp frame).
   std::optional<KDL::Frame> grasp_frame;
 };
 
