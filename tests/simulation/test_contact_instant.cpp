@@ -103,29 +103,43 @@ TEST(StopEvent, MetAtTheStartEndsTheRunThere) {
 
 // RK4 with steps of 0.05 s: the steps end at 1.0 and 1.05 s; the crossing at 1.01 s and the hard
 // stop at 1.04 s fall in the same step. The stop is located first (afterStep); the event, earlier,
-// ends the run before the impact: the joint still turns and no impact is counted.
+// ends the run before the impact: the joint still moves and no impact is counted. A constant
+// torque accelerates the joint (q = q0 + w t + a t^2 / 2, which RK4 integrates exactly), so the
+// step retaken with the joint held at the stop would put the crossing elsewhere.
 TEST(StopEvent, EarlierThanAHardStopInTheSameStepWins) {
-  const TurningJoint c(0.1 + 0.4 * 1.04);
-  const double q_c = 0.1 + 0.4 * 1.01;
+  const double torque = 2.0;
+  const TurningJoint probe;
+  Simulator inertia(probe.model, probe.options(Integrator::RK4));
+  probe.setUp(inertia);
+  double m = 0.0;
+  ASSERT_EQ(inertia.apparentInertia(probe.initial(), 0, m), E_NOERROR);
+  const double a = torque / m;
+  const auto q = [&](double t) { return probe.q0 + probe.w * t + 0.5 * a * t * t; };
+  const TurningJoint c(q(1.04));
+  const double q_c = q(1.01);
+  const auto pushed = [&](Simulator& sim) {
+    c.setUp(sim);
+    sim.setLimitMode(0, LimitMode::Stop);
+    sim.setTorqueCallback([&](const SimulationState&, KDL::JntArray& tau) { tau(0) = torque; });
+  };
   Simulator sim(c.model, c.options(Integrator::RK4));
-  c.setUp(sim);
-  sim.setLimitMode(0, LimitMode::Stop);
+  pushed(sim);
   sim.setStopEvent([&](const SimulationState& x) { return q_c - x.state.q(0); });
   SimulationState s = c.initial();
   ASSERT_EQ(sim.run(s, 5.0, 0.25, nullptr), E_NOERROR);
   EXPECT_NEAR(s.t, 1.01, 1e-9);
   EXPECT_NEAR(s.state.q(0), q_c, 1e-9);
-  EXPECT_EQ(s.velocity.qdot(0), c.w) << "not stopped: the impact comes later";
+  EXPECT_NEAR(s.velocity.qdot(0), c.w + a * 1.01, 1e-9) << "not stopped: the impact comes later";
   EXPECT_EQ(sim.stats().joints[0].stops, 0);
   EXPECT_EQ(s.work.limits, 0.0);
   // The stop alone: it is met at 1.04 s (the same run without the event).
   Simulator plain(c.model, c.options(Integrator::RK4));
-  c.setUp(plain);
-  plain.setLimitMode(0, LimitMode::Stop);
+  pushed(plain);
   SimulationState p = c.initial();
   ASSERT_EQ(plain.run(p, 1.05, 0.25, nullptr), E_NOERROR);
   EXPECT_EQ(plain.stats().joints[0].stops, 1);
   EXPECT_EQ(p.velocity.qdot(0), 0.0);
+  EXPECT_NEAR(p.state.q(0), q(1.04), 1e-10);
 }
 
 // g <= 0 made by the stop's impulse itself (the joint's rate falls to 0 at the stop): the run ends
