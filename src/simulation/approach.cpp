@@ -134,6 +134,19 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   return E_NOERROR;
 }
 
+namespace {
+/// The contact condition as one number: the largest of the margins of the rows in use, each
+/// normalised by its tolerance (distance / tol - 1; the angle's when the orientation is tracked;
+/// the relative speed's when its tolerance is finite). <= 0 exactly when all hold; continuous in
+/// the state, so its first crossing of 0 is the first instant the condition holds.
+double contactMargin(const ApproachSpec& spec, const ApproachCommand& c) {
+  double g = c.error.head<3>().norm() / spec.position_tolerance - 1.0;
+  if (spec.orientation) g = std::max(g, c.error.tail<3>().norm() / spec.orientation_tolerance - 1.0);
+  if (std::isfinite(spec.speed_tolerance)) g = std::max(g, c.relative_speed / spec.speed_tolerance - 1.0);
+  return g;
+}
+}  // namespace
+
 int runApproach(Simulator& sim, ApproachController& controller, SimulationState& s, double output_dt,
                 const std::function<void(const SimulationState&, const ApproachCommand&)>& observer,
                 ApproachRecord& record) {
@@ -149,18 +162,14 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
   }
   controller.setGrounded(sim.options().grounded);
   const KDL::Rotation base_start = s.state.world_T_base.M;
-  ApproachCommand stage, sample;
+  ApproachCommand stage, sample, probe;
   int failure = E_NOERROR;
   sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
     if (const int rc = controller.command(x, stage)) throw CommandFailed{rc};
     for (unsigned int j = 0; j < n; ++j) tau(j) += rec.kv[j] * (stage.qdot(j) - x.velocity.qdot(j));
   });
-  bool reached = false;
   const auto watch = [&](const SimulationState& x) {
-    if ((failure = controller.command(x, sample))) {
-      reached = true;  // stops the run: the failure is returned below
-      return;
-    }
+    if ((failure = controller.command(x, sample))) return;  // stops the run: returned below
     const double distance = sample.error.head<3>().norm(), angle = sample.error.tail<3>().norm();
     if (distance < rec.closest_distance) {
       rec.closest_distance = distance;
@@ -172,10 +181,14 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
     rec.max_damping = std::max(rec.max_damping, sample.damping);
     rec.min_scale = std::min(rec.min_scale, sample.scale);
     if (observer) observer(x, sample);
-    reached = distance <= spec.position_tolerance && (!spec.orientation || angle <= spec.orientation_tolerance) &&
-              sample.relative_speed <= spec.speed_tolerance;
   };
-  sim.setStopCondition([&](const SimulationState&) { return reached; });
+  sim.setStopCondition([&](const SimulationState&) { return failure != E_NOERROR; });
+  // The contact instant located between the steps (the simulator's stop event): the run ends
+  // there and its last output, the capture's state, is that instant.
+  sim.setStopEvent([&](const SimulationState& x) {
+    if (const int rc = controller.command(x, probe)) throw CommandFailed{rc};
+    return contactMargin(spec, probe);
+  });
   const double t0 = s.t;
   int rc = E_NOERROR;
   try {
@@ -185,12 +198,14 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
   } catch (...) {
     sim.setTorqueCallback({});
     sim.setStopCondition({});
+    sim.setStopEvent({});
     throw;
   }
   sim.setTorqueCallback({});
   sim.setStopCondition({});
+  sim.setStopEvent({});
   if (rc == E_NOERROR) rc = failure;
-  rec.reached = reached && failure == E_NOERROR;
+  rec.reached = rc == E_NOERROR && std::isfinite(sim.stats().event_time);
   if (rec.reached) rec.t_contact = s.t;
   rec.duration = s.t - t0;
   rec.base_rotation = (s.state.world_T_base.M * base_start.Inverse()).GetRot().Norm();

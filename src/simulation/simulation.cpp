@@ -32,6 +32,8 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   controls_.assign(n, JointControl{});
   limit_modes_.assign(n, LimitMode::Warn);
   at_stop_.assign(n, false);
+  at_stop_before_.assign(n, false);
+  at_stop_after_.assign(n, false);
   just_stopped_.assign(n, false);
   locked_now_.assign(n, false);
   saturated_.assign(n, false);
@@ -52,6 +54,7 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   x_new_.setZero(size);
   x_prev_.setZero(size);
   x_event_.setZero(size);
+  x_located_.setZero(size);
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   if (!positive(options_.step) || !positive(options_.rtol) || !positive(options_.atol) ||
       !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity) || !positive(options_.friction_rate))
@@ -258,6 +261,7 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   stats_.min_step = kInf;
   stats_.max_step = 0.0;
   stats_.base_saturation_time = 0.0;
+  stats_.event_time = std::numeric_limits<double>::quiet_NaN();
   std::fill(stats_.joints.begin(), stats_.joints.end(), JointRecord{});
   if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
   if (!std::isfinite(t_end) || !std::isfinite(s.t) || std::isnan(output_dt)) return E_NOT_FINITE;
@@ -277,6 +281,13 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   if (const int rc = publish(x, s.t, s)) return rc;
   if (observer) observer(s);
   if (stop_ && stop_(s)) return E_NOERROR;
+  if (event_) {  // the located stop: met at the start, the run ends there
+    event_start_ = event_(s);
+    if (event_start_ <= 0.0) {
+      stats_.event_time = s.t;
+      return E_NOERROR;
+    }
+  }
 
   // RK4 takes `step` as given; max_step bounds only the adaptive methods.
   const bool adaptive = stepper_->adaptive();
@@ -301,6 +312,7 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
     const bool lands = t_next - t <= h * (1.0 + 1e-9);
     const double h_try = lands ? t_next - t : h;
     x_prev_ = x;
+    std::copy(at_stop_.begin(), at_stop_.end(), at_stop_before_.begin());  // the step's locks (stop event)
     double error = 0.0;
     bool trial_failed = false;
     if (const int rc = step(t, h_try, x, x_new_, error, trial_failed)) {
@@ -322,15 +334,23 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
     x.segment<4>(3).normalize();  // the orientation stays a unit quaternion
     double t_new = lands ? t_next : t + h_try;
     if (const int rc = afterStep(t, h_try, x_prev_, t_new, x)) return failed(rc);
+    bool event = false;  // the located stop: t_new and x moved back to it
+    if (event_)
+      if (const int rc = stopEvent(t, x_prev_, t_new, x, event)) return failed(rc);
     const double taken = t_new - t;
-    if (!lands || stats_.accepted_steps == 1) {  // an output's sliver step says nothing of the motion
+    // An output's (or the stop event's) sliver step says nothing of the motion.
+    if ((!lands && !event) || stats_.accepted_steps == 1) {
       stats_.min_step = std::min(stats_.min_step, taken);
       stats_.max_step = std::max(stats_.max_step, taken);
     }
     t = t_new;
-    if (t == t_out) {
+    if (t == t_out || event) {
       if (const int rc = publish(x, t, s)) return failed(rc);
       if (observer) observer(s);
+      if (event) {
+        stats_.event_time = t;
+        break;
+      }
       ++outputs;
       if (stop_ && stop_(s)) break;
     }

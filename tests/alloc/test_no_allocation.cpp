@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 
@@ -350,6 +351,33 @@ TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
       ASSERT_EQ(sim.run(s, 0.05, 0.01, watch), E_NOERROR);                  // warm-up
       EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, s.t + 0.2, 0.05, watch), E_NOERROR); }), 0);
     }
+}
+
+TEST_P(EveryComputeCall, SimulatorStopEventAllocatesNothing) {
+  // The stop event located inside a step (retaken steps, the Illinois iterations): nothing allocated.
+  const auto model = load(GetParam());
+  std::mt19937 rng(8);
+  for (Integrator integrator : {Integrator::RK4, Integrator::DormandPrince54, Integrator::Rosenbrock}) {
+    SCOPED_TRACE(static_cast<int>(integrator));
+    SimulationOptions options;
+    options.integrator = integrator;
+    options.step = 0.01;
+    Simulator sim(model, options);
+    sim.setJointControl(0, JointControl{JointControl::Mode::PD, 10.0, 5.0, 0.2});
+    SimulationState s;
+    s.state = randomState(*model, rng);
+    s.velocity.qdot = KDL::JntArray(model->nj());
+    const std::function<void(const SimulationState&)> watch = [](const SimulationState&) {};
+    // Crossed at 0.0334 s, between the outputs; not linear in time (several iterations).
+    sim.setStopEvent([](const SimulationState& x) { return std::cos(50.0 * x.t) - std::cos(1.67); });
+    SimulationState warm = s;
+    ASSERT_EQ(sim.run(warm, 0.5, 0.01, watch), E_NOERROR);  // warm-up
+    EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(warm, 0.5, 0.01, nullptr), E_NOERROR); }), 0) << "at the start";
+    EXPECT_EQ(warm.t, sim.stats().event_time);
+    s.tau = warm.tau;  // run() sizes its output once
+    EXPECT_EQ(allocationsDuring([&] { EXPECT_EQ(sim.run(s, 0.5, 0.01, watch), E_NOERROR); }), 0);
+    EXPECT_NEAR(sim.stats().event_time, 0.0334, 1e-9);
+  }
 }
 
 TEST_P(EveryComputeCall, SampledControllerCallsAllocateNothing) {

@@ -98,9 +98,10 @@ class KDL_SPACE_EXPORT ApproachController {
 /// What an approach did.
 struct ApproachRecord {
   bool reached = false;
-  double t_contact = std::numeric_limits<double>::quiet_NaN();  ///< when the contact condition held
+  /// The first instant the contact condition held, located between the steps (within 1e-10 s)
+  double t_contact = std::numeric_limits<double>::quiet_NaN();
   double duration = 0.0;               ///< of the approach [s]
-  double closest_distance = std::numeric_limits<double>::infinity();  ///< [m], over the output samples
+  double closest_distance = std::numeric_limits<double>::infinity();  ///< [m], over the output samples and the contact
   double closest_time = 0.0;
   double final_distance = 0.0, final_angle = 0.0;  ///< at the end of the approach [m, rad]
   double min_sigma = std::numeric_limits<double>::infinity();  ///< smallest singular value of J* met
@@ -111,9 +112,15 @@ struct ApproachRecord {
 };
 
 /// \brief Runs the approach: the joints velocity-servoed to the controller's command (a torque
-/// callback on `sim`, with its effort limits), from s until the contact condition holds at an
-/// output sample (every output_dt) or spec().max_duration has passed. s is left at the contact
-/// instant (or the end). `observer` sees every output sample with the controller's command.
+/// callback on `sim`, with its effort limits), from s until the contact condition holds or
+/// spec().max_duration has passed. The contact instant is the first time the condition holds,
+/// located between the steps (Simulator::setStopEvent on the largest of the margins
+/// distance / position_tolerance - 1, angle / orientation_tolerance - 1 when the orientation is
+/// tracked, relative speed / speed_tolerance - 1 when that is finite): within 1e-10 s of the true
+/// crossing plus the integration error, not at the next output sample. s is left at the contact
+/// instant (or the end), where the condition holds. `observer` sees every output sample with the
+/// controller's command, and the contact instant as the last one. (The simulator's stop condition
+/// and stop event are set for the run and cleared after it.)
 /// \return 0 (reached or not: see record.reached) or the simulator's code.
 KDL_SPACE_EXPORT int runApproach(Simulator& sim, ApproachController& controller, SimulationState& s, double output_dt,
                                  const std::function<void(const SimulationState&, const ApproachCommand&)>& observer,
