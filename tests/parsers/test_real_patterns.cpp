@@ -9,7 +9,13 @@
 //    KDL six-virtual-joint route (virtual_joint_route.hpp) and the twin file's (the same robot
 //    written the unremarkable way) at random configurations;
 //  - over every file that loads and over random trees with massless roots and point masses, the
-//    compute calls return 0 and their results are finite.
+//    compute calls return 0 and their results are finite;
+//  - files as written (issue 28): zero mass with a rotational inertia (on the base, on fixed
+//    frames, on fingers), tiny fixed links whose inertias fail alone while their rigid body
+//    passes: they load with warnings, and their dynamics (H*, G*, KDL's full mass matrix) equal
+//    those of twins written by hand to 1e-12; a massless base loads when its links supply the mass
+//    (KDL's mass matrix positive definite), and singular systems are refused by loader and checker
+//    alike with the rule's kind.
 //
 // Tolerances: G* 1e-9 relative to its norm (the routes sum in different orders); the massless
 // world root against its twin 1e-12 (the composite base is the same rigid body, only re-expressed).
