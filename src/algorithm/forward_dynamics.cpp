@@ -114,7 +114,7 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
         b.a = parent.a;
       }
     }
-    if (b.mass > 0.0) {  // else a frame: no inertia
+    if (b.mass > 0.0 || !kin.I_com[i].isZero(0.0)) {  // else a frame: no inertia (issue 28: zero mass, inertia kept)
       const Vector3d c = kin.com[i] - p_b;
       const Matrix3d& I_c = kin.I_com[i];
       b.IA.setRigidBody(b.mass, c, I_c);

@@ -41,7 +41,7 @@ KDL_SPACE_MULTIVERSION void MomentumSolver::sweep(const Kinematics& kin, const V
     }
     detail::store3(v, V_[i].data());
     detail::store3(w, V_[i].data() + 3);
-    if (!(b.mass > 0.0)) continue;  // a frame-only link
+    if (!(b.mass > 0.0) && kin.I_com[i].isZero(0.0)) continue;  // a frame-only link (issue 28: zero mass, inertia kept)
     const Lanes r = detail::lanes(kin.com[i]) - base;
     const Lanes v_c = v + detail::cross(w, r);  // CoM velocity
     const Lanes P = b.mass * v_c;

@@ -13,11 +13,13 @@ struct LaneSymmetric6d {
   LaneMatrix A11, A12, A21, A22;
 
   /// The spatial inertia of a rigid body: mass m, CoM at c relative to the reference point,
-  /// inertia I_c about the CoM: [[m E, -m c^], [m c^, I_c - m c^ c^]] (zero for a massless frame).
+  /// inertia I_c about the CoM: [[m E, -m c^], [m c^, I_c - m c^ c^]] (zero for a massless frame; I_c alone
+  /// for a body with a rotational inertia but no mass).
   void setRigidBody(double m, const Vector3d& c, const Matrix3d& I_c) {
-    if (!(m > 0.0)) {
+    if (!(m > 0.0)) {  // no mass: its rotational inertia alone (zero for a frame)
       const Lanes zero{0.0, 0.0, 0.0, 0.0};
-      A11 = A12 = A21 = A22 = {{zero, zero, zero}};
+      A11 = A12 = A21 = {{zero, zero, zero}};
+      A22 = lanes(I_c);
       return;
     }
     const double x = m * c.x(), y = m * c.y(), z = m * c.z(), mc2 = m * c.squaredNorm();

@@ -39,6 +39,15 @@ std::vector<ReadLink> readLinks(const KDL::Tree& tree, const KDL::RigidBodyInert
     link.body.parent = link.node.parent = parent;
     detail::splitInertia(parent < 0 ? base_inertia : segment.getInertia(), link.body);
     link.node.mass = link.body.mass;
+    link.node.rotational = !link.body.I_com.isZero(0.0);
+    link.node.inertia_known = true;
+    link.node.com = link.body.com;
+    link.node.I_com = link.body.I_com;
+    if (parent >= 0) {  // the fixed pose (a movable joint's at q = 0 is not used by the rules)
+      const KDL::Frame pose = segment.pose(0.0);
+      link.node.R = toEigen(pose.M);
+      link.node.p = toEigen(pose.p);
+    }
     if (parent >= 0 && segment.getJoint().getType() != KDL::Joint::None) {
       link.node.joint = segment.getJoint().getName();
       link.node.movable = true;
@@ -89,9 +98,9 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
     rules::checkInertia(l.body.name, l.body.mass, l.body.I_com, findings);
     nodes.push_back(l.node);
   }
-  rules::checkBaseComposite(nodes, findings);
+  rules::checkRigidBodies(nodes, findings);
   rules::checkMassDistribution(nodes, findings);
-  if (const Finding* e = rules::firstError(findings)) throw ModelError(describe(*e));
+  if (const Finding* e = rules::firstError(findings)) throw rules::RuleError(*e);
   // What the dynamics read: a joint that moves no mass is fixed, round-off below zero is zero.
   std::set<std::string> moves_no_mass;
   for (const Finding& f : findings)
@@ -102,7 +111,7 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   std::vector<bool> fixed(links.size(), false), corrected(links.size(), false);
   for (std::size_t i = 0; i < links.size(); ++i) {
     fixed[i] = links[i].node.movable && moves_no_mass.count(links[i].node.joint) > 0;
-    const Matrix3d I = rules::withoutNegativeMoments(links[i].body.I_com);
+    const Matrix3d I = rules::withoutNegativeMoments(links[i].body.mass, links[i].body.I_com);
     corrected[i] = I != links[i].body.I_com;
     links[i].body.I_com = I;
   }
@@ -132,6 +141,7 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
   validate();
+  detail::checkMassMatrix(*this, diagnostics_);
 }
 
 namespace {
@@ -201,7 +211,7 @@ void FloatingModel::checkComposites() {
       if (head[i] != static_cast<int>(h)) continue;
       const Body& b = bodies_[i];
       names.push_back(detail::quoted(b.name));
-      if (!(b.mass > 0.0)) continue;
+      if (!(b.mass > 0.0) && b.I_com.isZero(0.0)) continue;  // a frame
       const Matrix3d R = toEigen(in_head[i].M);
       const Vector3d c = R * b.com + toEigen(in_head[i].p);
       m += b.mass;

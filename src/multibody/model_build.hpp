@@ -4,6 +4,7 @@
 
 #include <kdl/rigidbodyinertia.hpp>
 #include <string>
+#include <vector>
 
 #include "kdl_space/multibody/model.hpp"
 
@@ -18,5 +19,13 @@ void splitInertia(const KDL::RigidBodyInertia& I, Body& body);
 
 /// The KDL inertia of a body's mass, CoM and inertia about the CoM.
 KDL::RigidBodyInertia kdlInertia(const Body& b);
+
+/// \brief The rule on the system's mass matrix, for what the link rules let pass without judging
+/// it: a free-floating base without mass (the links may supply it), and rigid bodies with a
+/// rotational inertia but no mass on movable joints. When the model has either, its mass matrix
+/// (6 + n: the base twist, then the coordinates) at q = 0 must be positive definite: then a note
+/// `massless_base` for a massless base, else RuleError `base_without_mass` (the base's links and
+/// the joints that move with it) or `singular_inertia` (the joints that move no inertia).
+void checkMassMatrix(const FloatingModel& model, std::vector<Diagnostic>& diagnostics);
 
 }  // namespace kdl_space::detail

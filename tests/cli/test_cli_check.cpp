@@ -114,11 +114,42 @@ const std::vector<Case>& cases() {
       {"valid", " --tip gripper", 3,
        {{"unknown_tip", "tip", "gripper", "not a link of the model (its links: 'base', 'upper_arm', 'forearm')"}},
        {}},
+      // A massless base is refused when its mass matrix is singular (one joint turns it freely)...
       {"base_without_mass", "", 3,
        {{"base_without_mass", "link", "base",
-         "the free-floating base has no mass: give this link an <inertial> with its mass and inertia "
-         "(kdl_space reads the root link's <inertial>, which kdl_parser drops)"}},
+         "the free-floating base has no mass, and the links it carries do not supply it: the system's mass "
+         "matrix is singular (the base moves with joint 'shoulder' without moving any mass); give this link an "
+         "<inertial> with its mass and inertia (kdl_space reads the root link's <inertial>, which kdl_parser "
+         "drops)"}},
        {}},
+      // ... and read with a note when the links supply the mass (two arms on different axes).
+      {"massless_base", "", 0, {}, {},
+       {{"massless_base", "link", "base",
+         "the free-floating base has no mass: the links it carries supply it (the system's mass matrix is "
+         "positive definite at q = 0)"}}},
+      // Zero mass with a rotational inertia: read as written, a warning.
+      {"inertia_without_mass", "", 0, {},
+       {{"inertia_without_mass", "link", "camera",
+         "zero mass with a rotational inertia (principal moments 0.0001, 0.0002, 0.0003 kg m^2): read as "
+         "written, a body that resists rotation but not translation (give the link its mass if it has one; no "
+         "<inertial> if it only carries a frame)"}}},
+      // Judged on the rigid body (forearm + sensor), not the link: a warning naming both.
+      {"link_inertia_not_positive_definite", "", 0, {},
+       {{"link_inertia_not_positive_definite", "link", "sensor",
+         "inertia is not positive definite (principal moments -1e-06, 1e-06, 3e-06 kg m^2), but the rigid body "
+         "it forms by fixed joints with 'forearm' (principal moments 0.010001, 0.201596, 0.201596 kg m^2 about "
+         "its CoM) is positive definite: read as written (the dynamics see that rigid body, not the link "
+         "alone)"}}},
+      // A zero-mass body on a prismatic joint: that joint moves no inertia.
+      {"singular_inertia", "", 3,
+       {{"singular_inertia", "joint", "slider",
+         "the system's mass matrix is singular at q = 0: joint 'slider' moves no inertia (the link 'pad' has a "
+         "rotational inertia but no mass); give it its mass, the joint an armature, or no <inertial> to a link "
+         "that only carries a frame (its joint is then treated as fixed)"}},
+       {{"inertia_without_mass", "link", "pad",
+         "zero mass with a rotational inertia (principal moments 0.0001, 0.0001, 0.0001 kg m^2): read as "
+         "written, a body that resists rotation but not translation (give the link its mass if it has one; no "
+         "<inertial> if it only carries a frame)"}}},
       {"root_inertia_dropped_by_kdl_parser", "", 0, {}, {},
        {{"root_inertia_dropped_by_kdl_parser", "link", "base",
          "root link inertia kept as the base body's inertia (kdl_parser drops it: tools built on kdl_parser "
@@ -222,7 +253,9 @@ TEST(CheckTool, EveryFileOfTheCorpusIsTested) {
                            "free_joint_inside", "non_positive_mass", "massless_moving_link",
                            "inertia_not_positive_definite", "triangle_inequality", "not_finite", "zero_axis",
                            "base_without_mass", "root_inertia_dropped_by_kdl_parser", "massless_link",
-                           "axis_not_unit", "limits_exclude_zero", "mass_ratio", "multiple_problems"}) {
+                           "axis_not_unit", "limits_exclude_zero", "mass_ratio", "multiple_problems",
+                           "massless_base", "inertia_without_mass", "link_inertia_not_positive_definite",
+                           "singular_inertia"}) {
     EXPECT_TRUE(std::ifstream(kBroken + name + ".urdf").good()) << name;
     if (std::string(name) != "mass_ratio") EXPECT_TRUE(tested.count(name)) << name;  // mass_ratio: below
   }

@@ -9,7 +9,13 @@
 //    KDL six-virtual-joint route (virtual_joint_route.hpp) and the twin file's (the same robot
 //    written the unremarkable way) at random configurations;
 //  - over every file that loads and over random trees with massless roots and point masses, the
-//    compute calls return 0 and their results are finite.
+//    compute calls return 0 and their results are finite;
+//  - files as written (issue 28): zero mass with a rotational inertia (on the base, on fixed
+//    frames, on fingers), tiny fixed links whose inertias fail alone while their rigid body
+//    passes: they load with warnings, and their dynamics (H*, G*, KDL's full mass matrix) equal
+//    those of twins written by hand to 1e-12; a massless base loads when its links supply the mass
+//    (KDL's mass matrix positive definite), and singular systems are refused by loader and checker
+//    alike with the rule's kind.
 //
 // Tolerances: G* 1e-9 relative to its norm (the routes sum in different orders); the massless
 // world root against its twin 1e-12 (the composite base is the same rigid body, only re-expressed).
@@ -33,6 +39,7 @@
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/algorithm/recursive_ex_iit.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
@@ -140,6 +147,22 @@ std::vector<LoadCase> loadCases() {
        {"End_Effector", "Link_2"}, {}, "revolute_without_limit_twin.urdf"},
       {"revolute_without_limit_twin.urdf", {}, {"End_Effector"}, {}, ""},
       {"xacro_output_with_comments.urdf", {}, {"tool", "shoulder_yaw"}, {}, ""},
+      // Zero mass with a rotational inertia, read as written (issue 28): on the free-floating base
+      // (the arm supplies the mass), on fixed sensor frames, on fingers with revolute joints (which
+      // stay coordinates). Twins written by hand: G* equal to round-off.
+      {"zero_mass_base_inertia.urdf", {{"inertia_without_mass", {"body"}}}, {"tool", "arm_upper", "body"}, {},
+       "zero_mass_base_inertia_twin.urdf", 1e-12},
+      {"zero_mass_base_inertia_twin.urdf", {{"inertia_without_mass", {"body"}}}, {"tool"}, {}, ""},
+      {"zero_mass_inertia_frames.urdf", {{"inertia_without_mass", {"camera_link", "ft_sensor_link"}}},
+       {"ft_sensor_link", "camera_link", "upper_arm", "bus"}, {}, "zero_mass_inertia_frames_twin.urdf", 1e-12},
+      {"zero_mass_inertia_frames_twin.urdf", {}, {"ft_sensor_link"}, {}, ""},
+      {"zero_mass_inertia_fingers.urdf", {{"inertia_without_mass", {"left_finger", "right_finger"}}},
+       {"left_finger", "right_finger", "palm"}, {}, ""},
+      // Tiny fixed links whose inertias fail alone; the hand's rigid body is positive definite.
+      {"tiny_fixed_links_not_positive_definite.urdf",
+       {{"link_inertia_not_positive_definite", {"imu_link", "tool_tip", "hand"}}},
+       {"tool_tip", "imu_link", "hand", "arm"}, {}, "tiny_fixed_links_not_positive_definite_twin.urdf", 1e-12},
+      {"tiny_fixed_links_not_positive_definite_twin.urdf", {}, {"tool_tip"}, {}, ""},
       {"humanoid44.urdf", {},
        {"left_hand_index_finger_tip", "right_hand_thumb_tip", "right_leg_sole", "head_left_camera_optical_frame",
         "left_arm_wrist_ft_sensor_frame", "pelvis"},
@@ -160,7 +183,9 @@ inline void PrintTo(const RefusedCase& c, std::ostream* os) { *os << c.file; }
 std::vector<RefusedCase> refusedCases() {
   return {
       {"unexpanded.urdf.xacro", "xacro", {"xacro", ".urdf"}},
-      {"massless_base_composite.urdf", "base_without_mass", {"world", "mount", "flange"}},
+      // A massless base whose one joint can turn it without moving any mass: singular.
+      {"massless_base_composite.urdf", "base_without_mass",
+       {"world", "mount", "flange", "singular", "base_yaw", "<inertial>"}},
   };
 }
 
@@ -462,6 +487,153 @@ TEST(RealPatterns, XacroMessageSaysToRunXacro) {
   ASSERT_FALSE(report.errors.empty());
   EXPECT_NE(report.errors[0].message.find("xacro "), std::string::npos) << report.errors[0].message;
   EXPECT_NE(report.errors[0].message.find(" > "), std::string::npos) << report.errors[0].message;
+}
+
+// --- Zero mass, massless bases, rigid bodies (issue 28) -------------------------------------------
+
+/// `xml` with `from` replaced by `to` (once; the test fails when `from` is not there).
+std::string edited(std::string xml, const std::string& from, const std::string& to) {
+  const std::size_t at = xml.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? xml : xml.replace(at, from.size(), to);
+}
+
+/// ||a - b|| <= rel ||b|| for H* and M (the full mass matrix), both routes' by KDL.
+TEST(RealPatterns, TwinsWrittenByHandHaveTheSameDynamics) {
+  // The files' twins are the same robots written otherwise by hand (inertias moved and rotated,
+  // rigid bodies merged outside kdl_space): the full mass matrix from KDL's own dynamics (the
+  // virtual-joint route) and H* from the library equal the twin's to round-off.
+  for (const std::string file : {"zero_mass_base_inertia.urdf", "zero_mass_inertia_frames.urdf",
+                                 "tiny_fixed_links_not_positive_definite.urdf"}) {
+    SCOPED_TRACE(file);
+    const std::string twin_file = file.substr(0, file.size() - 5) + "_twin.urdf";
+    const auto model = std::make_shared<const FloatingModel>(loadUrdfFile(corpus(file)));
+    const auto twin = std::make_shared<const FloatingModel>(loadUrdfFile(corpus(twin_file)));
+    ASSERT_EQ(model->jointNames(), twin->jointNames());
+    FreeFloatingSolver solver(model), twin_solver(twin);
+    Route route(model), twin_route(twin);
+    std::mt19937 rng(2800 + static_cast<unsigned>(file.size()));
+    for (int s = 0; s < kStates; ++s) {
+      SCOPED_TRACE("state " + std::to_string(s));
+      const State state = randomState(*model, rng);
+      route.at(state);
+      const State twin_state = twinState(*model, state, route, *twin);
+      twin_route.at(twin_state);
+      ASSERT_EQ(solver.compute(state), E_NOERROR);
+      ASSERT_EQ(twin_solver.compute(twin_state), E_NOERROR);
+      EXPECT_TRUE(closeInNorm(solver.H_star().data, twin_solver.H_star().data, 1e-12, "H* vs the twin's"));
+      const VirtualJointTree a(*model, state), b(*twin, twin_state);
+      EXPECT_TRUE(closeInNorm(a.M_full(), b.M_full(), 1e-12, "KDL's full mass matrix vs the twin's"));
+    }
+  }
+}
+
+TEST(RealPatterns, MasslessBaseIsAllowedWhenTheLinksSupplyTheMass) {
+  // massless_base_composite.urdf is refused: its one joint turns the massless base without moving
+  // any mass. A second arm on the mount, on another axis, leaves no such motion: the mass matrix
+  // is positive definite, and the file loads with a note.
+  const std::string second_arm = R"(
+  <joint name="side_yaw" type="revolute">
+    <parent link="mount"/>
+    <child link="side_arm"/>
+    <origin xyz="0.1 0.1 0.02" rpy="1.2 0 0"/>
+    <axis xyz="0 0 1"/>
+    <limit lower="-2.9" upper="2.9" effort="40" velocity="1.2"/>
+  </joint>
+  <link name="side_arm">
+    <inertial>
+      <origin xyz="0 0 0.1" rpy="0 0 0"/>
+      <mass value="1.1"/>
+      <inertia ixx="0.004" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.001"/>
+    </inertial>
+  </link>
+</robot>)";
+  const std::string xml = edited(readFile(corpus("massless_base_composite.urdf")), "</robot>", second_arm);
+  std::shared_ptr<const FloatingModel> model;
+  try {
+    model = std::make_shared<const FloatingModel>(loadUrdfString(xml, "two_arms.urdf"));
+  } catch (const ModelError& e) {
+    FAIL() << e.what();
+  }
+  const auto note = std::find_if(model->diagnostics().begin(), model->diagnostics().end(),
+                                 [](const Diagnostic& d) { return d.kind == "massless_base"; });
+  ASSERT_NE(note, model->diagnostics().end()) << listed(model->diagnostics());
+  EXPECT_EQ(note->severity, Severity::Note);
+  EXPECT_EQ(note->element, "world");
+  EXPECT_NE(note->message.find("'world', 'mount', 'flange'"), std::string::npos) << note->message;
+  EXPECT_TRUE(modelWarnings(*model).empty()) << listed(modelWarnings(*model));
+  const UrdfReport report = checkUrdfString(xml, "two_arms.urdf");
+  EXPECT_TRUE(report.errors.empty()) << listed(report.errors);
+  EXPECT_EQ(kinds(report.notes).count("massless_base"), 1u) << listed(report.notes);
+
+  // KDL's full mass matrix (the virtual-joint route) is positive definite, and G* the route's.
+  RecursiveExIITSolver recursive(model);
+  FreeFloatingSolver dense(model);
+  Route route(model);
+  std::mt19937 rng(2801);
+  for (int s = 0; s < kStates; ++s) {
+    const State state = randomState(*model, rng);
+    route.at(state);
+    const VirtualJointTree tree(*model, state);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(tree.M_full(), Eigen::EigenvaluesOnly);
+    EXPECT_GT(eig.eigenvalues()(0), 1e-9 * eig.eigenvalues().maxCoeff());
+    ASSERT_EQ(recursive.compute(state), E_NOERROR);
+    ASSERT_EQ(dense.compute(state), E_NOERROR);
+    for (const std::string tip : {"tool", "side_arm", "flange"}) {
+      const LinkPoint point{tip, KDL::Vector(0.02, -0.01, 0.03)};
+      EXPECT_TRUE(closeInNorm(libraryGStar(recursive, dense, *model, point), route.G(point), kRel, "G* at " + tip));
+    }
+  }
+}
+
+/// The loader and the checker refuse `xml` alike: the checker's first error of `kind` on
+/// `element`, with `words`; the loader's message that error's.
+void expectRefusedAlike(const std::string& xml, const std::string& source, const std::string& kind,
+                        const std::string& element, const std::vector<std::string>& words) {
+  const UrdfReport report = checkUrdfString(xml, source);
+  ASSERT_FALSE(report.errors.empty()) << listed(report.warnings);
+  EXPECT_EQ(report.errors[0].kind, kind) << listed(report.errors);
+  EXPECT_EQ(report.errors[0].element, element) << listed(report.errors);
+  for (const std::string& word : words)
+    EXPECT_NE(report.errors[0].message.find(word), std::string::npos) << "'" << word << "' not in: " << report.errors[0].message;
+  try {
+    loadUrdfString(xml, source);
+    ADD_FAILURE() << source << " was loaded";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(std::string(e.what()), source + ": " + describe(report.errors[0]));
+  }
+}
+
+TEST(RealPatterns, SingularSystemsAreRefusedClearly) {
+  // A massless base (a rotational inertia only) with no massive link: nothing supplies the mass
+  // (its joints move no mass and are fixed; the base translates without inertia).
+  std::string xml = readFile(corpus("zero_mass_base_inertia.urdf"));
+  for (const std::string mass : {"0.9", "1.2", "0.7"}) xml = edited(xml, "<mass value=\"" + mass + "\"/>", "<mass value=\"0\"/>");
+  for (const std::string inertia : {R"(ixx="0.0011" ixy="0" ixz="0.0001" iyy="0.0012" iyz="0" izz="0.0008")",
+                                    R"(ixx="0.0009" ixy="0" ixz="0" iyy="0.0071" iyz="0" izz="0.0070")",
+                                    R"(ixx="0.0004" ixy="0" ixz="0" iyy="0.0031" iyz="0" izz="0.0030")"})
+    xml = edited(xml, inertia, R"(ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0")");
+  expectRefusedAlike(xml, "no_massive_link.urdf", "base_without_mass", "body",
+                     {"no mass", "singular", "without moving any mass", "<inertial>"});
+
+  // A finger with a rotational inertia but no mass on a prismatic joint: the joint moves no
+  // inertia (a zero-mass body translating), the mass matrix is singular.
+  std::string prismatic = readFile(corpus("zero_mass_inertia_fingers.urdf"));
+  prismatic = edited(prismatic, R"(<joint name="left_finger_joint" type="revolute">)",
+                     R"(<joint name="left_finger_joint" type="prismatic">)");
+  expectRefusedAlike(prismatic, "prismatic_finger.urdf", "singular_inertia", "left_finger_joint",
+                     {"singular", "'left_finger'", "rotational inertia but no mass", "armature"});
+}
+
+TEST(RealPatterns, ARigidBodyThatFailsIsStillRefused) {
+  // The hand's own inertia made indefinite: the rigid body hand + imu_link + tool_tip then fails
+  // too, and the file is refused, naming the rigid body's links.
+  const std::string xml = edited(readFile(corpus("tiny_fixed_links_not_positive_definite.urdf")),
+                                 R"(<inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.001"/>)",
+                                 R"(<inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="-0.001"/>)");
+  expectRefusedAlike(xml, "indefinite_hand.urdf", "inertia_not_positive_definite", "hand",
+                     {"not positive definite", "nor is the rigid body it forms by fixed joints with 'imu_link', 'tool_tip'",
+                      "check the signs"});
 }
 
 // --- Properties ----------------------------------------------------------------------------------

@@ -82,10 +82,13 @@ class KDL_SPACE_EXPORT FloatingModel {
   /// \brief Builds the model from a KDL tree whose root segment is the base, plus the base
   /// body's inertia (in the base frame, as KDL segments hold theirs).
   ///
-  /// The rigid bodies of the dynamics are composites (a link and every link fixed to it): the
-  /// base composite needs mass, links may be point masses or massless frames. A movable joint
-  /// that moves only massless links and has no armature is fixed at q = 0 (fixedJoints()); an
-  /// inertia negative within round-off is read with that moment 0. Each is a diagnostic.
+  /// The rigid bodies of the dynamics are composites (a link and every link fixed to it): their
+  /// inertias must be positive semidefinite (a link's alone need not be); links may be point
+  /// masses, massless frames, or bodies with a rotational inertia but no mass. A massless base
+  /// composite is allowed when the system's mass matrix at q = 0 is positive definite (the links
+  /// supply the mass). A movable joint that moves only massless links without inertia and has no
+  /// armature is fixed at q = 0 (fixedJoints()); an inertia negative within round-off is read
+  /// with that moment 0. Each is a diagnostic.
   /// \param armature optional rotor inertia per joint of `tree` (its q_nr order), added to H's
   /// diagonal; kept for the joints that stay coordinates.
   /// \throws ModelError naming the link or joint when the model cannot be used.

@@ -181,17 +181,23 @@ void Checker::checkTree() {
       node.link = link.name;
       node.parent = step.parent_step;
       node.mass = link.has_inertial ? link.mass : 0.0;
+      node.rotational = link.inertia_read && !link.I_com.isZero(0.0);
+      node.inertia_known = link.inertia_read;
+      node.com = link.com;
+      node.I_com = link.I_com;
       bool moves = false;
       if (step.parent_step >= 0) {
         const detail::XmlJoint& joint = doc_.joints[step.joint];
         node.joint = joint.name;
         node.movable = joint.known_type && rules::isMovable(joint.type);
+        node.R = joint.R;
+        node.p = joint.p;
         moves = node.movable || moving[step.parent_step];
       }
       nodes.push_back(node);
       moving.push_back(moves);
     }
-    rules::checkBaseComposite(nodes, found);
+    rules::checkRigidBodies(nodes, found);
     rules::checkMassDistribution(nodes, found);
     if (const int deep = detail::firstDeeperThan(below, rules::kMaxTreeDepth); deep >= 0)  // the first is enough
       rules::checkDepth(nodes[deep].link, below.steps[deep].depth, found);
@@ -201,6 +207,16 @@ void Checker::checkTree() {
         lightest_ = below.steps[i].link;
         lightest_fixed_ = !nodes[i].movable;
       }
+  } else {  // no tree, so no rigid bodies: each link's inertia is judged alone
+    for (const detail::XmlLink& link : doc_.links) {
+      rules::MassNode node;
+      node.link = link.name;
+      node.mass = link.mass;
+      node.inertia_known = link.inertia_read;
+      node.com = link.com;
+      node.I_com = link.I_com;
+      rules::checkRigidBodies({node}, found);
+    }
   }
   addAll(found);
 }

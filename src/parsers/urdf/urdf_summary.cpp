@@ -23,6 +23,8 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     for (const Diagnostic& d : model->diagnostics())
       if (d.kind == "singular_composite")
         report.warnings.push_back(rules::warning(d.kind, ElementType::Link, d.element, d.message));
+      else if (d.kind == "massless_base")  // the mass matrix's rule, the model's alone
+        report.notes.push_back(rules::note(d.kind, ElementType::Link, d.element, d.message));
     summary.base = model->bodies()[0].name;
     summary.joint_names = model->jointNames();
     summary.joint_properties = model->jointProperties();
@@ -62,6 +64,9 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     for (std::size_t i = 0; i < summary.condition_G_star.size(); ++i)
       conditions += (i == 0 ? ", cond(G*) = " : ", ") + rules::number(summary.condition_G_star[i].second) + " at " +
                     detail::quoted(summary.condition_G_star[i].first);
+  } catch (const rules::RuleError& e) {
+    // A rule only the model can judge (its mass matrix), in the rule's own kind.
+    report.errors.push_back(e.finding());
   } catch (const std::exception& e) {
     // The loader applies the same rules: whatever it still refuses, say it in its words.
     std::string why = e.what();

@@ -2,7 +2,7 @@
 
 #include <tinyxml.h>
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cctype>
 #include <limits>
 #include <map>
@@ -54,7 +54,9 @@ class Reader {
   }
   bool readRequired(const TiXmlElement* e, const std::vector<const char*>& attributes, const Owner& owner,
                     const std::string& path);
-  void readPose(const TiXmlElement* parent, const Owner& owner, const std::string& path);
+  /// Reads an <origin> (reported as readNumbers does); its pose into R and p when given.
+  void readPose(const TiXmlElement* parent, const Owner& owner, const std::string& path,
+                Eigen::Matrix3d* R = nullptr, Eigen::Vector3d* p = nullptr);
   void readMaterial(const TiXmlElement* e, const Owner& owner, const std::string& path, bool robot_level);
   void readShape(const TiXmlElement* geometry, const Owner& owner, const std::string& path);
   void readLink(const TiXmlElement* e);
@@ -126,12 +128,16 @@ bool Reader::readRequired(const TiXmlElement* e, const std::vector<const char*>&
   return false;
 }
 
-void Reader::readPose(const TiXmlElement* parent, const Owner& owner, const std::string& path) {
+void Reader::readPose(const TiXmlElement* parent, const Owner& owner, const std::string& path, Eigen::Matrix3d* R,
+                      Eigen::Vector3d* p) {
   const TiXmlElement* origin = parent->FirstChildElement("origin");
   if (!origin) return;
-  double v[3];
-  if (origin->Attribute("xyz")) readNumbers(origin, "xyz", 3, owner, path + "<origin", v);
-  if (origin->Attribute("rpy")) readNumbers(origin, "rpy", 3, owner, path + "<origin", v);
+  double xyz[3] = {0.0, 0.0, 0.0}, rpy[3] = {0.0, 0.0, 0.0};
+  if (origin->Attribute("xyz") && readNumbers(origin, "xyz", 3, owner, path + "<origin", xyz) && p)
+    *p = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+  if (origin->Attribute("rpy") && readNumbers(origin, "rpy", 3, owner, path + "<origin", rpy) && R)  // urdfdom's order
+    *R = (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX())).toRotationMatrix();
 }
 
 void Reader::readMaterial(const TiXmlElement* e, const Owner& owner, const std::string& path, bool robot_level) {
@@ -216,7 +222,8 @@ void Reader::readLink(const TiXmlElement* e) {
   if (const TiXmlElement* inertial = e->FirstChildElement("inertial")) {
     link.has_inertial = true;
     link.mass = std::numeric_limits<double>::quiet_NaN();
-    readPose(inertial, owner, "<inertial>");
+    Eigen::Matrix3d R_inertial = Eigen::Matrix3d::Identity();
+    readPose(inertial, owner, "<inertial>", &R_inertial, &link.com);
     const TiXmlElement* mass = inertial->FirstChildElement("mass");
     double m = 0.0;
     bool mass_read = false;
@@ -240,6 +247,8 @@ void Reader::readLink(const TiXmlElement* e) {
       Eigen::Matrix3d I_com;
       I_com << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
       rules::checkInertia(link.name, m, I_com, findings_);
+      link.inertia_read = true;
+      link.I_com = R_inertial * I_com * R_inertial.transpose();  // in the link's axes
     }
   }
   for (const TiXmlElement* v = e->FirstChildElement("visual"); v; v = v->NextSiblingElement("visual")) {
@@ -264,7 +273,7 @@ void Reader::readJoint(const TiXmlElement* e) {
   joint.name = name;
   joint.row = e->Row();
 
-  readPose(e, owner, "");
+  readPose(e, owner, "", &joint.R, &joint.p);
   for (const char* end : {"parent", "child"}) {
     const TiXmlElement* x = e->FirstChildElement(end);
     const char* link = x ? x->Attribute("link") : nullptr;

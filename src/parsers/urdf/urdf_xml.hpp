@@ -3,6 +3,7 @@
 // graph of its links and joints is urdf_graph.hpp's. Private to the library.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct XmlLink {
   int row = 0;                ///< line in the document
   bool has_inertial = false;
   double mass = 0.0;          ///< [kg]; NaN when its <inertial> has no readable mass
+  bool inertia_read = false;  ///< mass, CoM and inertia below were read
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();    ///< CoM, link frame [m]
+  Eigen::Matrix3d I_com = Eigen::Matrix3d::Zero();  ///< inertia about the CoM, link axes [kg m^2]
 };
 
 /// A <joint> with a unique name, as far as the checker needs it.
@@ -26,6 +30,8 @@ struct XmlJoint {
   std::string type;           ///< as written ("" if missing)
   bool known_type = false;    ///< a URDF joint type
   std::string parent, child;  ///< link names ("" if missing)
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< <origin>: the child frame's axes in the parent's
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();      ///< <origin>: its origin in the parent frame [m]
   bool has_mimic = false;     ///< a readable <mimic joint=...> (checked once all joints are read)
   std::string mimic_leader;
   double mimic_multiplier = 1.0, mimic_offset = 0.0;

@@ -44,10 +44,12 @@ struct UrdfReport {
 /// free-floating model (errors) or that deserves attention (warnings).
 ///
 /// Errors: not readable, not XML, not URDF; no root, several roots, a loop; a joint naming a
-/// link that does not exist; a floating or planar joint below the root; a moving link of zero
-/// or negative mass, an inertia that is not positive definite or that breaks the triangle
-/// inequality; NaN, infinite or malformed numbers (every number attribute is checked); a
-/// zero-length axis; a tip that is not a link; a base without mass. Warnings: the root link's
+/// link that does not exist; a floating or planar joint below the root; a negative mass, a rigid
+/// body (links joined by fixed joints) whose inertia is not positive definite; NaN, infinite or
+/// malformed numbers (every number attribute is checked); a zero-length axis; a tip that is not a
+/// link; a base without mass that the links do not supply (a singular mass matrix). Warnings: zero
+/// mass with a rotational inertia, a link's inertia that fails while its rigid body passes, the
+/// triangle inequality broken; the root link's
 /// inertia that kdl_parser would drop (kdl_space keeps it), massless links, an axis that is
 /// not unit length, limits that exclude 0, a base more than 1e6 times heavier than the lightest
 /// moving link (with the condition numbers of H* and G* at q = 0).
