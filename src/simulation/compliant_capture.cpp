@@ -1,4 +1,4 @@
-#include "kdl_space/operation/compliant_capture.hpp"
+#include "kdl_space/simulation/compliant_capture.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -165,11 +165,13 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   s.velocity = js.velocity;
   if (const int rc = sim.energyAndMomentum(s, res.energy_before, res.momentum_before))
     throw InputError(std::string("contact: the joined system cannot be evaluated: ") + strError(rc));
-  // The output step: a fortieth of the slowest axis' time scale tau_a = min(sqrt(m/K), m/D)
-  // (its period, or its rate's relaxation when overdamped), m the apparent inertia the grasp
-  // joint meets: the slowest axis decides when the relative motion is caught. (A light, heavily
-  // damped axis relaxes within the first samples; the integrator's steps resolve it.) With D =
-  // beta K every tau_a is ~ 1/K, so the catch is located to ~ 1/K as the stiffness grows.
+  // The output step: a fortieth of the slowest time scale tau_a = min(sqrt(m/K), m/D) (its
+  // period, or its rate's relaxation when overdamped; m the apparent inertia the grasp joint
+  // meets) among the axes that carry at least 1e-3 of the relative motion (K qdot^2): they decide
+  // when it is caught. (A light, heavily damped axis relaxes within the first samples; the
+  // integrator's steps resolve it.) With D = beta K every tau_a is ~ 1/K, so the catch is located
+  // to ~ 1/K as the stiffness grows.
+  const double s0 = probe.relativeSpeed2(s);
   double scale = 0.0;
   for (int k = 0; k < 6; ++k) {
     double m = 0.0;
@@ -178,12 +180,12 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
     const int a = kAxisOf[k];
     double tau = std::sqrt(m / K(a));
     if (D(a) > 0.0) tau = std::min(tau, m / D(a));
-    scale = std::max(scale, tau);
+    if (K(a) * std::pow(s.velocity.qdot(js.grasp_joints[k]), 2) >= 1e-3 * s0) scale = std::max(scale, tau);
   }
+  if (scale == 0.0) scale = grasp.max_duration;
   scale = std::min(scale, grasp.max_duration);
   const double dt = scale / 40.0;
 
-  const double s0 = probe.relativeSpeed2(s);
   const double tol2 = grasp.catch_tolerance * grasp.catch_tolerance * s0;
   SimulationState prev = s;
   double prev_speed2 = s0;
@@ -199,7 +201,8 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
       end = ContactEnd::Caught;
       return true;
     }
-    if (v2 > prev_speed2 && prev_speed2 < 0.25 * s0) {  // the first minimum (below half the speed)
+    // The first minimum below half the speed; a contact with a normal waits for the tolerance.
+    if (!grasp.normal && v2 > prev_speed2 && prev_speed2 < 0.25 * s0) {
       end = ContactEnd::Caught;
       at_min = true;
       return true;
@@ -236,7 +239,12 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
     throw InputError(std::string("contact: the end state cannot be evaluated: ") + strError(rc));
   res.spring_energy = probe.springEnergy(s.state);
   res.dissipated = -s.work.controller - res.spring_energy;
+  std::optional<Vector6d> lock_from;  // the robot's momentum before the lock
   if (end == ContactEnd::Caught) {
+    FloatingVelocity rv, tv;
+    Vector6d h_r, h_t;
+    probe.split(s, rv, tv, h_r, h_t);
+    lock_from = h_r;
     for (int k = 0; k < 6; ++k) sim.setJointControl(js.grasp_joints[k], {JointControl::Mode::Locked});
     if (const int rc = sim.engageBrakes(s))
       throw InputError(std::string("contact: the grasp cannot be locked: ") + strError(rc));
@@ -257,6 +265,10 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   const Vector6d dh = res.robot_momentum_after - rmom.momentum();
   const Vector3d p = rkin.point(robot.contact);
   res.impulse << dh.head<3>(), dh.tail<3>() - p.cross(dh.head<3>());
+  if (lock_from) {
+    const Vector6d dl = res.robot_momentum_after - *lock_from;
+    res.lock_impulse << dl.head<3>(), dl.tail<3>() - p.cross(dl.head<3>());
+  }
   return res;
 }
 

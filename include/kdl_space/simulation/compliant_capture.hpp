@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "kdl_space/export.hpp"
-#include "kdl_space/impact/capture.hpp"
 #include "kdl_space/impact/joined_system.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
@@ -28,12 +27,15 @@ struct CompliantGrasp {
   double damping_time = 1e-3;
   /// The relative motion is caught when its speed sqrt(qdot^T K qdot) over the grasp joints falls
   /// below catch_tolerance times its value at the start of the contact, or at its first local
-  /// minimum once it has fallen below half of it (the motion has stopped closing).
+  /// minimum once it has fallen below half of it (the motion has stopped closing; not with a
+  /// `normal`), both checked at the output samples.
   double catch_tolerance = 1e-3;
   double max_duration = 1.0;  ///< [s]: the contact ends (neither caught nor opened) after this
   /// Unit normal from the robot's contact point toward the target (world, at the start): if
-  /// given, the contact opens (a bounce) as soon as the normal force on the robot would pull it
-  /// toward the target (n^T f > 0) before the catch. Empty: the grasp holds (a closed gripper).
+  /// given, the contact is one-sided until the catch: it opens (a bounce) as soon as the force on
+  /// the robot would pull it toward the target (n^T f > 0), and it is caught only when the relative
+  /// speed falls below catch_tolerance (the fingers close on a target that has come to rest in
+  /// the hand; not at a minimum). Empty: the grasp holds from the touch (a closed gripper).
   std::optional<Vector3d> normal;
   /// The damping per axis (damping, else damping_time * stiffness).
   Vector6d dampingPerAxis() const { return damping ? *damping : Vector6d(damping_time * stiffness); }
@@ -59,6 +61,9 @@ struct CompliantCaptureResult {
   /// The impulse on the robot: its own momentum's change over the contact, (f; n about the
   /// robot's contact point at the start), as CaptureResult::impulse.F.
   Vector6d impulse = Vector6d::Zero();
+  /// The part of `impulse` the lock gave at the catch (the residual relative motion stopped at
+  /// once; not in `history`), the moment about the same point. Zero unless caught.
+  Vector6d lock_impulse = Vector6d::Zero();
   FloatingVelocity robot_after, target_after;  ///< each side's base twist and rates at the end
   /// The joined system at the end (the grasp's joints braked if caught: its velocity after the lock).
   JoinedSystem joined;
