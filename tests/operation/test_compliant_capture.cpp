@@ -13,7 +13,8 @@
 //      in + the lock's loss, every term >= 0; the peak force is the largest of the history, and
 //      the impulse is the history's force integrated (trapezoids) plus the lock's;
 //   4. a bounce: with a light damping and the normal given, the contact opens when the force
-//      would pull; a spring of the wrong sign is refused.
+//      would pull; with springs alone the kinetic energy taken is what the springs hold (the
+//      springs' sign); a spring of the wrong sign is refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -163,6 +164,17 @@ TEST(CompliantCapture, OpensWhenTheSpringWouldPullAndRefusesAWrongSpring) {
   EXPECT_EQ(c.lock_loss, 0.0);
   EXPECT_GT(g.normal->dot(c.history.back().wrench.head<3>()), 0.0);
   for (std::size_t i = 1; i + 1 < c.history.size(); ++i) EXPECT_LE(g.normal->dot(c.history[i].wrench.head<3>()), 0.0);
+
+  // Springs alone (no damping): the kinetic energy the contact took is what the springs hold
+  // at the opening (a spring of the wrong sign would give energy instead of taking it).
+  CompliantGrasp elastic = gripper(1e6);
+  elastic.damping = Vector6d::Zero();
+  elastic.normal = g.normal;
+  const CompliantCaptureResult b = solveCompliantCapture(p.robot, target, elastic);
+  EXPECT_EQ(b.end, ContactEnd::Opened);
+  EXPECT_NEAR(b.dissipated, 0.0, 1e-9 * b.energy_before);
+  EXPECT_GT(b.spring_energy, 1e-6 * b.energy_before);
+  EXPECT_NEAR(b.energy_before - b.energy_after, b.spring_energy, 1e-8 * b.energy_before);
 
   CompliantGrasp wrong = gripper(1e6);
   wrong.stiffness(2) = -1e6;
