@@ -14,6 +14,7 @@
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/operation/overlap_check.hpp"
+#include "kdl_space/simulation/compliant_capture.hpp"
 #include "scene_writer.hpp"
 
 namespace kdl_space::cli {
@@ -226,6 +227,53 @@ std::vector<InputFile> scenarioInputs(const Scenario& sc) {
   return {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf}, {"the target's URDF", sc.target_urdf}};
 }
 
+/// The compliant contact beside the impulsive capture (`law: {type: compliant}`): what the
+/// contact gave, in the terms of captureJson's keys, and its history as columns.
+Json compliantJson(const CompliantCaptureResult& c) {
+  const char* ends[3] = {"caught", "opened", "timed_out"};
+  Json history;
+  std::vector<double> t;
+  std::vector<Json> wrench, deflection;
+  for (const ContactSample& s : c.history) {
+    t.push_back(s.t);
+    wrench.push_back(toJson(s.wrench));
+    deflection.push_back(toJson(s.deflection));
+  }
+  history["t"] = t;
+  history["wrench"] = wrench;  // on the robot, (f; n about its contact point), world
+  history["deflection"] = deflection;  // x, y, z, rz, ry, rx of the grasp
+  return Json{{"end", ends[static_cast<int>(c.end)]},
+              {"duration", c.duration},
+              {"peak_force", c.peak_force},
+              {"peak_moment", c.peak_moment},
+              {"peak_force_wrench", toJson(c.peak_force_wrench)},
+              {"impulse", toJson(c.impulse)},
+              {"lock_impulse", toJson(c.lock_impulse)},
+              {"robot", Json{{"base_twist_after", twist(c.robot_after.base_twist)}, {"qdot_after", toJson(c.robot_after.qdot.data)}}},
+              {"target", Json{{"base_twist_after", twist(c.target_after.base_twist)}, {"qdot_after", toJson(c.target_after.qdot.data)}}},
+              {"momentum_before", toJson(c.momentum_before)},
+              {"momentum_after", toJson(c.momentum_after)},
+              {"energy_before", c.energy_before},
+              {"energy_after", c.energy_after},
+              {"energy_dissipated", c.dissipated},
+              {"spring_energy", c.spring_energy},
+              {"lock_loss", c.lock_loss},
+              {"steps", c.steps},
+              {"history", history}};
+}
+
+void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& c, const CaptureResult& r) {
+  const char* ends[3] = {"caught (the grasp locked)", "opened (a bounce)", "timed out (law.max_duration)"};
+  out << "\nCompliant contact (law.type compliant; the impulsive capture above is its limit):\n"
+      << "  end " << ends[static_cast<int>(c.end)] << " after " << c.duration << " s (" << c.history.size()
+      << " samples, " << c.steps << " steps)\n"
+      << "  peak force " << c.peak_force << " N, peak moment " << c.peak_moment << " N m\n"
+      << "  impulse (f; n)   " << row(c.impulse) << "\n"
+      << "  impulsive        " << row(r.impulse.F) << "\n"
+      << "  energy dissipated " << c.dissipated << " J, locked in the springs " << c.spring_energy
+      << " J, taken by the lock " << c.lock_loss << " J\n";
+}
+
 void runCapture(const CaptureOptions& o, std::ostream& out) {
   // An output that cannot be written is refused before any work.
   if (!o.scene.empty()) {
@@ -258,6 +306,11 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
                      "simulate (it solves the capture then), or remove the approach section to solve the impact "
                      "at the scenario's states");
   const CaptureResult result = inScenario(sc, [&] { return solveCapture(sc.capture); });
+  std::optional<CompliantCaptureResult> compliant;
+  if (sc.compliant)
+    compliant = inScenario(sc, [&] {
+      return solveCompliantCapture(sc.capture.robot, std::get<FloatingSystem>(sc.capture.target), *sc.compliant);
+    });
   if (!o.scene.empty()) {
     AtomicFile scene(o.scene, "--scene");
     writeScene(scene, {impactSnapshot(sc)},
@@ -280,9 +333,11 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     std::vector<Diagnostic> all = warnings;
     all.insert(all.end(), mesh_warnings.begin(), mesh_warnings.end());
     j["warnings"] = warningsJson(all);
+    if (compliant) j["compliant"] = compliantJson(*compliant);  // beside the impulsive capture
     out << j.dump(2) << "\n";
   } else {
     printCaptureSummary(out, sc, result);
+    if (compliant) printCompliantSummary(out, *compliant, result);
     printWarnings(out, warnings);
     if (!o.scene.empty()) out << "Scene: " << o.scene << "\n";
     if (!o.html.empty()) out << "Page: " << o.html << " (open it in a browser)\n";

@@ -136,7 +136,7 @@ SideView view(const FloatingSystem& s, const FloatingVelocity& after, const std:
 JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& robot_after,
                          const FloatingSystem& target, const FloatingVelocity& target_after, GraspJoint grasp,
                          double touch_tolerance) {
-  if (grasp != GraspJoint::Rigid && grasp != GraspJoint::Spherical)
+  if (grasp != GraspJoint::Rigid && grasp != GraspJoint::Spherical && grasp != GraspJoint::Compliant)
     throw InputError("grasp: not one of the grasp joints");
   if (!(touch_tolerance >= 0.0) || !std::isfinite(touch_tolerance))
     throw InputError("target.contact: the touch tolerance must be a finite length >= 0, got " +
@@ -157,7 +157,7 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
   const Vector6d dt = t.t - r.t;
   const double scale = r.t.norm() + t.t.norm();
   const double mismatch = grasp == GraspJoint::Rigid ? dt.norm() : dt.head<3>().norm();
-  if (!(mismatch <= 1e-6 * scale + 1e-12))
+  if (grasp != GraspJoint::Compliant && !(mismatch <= 1e-6 * scale + 1e-12))
     throw InputError(std::string("grasp: the contact points do not move together after the capture (") +
                      (grasp == GraspJoint::Rigid ? "twists" : "linear velocities") + " differ by " +
                      detail::number(mismatch) + "): give the velocities after a " +
@@ -187,15 +187,19 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
   js.grasp = grasp;
   js.target_prefix = nm.prefix;
   std::vector<std::string> ball;
-  if (grasp == GraspJoint::Spherical) {
+  if (grasp == GraspJoint::Spherical || grasp == GraspJoint::Compliant) {
+    // Compliant: x, y, z prismatic, then the ball's rz, ry, rx, all through the contact point.
     const KDL::Vector o = robot.contact.offset;
-    const char* axes[3] = {"rz", "ry", "rx"};
-    const KDL::Vector dirs[3] = {KDL::Vector(0, 0, 1), KDL::Vector(0, 1, 0), KDL::Vector(1, 0, 0)};
-    for (int k = 0; k < 3; ++k) {
+    const bool slide = grasp == GraspJoint::Compliant;
+    const char* axes[6] = {"x", "y", "z", "rz", "ry", "rx"};
+    const KDL::Vector dirs[6] = {KDL::Vector(1, 0, 0), KDL::Vector(0, 1, 0), KDL::Vector(0, 0, 1),
+                                 KDL::Vector(0, 0, 1), KDL::Vector(0, 1, 0), KDL::Vector(1, 0, 0)};
+    for (int k = slide ? 0 : 3; k < 6; ++k) {
       const std::string joint = unique(std::string("grasp_") + axes[k], used);
       const std::string link = unique(joint + "_link", used);
-      const KDL::Vector origin = k == 0 ? o : KDL::Vector::Zero();
-      add(joined, KDL::Segment(link, KDL::Joint(joint, origin, dirs[k], KDL::Joint::RotAxis), KDL::Frame(origin)), hook);
+      const KDL::Vector origin = k == (slide ? 0 : 3) ? o : KDL::Vector::Zero();
+      const KDL::Joint::JointType type = k < 3 ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
+      add(joined, KDL::Segment(link, KDL::Joint(joint, origin, dirs[k], type), KDL::Frame(origin)), hook);
       ball.push_back(joint);
       hook = link;
     }
@@ -241,7 +245,9 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
   std::vector<Diagnostic> notes{{"", "joined after a capture: the target re-rooted at its contact link " +
                                          quoted(nm.link(tb[target.contact.body].name)) + ", hung on " +
                                          quoted(robot_link) +
-                                         (grasp == GraspJoint::Rigid ? " by a fixed joint" : " by a ball joint"),
+                                         (grasp == GraspJoint::Rigid       ? " by a fixed joint"
+                                          : grasp == GraspJoint::Spherical ? " by a ball joint"
+                                                                           : " by a compliant 6-joint grasp"),
                                  "joined", Severity::Note}};
   FloatingModel model(joined, detail::kdlInertia(rm.bodies()[0]), armature, notes, rm.mimic());
   std::map<std::string, JointProperties> props;
@@ -286,6 +292,19 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
     const Vector3d rates = ballAxes(0.0, 0.0).fullPivLu().solve(w_rel);
     for (int k = 0; k < 3; ++k) js.velocity.qdot(js.grasp_joints[k]) = rates(k);
   }
+  if (grasp == GraspJoint::Compliant) {
+    for (const std::string& b : ball) js.grasp_joints.push_back(indexOf(b, "grasp"));
+    // The target's material point at the robot's contact point, relative to the robot's, in the
+    // robot contact link's axes (the slides' rates); the relative rotation in the ball's axes.
+    const Matrix3d R = toEigen(W_r.M);
+    const Vector3d v_t = t.t.head<3>() + t.t.tail<3>().cross(r.point - t.point);
+    const Vector3d slide_rates = R.transpose() * (v_t - r.t.head<3>());
+    const Vector3d ball_rates = ballAxes(0.0, 0.0).fullPivLu().solve(R.transpose() * (t.t.tail<3>() - r.t.tail<3>()));
+    for (int k = 0; k < 3; ++k) {
+      js.velocity.qdot(js.grasp_joints[k]) = slide_rates(k);
+      js.velocity.qdot(js.grasp_joints[3 + k]) = ball_rates(k);
+    }
+  }
   return js;
 }
 
@@ -293,7 +312,7 @@ double sphericalChartMargin(const JoinedSystem& joined, const State& state) {
   if (joined.grasp_joints.empty()) return 1.0;
   if (!joined.model || state.q.rows() != joined.model->nj())
     throw InputError("state.q: " + std::string(strError(E_SIZE_MISMATCH)) + " (the joined model's joints)");
-  return std::abs(std::cos(state.q(joined.grasp_joints[1])));
+  return std::abs(std::cos(state.q(joined.grasp_joints[joined.grasp_joints.size() - 2])));  // ry
 }
 
 }  // namespace kdl_space

@@ -146,7 +146,7 @@ const std::vector<Broken>& corpus() {
        "holds NaN or infinite values, or a result overflowed",
        false},
       // The impact law.
-      {"bad_law_type.yaml", "{f}:15: law.type: 'bounce' is not one of capture, point, friction, translational", false},
+      {"bad_law_type.yaml", "{f}:15: law.type: 'bounce' is not one of capture, point, friction, translational, compliant", false},
       {"point_without_normal.yaml", "{f}:15: law.normal: missing (a required field)", false},
       {"zero_normal.yaml", "{f}:15: law.normal: has zero length", false},
       {"restitution_out_of_range.yaml", "{f}:15: law.restitution: must lie in [0, 1], got 1.5", false},

@@ -186,6 +186,71 @@ TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
   EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
 }
 
+// --- The compliant law -------------------------------------------------------------------------
+
+/// robot_to_robot_capture.yaml (a free-floating target) with `law` (YAML after "law:"), in a
+/// scratch folder; `tumbling` takes the tumbling box (a rigid target) instead.
+std::string withLaw(const std::string& name, const std::string& law, bool tumbling = false) {
+  std::ifstream in(kShipped + (tumbling ? "tumbling_box_capture.yaml" : "robot_to_robot_capture.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const std::size_t from = s.find("law:");
+  std::size_t to = s.find("\n", from);
+  while (to + 1 < s.size() && (s[to + 1] == ' ' || s[to + 1] == '#')) to = s.find("\n", to + 1);
+  s.replace(from, to - from, "law: " + law);
+  for (std::size_t at = s.find("../urdf/"); at != std::string::npos; at = s.find("../urdf/", at))
+    s.replace(at, 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_compliant_law";
+  fs::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << s;
+  return path;
+}
+
+TEST(LoadScenario, CompliantLawDefaultsAndOverrides) {
+  const Scenario d = loadScenario(withLaw("default.yaml", "{type: compliant}"));
+  ASSERT_TRUE(d.compliant);
+  EXPECT_EQ(d.capture.law.kind, ImpactKind::Capture);  // the impulsive limit beside it
+  const CompliantGrasp defaults;
+  EXPECT_EQ(d.compliant->stiffness, defaults.stiffness);
+  EXPECT_FALSE(d.compliant->damping);
+  EXPECT_EQ(d.compliant->damping_time, defaults.damping_time);
+  EXPECT_FALSE(d.compliant->normal);
+  const Scenario o = loadScenario(withLaw("override.yaml",
+      "{type: compliant, stiffness: [1, 2, 3, 4, 5, 6], damping: [0, 1, 0, 1, 0, 1], catch_tolerance: 0.01, "
+      "max_duration: 2, normal: [0, 0, 2]}"));
+  ASSERT_TRUE(o.compliant);
+  EXPECT_EQ(o.compliant->stiffness, (Vector6d() << 1, 2, 3, 4, 5, 6).finished());
+  ASSERT_TRUE(o.compliant->damping);
+  EXPECT_EQ(*o.compliant->damping, (Vector6d() << 0, 1, 0, 1, 0, 1).finished());
+  EXPECT_EQ(o.compliant->catch_tolerance, 0.01);
+  EXPECT_EQ(o.compliant->max_duration, 2.0);
+  ASSERT_TRUE(o.compliant->normal);
+  EXPECT_EQ(*o.compliant->normal, Vector3d(0, 0, 1));
+  EXPECT_EQ(loadScenario(withLaw("beta.yaml", "{type: compliant, damping_time: 0.02}")).compliant->damping_time, 0.02);
+  EXPECT_FALSE(loadScenario(kShipped + "robot_to_robot_capture.yaml").compliant);
+}
+
+TEST(LoadScenario, CompliantLawRefusals) {
+  const auto tail = [](const std::string& message) { return message.substr(message.find(": law") + 2); };
+  EXPECT_EQ(tail(refusal(withLaw("k.yaml", "{type: compliant, stiffness: [1, 1, 0, 1, 1, 1]}"))),
+            "law.stiffness: each value must be > 0 (x, y, z [N/m or N s/m]; about x, y, z [N m/rad or N m s/rad]), got 0");
+  EXPECT_EQ(tail(refusal(withLaw("d.yaml", "{type: compliant, damping: [1, 1, -1, 1, 1, 1]}"))),
+            "law.damping: each value must be >= 0 (x, y, z [N/m or N s/m]; about x, y, z [N m/rad or N m s/rad]), got -1");
+  EXPECT_EQ(tail(refusal(withLaw("both.yaml", "{type: compliant, damping: [1, 1, 1, 1, 1, 1], damping_time: 1}"))),
+            "law.damping_time: give damping (per axis) or damping_time (D = damping_time * stiffness), not both");
+  EXPECT_EQ(tail(refusal(withLaw("tol.yaml", "{type: compliant, catch_tolerance: 1}"))),
+            "law.catch_tolerance: must be < 1, got 1");
+  EXPECT_EQ(tail(refusal(withLaw("six.yaml", "{type: compliant, stiffness: [1, 1, 1]}"))),
+            "law.stiffness: expected a list of 6 numbers, got a list of 3");
+  EXPECT_EQ(tail(refusal(withLaw("key.yaml", "{type: compliant, restitution: 0.5}"))).substr(0, 29),
+            "law.restitution: unknown fiel");
+  EXPECT_EQ(tail(refusal(withLaw("rigid.yaml", "{type: compliant}", true))),
+            "law.type: compliant joins two free-floating systems: give the target's urdf with movable joints (a "
+            "rigid target is not supported yet)");
+}
+
 
 // --- A rigid target read from a URDF ---------------------------------------------------------
 

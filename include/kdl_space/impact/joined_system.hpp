@@ -18,6 +18,9 @@ namespace kdl_space {
 enum class GraspJoint {
   Rigid,      ///< a fixed joint (after ImpactKind::Capture: the contact twists are equal)
   Spherical,  ///< a ball joint at the robot's contact point (after ImpactKind::TranslationalCapture)
+  /// Six joints whose coordinates are the grasp's deflection (a compliant capture: a spring-damper
+  /// acts on them, docs/COMPLIANT.md); the velocities given are any, e.g. those before the contact.
+  Compliant,
 };
 
 /// \brief The joined model, its state and velocity, and where each side's joints went.
@@ -31,6 +34,12 @@ enum class GraspJoint {
 ///    is Rz(q1) Ry(q2) Rx(q3) (ZYX) followed by a fixed joint "grasp" to the target's contact link
 ///    at its pose at the capture instant. At the join all three angles are 0: the chart's centre,
 ///    pi/2 away from its only singularity, the middle angle q2 = +-pi/2 (sphericalChartMargin).
+///  - Compliant: three prismatic joints "grasp_x", "grasp_y", "grasp_z" (massless links
+///    "grasp_x_link"...) along the x, y, z axes of the robot's contact link, through its contact
+///    point, then the three revolute joints of Spherical about the point they carry: the six
+///    coordinates are the deflection of the target's contact link from its pose at the join (all
+///    0 there): the translation of the grasp point in the robot contact link's axes, then the ZYX
+///    angles of the relative rotation.
 ///  - the links on the path from the target's contact link to its old base are inverted: each
 ///    keeps its own frame and inertia (the base's from bodies()[0]), and hangs on its old child
 ///    by the old joint reversed: the same axis line, the joint's origin inverted, and the joint's
@@ -49,7 +58,9 @@ struct JoinedSystem {
   std::vector<int> target_joints;  ///< joined-model joint index of each target joint (target model order)
   /// +1, or -1 where the re-rooting reversed the joint: q_joined = sign * q_target (and rates).
   std::vector<double> target_joint_sign;
-  std::vector<int> grasp_joints;   ///< the 3 ball-joint coordinates (rz, ry, rx; Spherical), empty for Rigid
+  /// The 3 ball-joint coordinates (rz, ry, rx; Spherical), the 6 (x, y, z, rz, ry, rx; Compliant),
+  /// empty for Rigid.
+  std::vector<int> grasp_joints;
   GraspJoint grasp = GraspJoint::Rigid;
   std::string target_prefix;       ///< "" or "target/": what the target's names were given
 };
@@ -64,6 +75,10 @@ struct JoinedSystem {
 /// every body exactly as it moved in its own system: the robot's base twist and rates, the
 /// target's rates (times the sign), and for Spherical the ball joint's rates from the relative
 /// angular velocity (target's contact link minus the robot's, solved in the joint axes).
+/// Compliant takes any velocities (no capture law: e.g. those before the contact): the six grasp
+/// rates are the relative twist of the target's contact link at the robot's contact point (the
+/// linear part in the robot contact link's axes, the angular part solved in the joint axes), so
+/// that every body again moves as in its own system and the joined momentum is the sum of both.
 /// The responses and braked joints of the sides are not read (the joined model is free).
 /// A set-up call: \throws InputError ("robot: ...", "target: ...", "target.contact: ..." naming
 /// the distance when the contact points are more than `touch_tolerance` [m] apart, "grasp: ..."

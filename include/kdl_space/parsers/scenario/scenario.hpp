@@ -14,6 +14,7 @@
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/export.hpp"
 #include "kdl_space/simulation/simulation.hpp"
+#include "kdl_space/simulation/compliant_capture.hpp"
 
 namespace kdl_space {
 
@@ -54,6 +55,9 @@ struct Scenario {
   /// `contact` may then be omitted: the base's origin).
   bool impact = true;
   CaptureProblem capture;   ///< robot, target, law (ExIITMethod::Recursive, touch tolerance 1 mm)
+  /// `law: {type: compliant, ...}`: the hand's spring-damper (docs/COMPLIANT.md); capture.law is
+  /// then the rigid capture (ImpactKind::Capture), the impulsive limit reported beside it.
+  std::optional<CompliantGrasp> compliant;
   /// The `approach` section: the robot starts from its initial state, reaches the grasp point on
   /// the moving target, and the law applies at the contact instant, from the states then. For a
   /// free-floating robot target its `grasp` is in the frame of target.contact's link, its origin

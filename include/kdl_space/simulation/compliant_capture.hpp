@@ -1,0 +1,94 @@
+// A capture that lasts: the robot and a free-floating target joined at the grasp by a
+// spring-damper (a 6-joint compliant grasp, joinAtGrasp's GraspJoint::Compliant), the contact
+// integrated in the simulator until the relative motion is caught (the grasp then locks) or the
+// contact opens (docs/COMPLIANT.md). As the stiffness grows it tends to the impulsive capture.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "kdl_space/export.hpp"
+#include "kdl_space/impact/joined_system.hpp"
+#include "kdl_space/simulation/simulation.hpp"
+
+namespace kdl_space {
+
+/// \brief The hand's compliance: a spring-damper per axis of the robot's contact link, acting on
+/// the deflection of the grasp (GraspJoint::Compliant's six coordinates: x, y, z of the grasp
+/// point [m]; the ZYX angles about z, y, x [rad]). The defaults are a stiff gripper.
+struct CompliantGrasp {
+  /// (x, y, z [N/m]; about x, y, z [N m/rad]), the robot contact link's axes.
+  Vector6d stiffness = (Vector6d() << 1e6, 1e6, 1e6, 1e4, 1e4, 1e4).finished();
+  /// Per axis, the same order [N s/m; N m s/rad]; empty: damping_time * stiffness.
+  std::optional<Vector6d> damping;
+  /// beta [s] of the stiffness-proportional (Rayleigh) damping D = beta K used when `damping` is
+  /// empty. With beta fixed the contact lasts ~ m / (beta K) and the capture converges to the
+  /// impulsive one at first order in 1/K (with a fixed damping ratio: order 1/2).
+  double damping_time = 1e-3;
+  /// The relative motion is caught when its speed sqrt(qdot^T K qdot) over the grasp joints falls
+  /// below catch_tolerance times its value at the start of the contact, or at its first local
+  /// minimum once it has fallen below half of it (the motion has stopped closing; not with a
+  /// `normal`), both checked at the output samples.
+  double catch_tolerance = 1e-3;
+  double max_duration = 1.0;  ///< [s]: the contact ends (neither caught nor opened) after this
+  /// Unit normal from the robot's contact point toward the target (world, at the start): if
+  /// given, the contact is one-sided until the catch: it opens (a bounce) as soon as the force on
+  /// the robot would pull it toward the target (n^T f > 0), and it is caught only when the relative
+  /// speed falls below catch_tolerance (the fingers close on a target that has come to rest in
+  /// the hand; not at a minimum). Empty: the grasp holds from the touch (a closed gripper).
+  std::optional<Vector3d> normal;
+  /// The damping per axis (damping, else damping_time * stiffness).
+  Vector6d dampingPerAxis() const { return damping ? *damping : Vector6d(damping_time * stiffness); }
+};
+
+/// One output sample of the contact.
+struct ContactSample {
+  double t = 0.0;                        ///< [s] since the start of the contact
+  Vector6d wrench = Vector6d::Zero();    ///< on the robot: (f; n about its contact point), world
+  Vector6d deflection = Vector6d::Zero();  ///< the grasp's six coordinates (x, y, z, rz, ry, rx)
+};
+
+/// How the contact ended.
+enum class ContactEnd { Caught, Opened, TimedOut };
+
+/// Everything about an integrated compliant capture (world frame; momentum about the origin).
+struct CompliantCaptureResult {
+  ContactEnd end = ContactEnd::TimedOut;
+  double duration = 0.0;                 ///< [s]
+  double peak_force = 0.0, peak_moment = 0.0;  ///< largest |f|, |n| of the samples [N], [N m]
+  Vector6d peak_force_wrench = Vector6d::Zero();  ///< the sample's wrench where |f| peaks
+  std::vector<ContactSample> history;    ///< the samples, from the start to the end
+  /// The impulse on the robot: its own momentum's change over the contact, (f; n about the
+  /// robot's contact point at the start), as CaptureResult::impulse.F.
+  Vector6d impulse = Vector6d::Zero();
+  /// The part of `impulse` the lock gave at the catch (the residual relative motion stopped at
+  /// once; not in `history`), the moment about the same point. Zero unless caught.
+  Vector6d lock_impulse = Vector6d::Zero();
+  FloatingVelocity robot_after, target_after;  ///< each side's base twist and rates at the end
+  /// The joined system at the end (the grasp's joints braked if caught: its velocity after the lock).
+  JoinedSystem joined;
+  Vector6d momentum_before = Vector6d::Zero(), momentum_after = Vector6d::Zero();  ///< both sides
+  /// Each side's own momentum at the end (its own model): their sum is momentum_after.
+  Vector6d robot_momentum_after = Vector6d::Zero(), target_momentum_after = Vector6d::Zero();
+  double energy_before = 0.0;  ///< kinetic, both sides [J]
+  double energy_after = 0.0;   ///< kinetic at the end (after the lock) [J]
+  double dissipated = 0.0;     ///< the dampers' work taken [J]
+  double spring_energy = 0.0;  ///< held in the springs at the end (locked in by a catch) [J]
+  double lock_loss = 0.0;      ///< taken by the lock of the residual relative motion [J]
+  long steps = 0;              ///< the integrator's accepted steps
+};
+
+/// \brief Integrates the compliant capture of the free-floating `target` by `robot` from their
+/// states and velocities (before the contact): joinAtGrasp(..., GraspJoint::Compliant), the torque
+/// tau = -K q - D qdot on the six grasp joints (an internal force: the momentum is an invariant
+/// of the integrator), output samples at a fortieth of the fastest axis' time scale, until the
+/// catch (the grasp joints braked by engageBrakes: momentum kept), the opening or max_duration.
+/// Joints braked on either side (FloatingSystem::locked, Response::JointsLocked) stay braked.
+/// A set-up call: \throws InputError ("law.stiffness: ..." etc. for a parameter that is not
+/// finite and > 0, joinAtGrasp's errors, "contact: ..." with the simulator's code when the
+/// integration fails).
+KDL_SPACE_EXPORT CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const FloatingSystem& target,
+                                                              const CompliantGrasp& grasp,
+                                                              const SimulationOptions& options = {});
+
+}  // namespace kdl_space
