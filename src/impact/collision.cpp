@@ -72,7 +72,7 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::JointsLocked) {
     // eq. 20: no recursion
-  } else if (method == ExIITMethod::Recursive && model_->mimic().empty()) {  // mimic joints: dense
+  } else if (method == ExIITMethod::Recursive) {  // mimic joints too: their couplings as constraints
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
     recursive_->setLocked(locked_);  // sizes checked above
   } else {

@@ -10,15 +10,15 @@
 
 namespace kdl_space::detail {
 
-/// \brief The accelerations of a motion: the O(n) articulated-body recursion, or the dense
-/// composite-rigid-body route when joints are coupled (mimic), which the recursion cannot carry.
+/// \brief The accelerations of a motion: the O(n) articulated-body recursion (mimic joints as
+/// constraints on it: O(n k + k^3) for k of them), or the dense composite-rigid-body route
+/// (O(n^3)), kept as the second route.
 /// Both keep ForwardDynamicsSolver's contract, so the simulator never asks which route it runs.
 /// A copy is an independent solver (stopJoints' with other locks and no gravity).
 class Dynamics {
  public:
   explicit Dynamics(const std::shared_ptr<const FloatingModel>& model)
-      : route_(model->mimic().empty() ? Route(std::in_place_type<ForwardDynamicsSolver>, model)
-                                      : Route(std::in_place_type<DenseForwardDynamicsSolver>, model)) {}
+      : route_(Route(std::in_place_type<ForwardDynamicsSolver>, model)) {}
 
   void setGravity(const Vector3d& g) {
     std::visit([&](auto& d) { d.setGravity(g); }, route_);

@@ -17,6 +17,9 @@
 #include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space {
+namespace detail {
+class MimicCoupling;  // src/algorithm/mimic_coupling.hpp: mimic joints as constraints
+}
 
 /// Generalized acceleration of a free-floating system, world frame.
 struct FloatingAcceleration {
@@ -91,6 +94,11 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   Kinematics own_;                 ///< for CartToJnt(State) only
   std::vector<BodyData> data_;     ///< per body
   Eigen::VectorXd qddot_;          ///< joint accelerations before they are returned (n)
+  /// Mimic joints as constraints on the recursion (src/algorithm/mimic_coupling.hpp; one element,
+  /// with no rows for a model without mimic joints).
+  std::vector<detail::MimicCoupling> coupling_;
+  /// The couplings' share taken from qddot_ and the base's acceleration A0 (mimic joints).
+  int couple(const Kinematics& kin, Vector6d& A0);
 };
 
 }  // namespace kdl_space
