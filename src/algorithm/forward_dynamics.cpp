@@ -213,12 +213,17 @@ int ForwardDynamicsSolver::couple(const Kinematics& kin, Vector6d& A0) {
                            [&](int i) -> const Vector6d& { return kin.S[i]; },
                            [&](int i) -> const Vector6d& { return data_[i].U; },
                            [&](int i) { return data_[i].D_inv; },
-                           [&](const Vector6d& p0, Vector6d& a0) {
+                           [&](const auto& P0, auto A0) {  // 6 x k blocks
                              if (grounded_) {
-                               a0.setZero();
+                               A0.setZero();
                                return true;
                              }
-                             return data_[0].IA.solve(-p0, a0);
+                             for (Eigen::Index c = 0; c < P0.cols(); ++c) {
+                               Vector6d a;
+                               if (!data_[0].IA.solve(-Vector6d(P0.col(c)), a)) return false;
+                               A0.col(c) = a;
+                             }
+                             return true;
                            });
   if (rc != E_NOERROR) return rc;
   c.solve([&](int i) { return data_[i].qdd; });

@@ -42,22 +42,16 @@ class MimicCoupling {
       }
     }
     const int k = rows();
-    // Per row, the bodies whose bias force the torque pair makes non-zero: the paths from m and l
-    // to the base (the inward pass walks only these, leaves first).
-    path_start_.push_back(0);
-    std::vector<char> on(nb, 0);
+    tau_.resize(nb);  // per body: the rows whose torque pair acts on it, and the sign
     for (int r = 0; r < k; ++r) {
-      for (int b : {m_[r], l_[r]})
-        for (; b > 0; b = bodies[b].parent) on[b] = 1;
-      for (std::size_t i = nb; i-- > 1;)
-        if (on[i]) path_.push_back(static_cast<int>(i)), on[i] = 0;
-      path_start_.push_back(static_cast<int>(path_.size()));
+      tau_[m_[r]].push_back({r, 1.0});
+      tau_[l_[r]].push_back({r, -1.0});
     }
-    on_path_.assign(nb, 0);
-    a_.assign(nb * k, Vector6d::Zero());
-    qdd_.assign(nb * k, 0.0);
-    p_.assign(nb, Vector6d::Zero());
-    u_.assign(nb, 0.0);
+    A_.setZero(6, nb * k);
+    P_.setZero(6, nb * k);
+    Q_.setZero(k, nb);
+    u_.setZero(k, nb);
+    row_.setZero(k);
     S_.setZero(k, k);
     llt_ = Eigen::LLT<Eigen::MatrixXd>(k);
     c_.setZero(k);
@@ -72,62 +66,52 @@ class MimicCoupling {
 
   /// \brief Y = M^-1 C^T of the free system from its articulated-body quantities (world axes, about
   /// one point): parent(i), moves(i) (a joint that is neither fixed nor locked), S(i), U(i) = I^A S,
-  /// Dinv(i) = 1 / D, and base(p0, a0) the base's acceleration from its articulated bias force
-  /// (false if singular); then S = C Y, factorised. A locked row (m and l both braked) answers
+  /// Dinv(i) = 1 / D, and base(P0, A0) the base's accelerations (6 x k) from its articulated bias
+  /// forces (false if singular); then S = C Y, factorised. A locked row (m and l both braked) answers
   /// nothing: its row and column of S are e_r. \return 0 or E_NOT_POSITIVE_DEFINITE.
+  /// All k rows at once: per body a 6 x k block of bias forces (inward) and of accelerations
+  /// (outward), so that each step is a few vectorised 6 x k operations.
   template <class Parent, class Moves, class SFn, class UFn, class DinvFn, class BaseFn>
   int compute(Parent parent, Moves moves, SFn S, UFn U, DinvFn Dinv, BaseFn base) {
     const int k = rows();
-    const std::size_t nb = p_.size();
-    for (int r = 0; r < k; ++r) {
-      Vector6d* a = a_.data() + r * nb;
-      double* qdd = qdd_.data() + r * nb;
-      if (!moves(m_[r])) {
-        for (std::size_t i = 0; i < nb; ++i) a[i].setZero(), qdd[i] = 0.0;
+    const Eigen::Index nb = Q_.cols();
+    const auto P = [&](Eigen::Index i) { return P_.middleCols(i * k, k); };
+    const auto A = [&](Eigen::Index i) { return A_.middleCols(i * k, k); };
+    P_.setZero();
+    for (Eigen::Index i = nb; i-- > 1;) {  // inward: bias forces of the torque pairs alone
+      const int b = static_cast<int>(i);
+      if (!moves(b)) {
+        P(parent(b)) += P(i);
         continue;
       }
-      // Inward: bias forces p^A from the torque pair alone (no velocity, no external force): zero
-      // off the paths of m and l to the base, so only those are walked.
-      const int* first = path_.data() + path_start_[r];
-      const int* last = path_.data() + path_start_[r + 1];
-      p_[0].setZero();
-      for (const int* b = first; b != last; ++b) p_[*b].setZero(), on_path_[*b] = 1;
-      for (const int* it = first; it != last; ++it) {
-        const int b = *it;
-        if (!moves(b)) {
-          p_[parent(b)] += p_[b];
-          u_[b] = 0.0;
-          continue;
-        }
-        const double tau = (b == m_[r]) - (b == l_[r]);
-        u_[b] = tau - S(b).dot(p_[b]);
-        p_[parent(b)] += p_[b] + U(b) * (u_[b] * Dinv(b));
-      }
-      const bool ok = base(p_[0], a[0]);
-      if (!ok) {
-        for (const int* b = first; b != last; ++b) on_path_[*b] = 0;
-        return E_NOT_POSITIVE_DEFINITE;
-      }
-      qdd[0] = 0.0;
-      for (std::size_t i = 1; i < nb; ++i) {  // outward
-        const int b = static_cast<int>(i);
-        const Vector6d& a_parent = a[parent(b)];
-        if (!moves(b)) {
-          a[i] = a_parent;
-          qdd[i] = 0.0;
-          continue;
-        }
-        qdd[i] = ((on_path_[i] ? u_[i] : 0.0) - U(b).dot(a_parent)) * Dinv(b);
-        a[i] = a_parent + S(b) * qdd[i];
-      }
-      for (const int* b = first; b != last; ++b) on_path_[*b] = 0;
+      row_.noalias() = -(P(i).transpose() * S(b));
+      for (const Tau& t : tau_[i]) row_(t.row) += t.sign;
+      u_.col(i) = row_;
+      row_ *= Dinv(b);
+      P(parent(b)) += P(i);
+      P(parent(b)).noalias() += U(b) * row_.transpose();
     }
-    for (int s = 0; s < k; ++s)
-      for (int r = 0; r < k; ++r) S_(r, s) = qdd(s, m_[r]) - qdd(s, l_[r]);
+    if (!base(P(0), A(0))) return E_NOT_POSITIVE_DEFINITE;
+    Q_.col(0).setZero();
+    for (Eigen::Index i = 1; i < nb; ++i) {  // outward
+      const int b = static_cast<int>(i);
+      if (!moves(b)) {
+        A(i) = A(parent(b));
+        Q_.col(i).setZero();
+        continue;
+      }
+      row_ = u_.col(i);
+      row_.noalias() -= A(parent(b)).transpose() * U(b);
+      row_ *= Dinv(b);
+      Q_.col(i) = row_;
+      A(i) = A(parent(b));
+      A(i).noalias() += S(b) * row_.transpose();
+    }
+    for (int r = 0; r < k; ++r) S_.row(r) = Q_.col(m_[r]).transpose() - Q_.col(l_[r]).transpose();
     for (int s = 0; s < k; ++s)  // symmetric up to round-off: exactly so (in place: no allocation)
       for (int r = s + 1; r < k; ++r) S_(r, s) = S_(s, r) = 0.5 * (S_(r, s) + S_(s, r));
     for (int r = 0; r < k; ++r)
-      if (!moves(m_[r])) S_(r, r) = 1.0;
+      if (!moves(m_[r])) S_(r, r) = 1.0;  // a braked pair: its row and column are zero
     llt_.compute(S_);
     return llt_.info() == Eigen::Success ? E_NOERROR : E_NOT_POSITIVE_DEFINITE;
   }
@@ -140,39 +124,32 @@ class MimicCoupling {
     lambda_ = llt_.solve(c_);
   }
   double lambda(int r) const { return lambda_(r); }
-  /// Row r's response: the acceleration (twist, about the common point) of body i, and its joint's.
-  const Vector6d& a(int r, int i) const { return a_[r * p_.size() + i]; }
-  double qdd(int r, int i) const { return qdd_[r * p_.size() + i]; }
   /// sum_r lambda_r qdd(r, i): what the couplings take from body i's joint acceleration.
-  double qddShare(int i) const {
-    double s = 0.0;
-    for (int r = 0; r < rows(); ++r) s += lambda_(r) * qdd(r, i);
-    return s;
-  }
+  double qddShare(int i) const { return Q_.col(i).dot(lambda_); }
   /// sum_r lambda_r a(r, 0): what they take from the base's.
-  Vector6d baseShare() const {
-    Vector6d s = Vector6d::Zero();
-    for (int r = 0; r < rows(); ++r) s += lambda_(r) * a(r, 0);
-    return s;
-  }
+  Vector6d baseShare() const { return A_.leftCols(rows()) * lambda_; }
 
   /// G -= (X Y_i) S^-1 (X Y_i)^T: the couplings' share of the inverse inertia at a point of body i
   /// (X the transfer from the common point to it).
   void correctG(const Matrix6d& X, int i, Matrix6d& G) {
-    for (int r = 0; r < rows(); ++r) Y_.col(r).noalias() = X * a(r, i);
+    Y_.noalias() = X * A_.middleCols(static_cast<Eigen::Index>(i) * rows(), rows());
     Z_ = llt_.solve(Y_.transpose());
     G.noalias() -= Y_ * Z_;
   }
 
  private:
   std::vector<int> m_, l_;          ///< per row: the mimic body and its coordinate's own body
-  std::vector<int> path_, path_start_;  ///< per row r: path_[path_start_[r] .. path_start_[r + 1]), leaves first
-  std::vector<char> on_path_;       ///< scratch: the current row's path bodies
   std::vector<double> armature_;    ///< per body (free system)
-  std::vector<Vector6d> a_;         ///< per row, per body: accelerations of Y's column
-  std::vector<double> qdd_;         ///< per row, per body: joint accelerations of Y's column
-  std::vector<Vector6d> p_;         ///< scratch: bias forces
-  std::vector<double> u_;           ///< scratch: tau - S^T p
+  struct Tau {
+    int row;
+    double sign;
+  };
+  std::vector<std::vector<Tau>> tau_;  ///< per body: the torque pairs' entries on its joint
+  Eigen::MatrixXd A_;               ///< 6 x (k per body): the accelerations of Y's columns (twists)
+  Eigen::MatrixXd P_;               ///< 6 x (k per body): scratch, bias forces
+  Eigen::MatrixXd Q_;               ///< k x bodies: the joint accelerations of Y's columns
+  Eigen::MatrixXd u_;               ///< k x bodies: scratch, tau - S^T p
+  Eigen::VectorXd row_;             ///< scratch (k): one body's entries of the k rows
   Eigen::MatrixXd S_;               ///< C M^-1 C^T
   Eigen::LLT<Eigen::MatrixXd> llt_;
   Eigen::VectorXd c_, lambda_;

@@ -159,9 +159,9 @@ int RecursiveExIITSolver::couple(Response response) {
   const int rc = c.compute([&](int i) { return bodies[i].parent; }, [&](int i) { return moves_[i] != 0; },
                            [&](int i) -> const Vector6d& { return S_[i]; },
                            [&](int i) -> const Vector6d& { return U_[i]; }, [&](int i) { return Dinv_[i]; },
-                           [&](const Vector6d& p0, Vector6d& a0) {
-                             if (grounded) a0.setZero();  // a base of infinite inertia
-                             else a0.noalias() = -(Omega0_ * p0);
+                           [&](const auto& P0, auto A0) {  // 6 x k blocks
+                             if (grounded) A0.setZero();  // a base of infinite inertia
+                             else A0.noalias() = (-Omega0_) * P0;
                              return true;
                            });
   grounded_ready_ = grounded && rc == E_NOERROR;
