@@ -72,7 +72,9 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::JointsLocked) {
     // eq. 20: no recursion
-  } else if (method == ExIITMethod::Recursive) {  // mimic joints too: their couplings as constraints
+  } else if (method == ExIITMethod::Recursive && model_->mimic().empty()) {
+    // Mimic joints: the dense route, measured faster for G* than the recursion with the couplings
+    // as constraints (O(n k), k growing with n on a hand: docs/benchmarks.md, "Mimic joints").
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
     recursive_->setLocked(locked_);  // sizes checked above
   } else {

@@ -126,8 +126,9 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
                mimic_.end());
   build(detail::kdlInertia(links.front().body), armature);
   if (!mimic_.empty())
-    diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: the O(n) "
-                                "recursions impose the couplings as constraints (one more pass per mimic joint)",
+    diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: the motion's "
+                                "O(n) recursion imposes the couplings as constraints; G*, the velocity jumps "
+                                "and the capture take the dense route (faster there)",
                             "mimic_constraints", Severity::Note});
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
@@ -231,7 +232,8 @@ void FloatingModel::refuseMimic(const std::string& who) const {
   std::vector<std::string> names;
   for (const Mimic& m : mimic_) names.push_back(detail::quoted(m.joint));
   throw ModelError(who + ": the model has mimic joints (" + detail::listNames(names) +
-                   "): coupled joints are not supported here; remove the <mimic> elements to treat them as free joints");
+                   "): coupled joints are not supported here; remove the <mimic> elements to treat them as "
+                   "free joints");
 }
 
 int FloatingModel::jointIndex(const std::string& name) const {

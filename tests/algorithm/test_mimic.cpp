@@ -109,8 +109,8 @@ TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
       const Eigen::MatrixXd G = J_star * H_star.ldlt().solve(J_star.transpose()) + G_locked;
       ASSERT_EQ(a.G_star(ha, Ga), 0);
       EXPECT_TRUE(Ga.isApprox(G, 1e-10)) << tip << "\n" << Ga << "\n\n" << G;
-      // A capture side on the coupled model (the O(n) route, the couplings as constraints): its
-      // velocity jump is H*^-1 J*^T F in the coupled coordinates (eq. 18).
+      // A capture side on the coupled model takes the dense route by itself, and its velocity
+      // jump is H*^-1 J*^T F in the coupled coordinates (eq. 18).
       FloatingVelocity v{KDL::Twist::Zero(), KDL::JntArray(3)};
       FloatingSide side(coupled, sa, ha, v);
       EXPECT_TRUE(side.G().isApprox(G, 1e-10)) << tip;

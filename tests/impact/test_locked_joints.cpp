@@ -295,7 +295,7 @@ TEST(LockedJointsSide, JointsLockedAcceptsASubset) {
   EXPECT_EQ(subset.G(), all.G());
 }
 
-// A mimic leader braked brakes its follower (the O(n) route, the couplings as constraints):
+// A mimic leader braked brakes its follower (the dense route, which a capture side of a mimic model takes):
 // the same as the model with both joints fixed.
 TEST(LockedJointsSide, ABrakedMimicLeaderBrakesItsFollower) {
   const std::string urdf = R"(<robot name="m">
@@ -328,7 +328,7 @@ TEST(LockedJointsSide, ABrakedMimicLeaderBrakesItsFollower) {
   fixed_v.qdot(0) = 0.3;
   const Contact fixed_h = fixed->contact("c", KDL::Vector(0.1, 0, 0));
   for (Response r : {Response::FreeFloating, Response::Grounded}) {
-    const FloatingSide side(model, state, h, v, r, ExIITMethod::Recursive, locked);  // the couplings as constraints
+    const FloatingSide side(model, state, h, v, r, ExIITMethod::Recursive, locked);  // takes the dense route
     const FloatingSide ref(fixed, fixed_state, fixed_h, fixed_v, r);
     EXPECT_TRUE(same(side.G(), ref.G(), "G with a braked mimic leader"));
   }
