@@ -10,9 +10,10 @@
 
 namespace kdl_space::detail {
 
-/// \brief The accelerations of a motion: the O(n) articulated-body recursion (mimic joints as
-/// constraints on it: O(n k + k^3) for k of them), or the dense composite-rigid-body route
-/// (O(n^3)), kept as the second route.
+/// \brief The accelerations of a motion: the O(n) articulated-body recursion, for every model (mimic
+/// joints as constraints on it: O(n k + k^3) for k of them, measured faster than the dense route
+/// at 10 to 100 joints, docs/benchmarks.md). The seam keeps the dense composite-rigid-body route
+/// (O(n^3)) as an alternative, which no model takes now.
 /// Both keep ForwardDynamicsSolver's contract, so the simulator never asks which route it runs.
 /// A copy is an independent solver (stopJoints' with other locks and no gravity).
 class Dynamics {
