@@ -43,7 +43,8 @@ struct FloatingAcceleration {
 /// Locked joints (brakes on) are fixed joints in steps 2 and 3 (qddot = 0; their torque is
 /// whatever holds them); a locked joint that still moves keeps its velocity product in step 1.
 /// Mimic joints: every joint free in the recursion, then a = a_free - M^-1 C^T S^-1 C a_free from k
-/// more passes on the same articulated inertias (src/algorithm/mimic_coupling.hpp; O(n k + k^3)).
+/// more passes on the same articulated inertias (src/algorithm/mimic_coupling.hpp; O(n k + k^3); its
+/// being allocation-free is not yet proved by tests/alloc for such a model).
 /// Workspaces are sized in the constructor; CartToJnt allocates nothing and never throws.
 class KDL_SPACE_EXPORT ForwardDynamicsSolver {
  public:
