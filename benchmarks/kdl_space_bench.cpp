@@ -688,7 +688,8 @@ int main(int argc, char** argv) {
       }
     }
     if (model.empty())
-      for (int n : mimic_sizes) bench::mimicCases().push_back(bench::makeMimicCase(n));
+      for (bool grippers : {false, true})
+        for (int n : mimic_sizes) bench::mimicCases().push_back(bench::makeMimicCase(n, grippers));
   } catch (const ModelError& e) {
     std::cerr << "kdl_space_bench: " << e.what() << "\n";
     return 3;

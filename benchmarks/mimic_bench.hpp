@@ -1,5 +1,6 @@
 // kdl_space_bench's mimic section (issue 28): G* and forward dynamics of a humanoid's upper body
-// whose fingers are coupled (generatedHandsUrdf: a third of the joints are mimic joints), by the
+// whose fingers are coupled (generatedHandsUrdf: a third of the joints are mimic joints;
+// generatedGrippersUrdf: two two-finger grippers, four mimic joints at every size), by the
 // O(n) recursions with the couplings as constraints against the dense route (T^T H T, O(n^3)),
 // side by side in one run. Checked equal to 1e-9 before timing.
 #pragma once
@@ -22,7 +23,7 @@
 namespace kdl_space::bench {
 
 struct MimicCase {
-  std::string name;  ///< "hands N=..." (N: movable joints of the URDF, mimic ones included)
+  std::string name;  ///< "hands N=..." or "grippers N=..." (N: movable joints of the URDF, mimic ones included)
   std::shared_ptr<const FloatingModel> model;
   State state[2];    ///< calls alternate between two configurations
   Contact contact;
@@ -35,10 +36,13 @@ inline std::vector<MimicCase>& mimicCases() {
   return all;
 }
 
-inline MimicCase makeMimicCase(int N) {
+/// \param grippers the "grippers" family (k = 4 mimic joints at every N), else the "hands" one
+/// (k = N / 3).
+inline MimicCase makeMimicCase(int N, bool grippers = false) {
   MimicCase c;
-  c.name = "hands N=" + std::to_string(N);
-  c.model = std::make_shared<const FloatingModel>(loadUrdfString(generatedHandsUrdf(N), c.name));
+  c.name = (grippers ? "grippers N=" : "hands N=") + std::to_string(N);
+  c.model = std::make_shared<const FloatingModel>(
+      loadUrdfString(grippers ? generatedGrippersUrdf(N) : generatedHandsUrdf(N), c.name));
   const unsigned int n = c.model->nj();
   for (int k = 0; k < 2; ++k) {
     c.state[k] = State(*c.model);
@@ -128,7 +132,8 @@ std::string mimicTable(Time time, Fmt fmt) {
   std::ostringstream t;
   if (mimicCases().empty()) return "";
   t << "\n### Mimic joints: the O(n) recursions with the couplings as constraints vs the dense route "
-       "(generated humanoid upper body, a third of the joints mimic finger joints)\n\n"
+       "(generated humanoid upper body: hands, a third of the joints mimic finger joints; grippers, "
+       "four mimic joints)\n\n"
        "| model | joints (coordinates + mimic) | G* O(n) | G* dense | dense / O(n) | forward dynamics O(n) | "
        "dense | dense / O(n) |\n|---|---|---|---|---|---|---|---|\n";
   const auto ratio = [](double a, double b) {

@@ -11,6 +11,7 @@
 #include "multibody/joint_motion.hpp"
 #include "detail/text.hpp"
 #include "multibody/model_build.hpp"
+#include "multibody/mimic_route.hpp"
 #include "multibody/model_rules.hpp"
 
 namespace kdl_space {
@@ -128,7 +129,10 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
   if (!mimic_.empty())
     diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: the motion's "
                                 "O(n) recursion imposes the couplings as constraints; G*, the velocity jumps "
-                                "and the capture take the dense route (faster there)",
+                                "and the capture take " +
+                                    std::string(detail::mimicGStarTakesRecursion(nj(), mimic_.size())
+                                                    ? "it too (few mimic joints: 4 k <= n, faster there)"
+                                                    : "the dense route (many mimic joints: 4 k > n, faster there)"),
                             "mimic_constraints", Severity::Note});
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();

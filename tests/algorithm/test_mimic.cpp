@@ -20,6 +20,8 @@
 #include "kdl_space/simulation/simulation.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "generated_chain.hpp"
+#include "multibody/mimic_route.hpp"
 
 namespace kdl_space {
 namespace {
@@ -378,6 +380,55 @@ TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
     ASSERT_EQ(report.errors.size(), 1u);
     EXPECT_EQ(report.errors[0].kind, "bad_mimic");
     EXPECT_EQ(std::string(e.what()), "bad.urdf: " + describe(report.errors[0]));
+  }
+}
+
+// The capture's route for mimic models (issue 28): the recursion where few joints are mimic
+// (4 k <= n, measured faster: docs/benchmarks.md), the dense route where many are.
+TEST(Mimic, TheCaptureTakesTheRecursionForFewMimicJointsAndTheDenseRouteForMany) {
+  EXPECT_TRUE(detail::mimicGStarTakesRecursion(16, 4));   // grippers N=20: 1.3x faster measured
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(15, 4));  // just beyond the rule
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(6, 4));   // grippers N=10: 0.88x
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(68, 32)); // hands N=100: 0.7x
+  EXPECT_TRUE(detail::mimicGStarTakesRecursion(7, 0));    // no mimic joint
+  // The model's note says which route its capture takes, on both sides of the rule.
+  const auto note = [](const std::string& urdf) {
+    const FloatingModel model = loadUrdfString(urdf, "generated.urdf");
+    for (const Diagnostic& d : model.diagnostics())
+      if (d.kind == "mimic_constraints") return d.message;
+    return std::string();
+  };
+  EXPECT_NE(note(bench::generatedGrippersUrdf(30)).find("take it too"), std::string::npos)
+      << note(bench::generatedGrippersUrdf(30));
+  EXPECT_NE(note(bench::generatedGrippersUrdf(10)).find("take the dense route"), std::string::npos);
+  EXPECT_NE(note(bench::generatedHandsUrdf(50)).find("take the dense route"), std::string::npos);
+}
+
+TEST(Mimic, ACaptureOnTheRecursiveRouteEqualsTheDenseRoute) {
+  const auto model = std::make_shared<const FloatingModel>(loadUrdfString(bench::generatedGrippersUrdf(30), "g.urdf"));
+  const unsigned int n = model->nj();
+  ASSERT_EQ(model->mimic().size(), 4u);
+  ASSERT_TRUE(detail::mimicGStarTakesRecursion(n, 4));
+  State state(*model);
+  state.world_T_base = KDL::Frame(KDL::Rotation::RPY(0.1, -0.2, 0.3), KDL::Vector(0.3, -0.2, 0.1));
+  FloatingVelocity v{KDL::Twist(KDL::Vector(0.01, -0.005, 0.002), KDL::Vector(0.003, 0.02, -0.01)), KDL::JntArray(n)};
+  for (unsigned int j = 0; j < n; ++j) {
+    state.q(j) = std::sin(1.3 * j + 0.2);
+    v.qdot(j) = 0.1 - 0.02 * (j % 7);
+  }
+  const Contact h = model->contact("tip");
+  Vector6d F;
+  F << 3.0, -2.0, 1.5, 0.4, -0.3, 0.2;
+  for (Response r : {Response::FreeFloating, Response::Grounded}) {
+    SCOPED_TRACE(r == Response::FreeFloating ? "free" : "grounded");
+    FloatingSide fast(model, state, h, v, r, ExIITMethod::Recursive), dense(model, state, h, v, r, ExIITMethod::Dense);
+    EXPECT_LE((fast.G() - dense.G()).norm(), 1e-10 * dense.G().norm());
+    ASSERT_EQ(fast.applyImpulse(F), 0);
+    ASSERT_EQ(dense.applyImpulse(F), 0);
+    EXPECT_LE((fast.after().qdot.data - dense.after().qdot.data).norm(), 1e-10 * (1.0 + dense.after().qdot.data.norm()));
+    EXPECT_LE((toEigen(fast.after().base_twist) - toEigen(dense.after().base_twist)).norm(),
+              1e-10 * (1.0 + toEigen(dense.after().base_twist).norm()));
+    EXPECT_LE((fast.contactTwistAfter() - dense.contactTwistAfter()).norm(), 1e-10 * (1.0 + dense.contactTwistAfter().norm()));
   }
 }
 
