@@ -2,6 +2,7 @@
 // written as URDF so that every library under comparison reads the same file.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -48,6 +49,101 @@ inline std::string generatedChainUrdf(int N) {
   }
   u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"link" << N
     << "\"/><child link=\"tip\"/><origin xyz=\"0.1 0 0\" rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
+  return u.str();
+}
+
+/// A humanoid's upper body with coupled fingers, N movable joints in all: a 500 kg torso, two arms
+/// of (N - 6F) / 2 revolute joints each (as the chain's links), each arm ending in a hand of
+/// F = max(1, round(N / 12)) three-joint fingers whose middle and distal joints follow the proximal
+/// one (URDF <mimic>, multipliers 0.9 and 0.7): a third of the joints are mimic joints at every N.
+/// The contact link `tip` is beyond the first finger's distal phalanx of the first hand.
+inline std::string generatedHandsUrdf(int N) {
+  const int F = std::max(1, static_cast<int>(std::lround(N / 12.0)));
+  const int arm = std::max(1, (N - 6 * F) / 2);
+  std::ostringstream u;
+  u << "<?xml version=\"1.0\"?>\n<robot name=\"hands" << N << "\">\n";
+  u << "<link name=\"base\">" << inertial(500.0, 1.6, 1.4, 1.2, 0.2, "0.02 -0.01 0.03") << "</link>\n";
+  const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
+  const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
+                         const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
+    u << "<joint name=\"" << name << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << child
+      << "\"/><origin xyz=\"" << xyz << "\" rpy=\"0 0 " << yaw << "\"/><axis xyz=\"" << axis
+      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
+  };
+  for (int side = 0; side < 2; ++side) {
+    const std::string s = side == 0 ? "r" : "l";
+    std::string parent = "base";
+    for (int i = 1; i <= arm; ++i) {
+      const std::string child = s + "_link" + std::to_string(i);
+      joint(s + "_joint" + std::to_string(i), parent, child, i == 1 ? (side == 0 ? "0 -0.8 0.5" : "0 0.8 0.5") : "0.3 0 0",
+            0.1 * (i % 3), axes[i % 3], "");
+      u << "<link name=\"" << child << "\">" << inertial(4.0 + 2.0 * (arm - i) / std::max(1, arm - 1), 0.3, 0.08, 0.08,
+                                                        0.1 + 0.01 * i, "0.15 0.01 0")
+        << "</link>\n";
+      parent = child;
+    }
+    for (int f = 0; f < F; ++f) {
+      const std::string p = s + "_f" + std::to_string(f), y = std::to_string(0.02 * f - 0.01 * F);
+      std::string previous = parent;
+      const char* names[3] = {"_proximal", "_middle", "_distal"};
+      for (int k = 0; k < 3; ++k) {
+        const std::string child = p + "_" + std::to_string(k + 1);
+        const std::string mimic = k == 0 ? "" : "<mimic joint=\"" + p + names[0] + "\" multiplier=\"" +
+                                                    (k == 1 ? "0.9" : "0.7") + "\" offset=\"0.01\"/>";
+        joint(p + names[k], previous, child, k == 0 ? "0.32 " + y + " 0" : "0.04 0 0", 0.0, "0 1 0", mimic);
+        u << "<link name=\"" << child << "\">" << inertial(0.05 - 0.01 * k, 0.04, 0.015, 0.015, 0.2, "0.02 0 0")
+          << "</link>\n";
+        previous = child;
+      }
+    }
+  }
+  u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"r_f0_3\"/><child link=\"tip\"/><origin xyz=\"0.03 0 0\" "
+       "rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
+  return u.str();
+}
+
+/// A humanoid's upper body with few coupled fingers, N movable joints in all: a 500 kg torso, two
+/// arms of (N - 8) / 2 revolute joints each (N - 8 odd: the right arm one more), each arm ending in
+/// a two-finger gripper whose fingers have a proximal joint and a distal one that follows it (URDF
+/// <mimic>, multiplier 0.6): k = 4 mimic joints at every N (the issue's "large humanoid with coupled
+/// fingers"; generatedHandsUrdf is the hand-dominated case, k = N / 3). The contact link `tip` is
+/// beyond the right gripper's first distal phalanx.
+inline std::string generatedGrippersUrdf(int N) {
+  const int arms = std::max(2, N - 8);
+  std::ostringstream u;
+  u << "<?xml version=\"1.0\"?>\n<robot name=\"grippers" << N << "\">\n";
+  u << "<link name=\"base\">" << inertial(500.0, 1.6, 1.4, 1.2, 0.2, "0.02 -0.01 0.03") << "</link>\n";
+  const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
+  const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
+                         const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
+    u << "<joint name=\"" << name << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << child
+      << "\"/><origin xyz=\"" << xyz << "\" rpy=\"0 0 " << yaw << "\"/><axis xyz=\"" << axis
+      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
+  };
+  for (int side = 0; side < 2; ++side) {
+    const std::string s = side == 0 ? "r" : "l";
+    const int arm = side == 0 ? arms - arms / 2 : arms / 2;
+    std::string parent = "base";
+    for (int i = 1; i <= arm; ++i) {
+      const std::string child = s + "_link" + std::to_string(i);
+      joint(s + "_joint" + std::to_string(i), parent, child, i == 1 ? (side == 0 ? "0 -0.8 0.5" : "0 0.8 0.5") : "0.3 0 0",
+            0.1 * (i % 3), axes[i % 3], "");
+      u << "<link name=\"" << child << "\">" << inertial(4.0 + 2.0 * (arm - i) / std::max(1, arm - 1), 0.3, 0.08, 0.08,
+                                                        0.1 + 0.01 * i, "0.15 0.01 0")
+        << "</link>\n";
+      parent = child;
+    }
+    for (int f = 0; f < 2; ++f) {
+      const std::string p = s + "_finger" + std::to_string(f);
+      joint(p + "_proximal", parent, p + "_1", f == 0 ? "0.32 0.03 0" : "0.32 -0.03 0", 0.0, f == 0 ? "0 0 1" : "0 0 -1", "");
+      u << "<link name=\"" << p << "_1\">" << inertial(0.08, 0.05, 0.02, 0.02, 0.2, "0.025 0 0") << "</link>\n";
+      joint(p + "_distal", p + "_1", p + "_2", "0.05 0 0", 0.0, "0 0 1",
+            "<mimic joint=\"" + p + "_proximal\" multiplier=\"0.6\" offset=\"0.01\"/>");
+      u << "<link name=\"" << p << "_2\">" << inertial(0.05, 0.04, 0.015, 0.015, 0.2, "0.02 0 0") << "</link>\n";
+    }
+  }
+  u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"r_finger0_2\"/><child link=\"tip\"/><origin xyz=\"0.04 0 0\" "
+       "rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
   return u.str();
 }
 

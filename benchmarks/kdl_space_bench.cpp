@@ -8,7 +8,7 @@
 // ratios; --markdown FILE writes the tables.
 //
 //   kdl_space_bench [--model FILE.urdf --tip LINK [--offset X Y Z]] [--sizes 7,14,...]
-//                   [--simulate 7,100] [--markdown FILE]
+//                   [--simulate 7,100] [--mimic-sizes 10,30,50,100] [--markdown FILE]
 //                   [Google Benchmark flags, e.g. --benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
@@ -26,6 +26,7 @@
 
 #include "crb_forward_dynamics.hpp"
 #include "generated_chain.hpp"
+#include "mimic_bench.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -629,6 +630,7 @@ int main(int argc, char** argv) {
   std::string model, tip, markdown;
   KDL::Vector offset = KDL::Vector::Zero();
   std::vector<int> sizes{7, 14, 28, 50, 100}, simulate{7, 100};
+  std::vector<int> mimic_sizes{10, 20, 30, 50, 100};  // the mimic section (mimic_bench.hpp); "" for none
   const auto list = [](const std::string& text) {
     std::vector<int> out;
     std::stringstream s(text);
@@ -653,6 +655,9 @@ int main(int argc, char** argv) {
     } else if (a == "--sizes") {
       need(1);
       sizes = list(argv[++i]);
+    } else if (a == "--mimic-sizes") {
+      need(1);
+      mimic_sizes = list(argv[++i]);
     } else if (a == "--simulate") {
       need(1);
       simulate = list(argv[++i]);
@@ -682,15 +687,19 @@ int main(int argc, char** argv) {
         cases().back().simulate = std::find(simulate.begin(), simulate.end(), n) != simulate.end();
       }
     }
+    if (model.empty())
+      for (bool grippers : {false, true})
+        for (int n : mimic_sizes) bench::mimicCases().push_back(bench::makeMimicCase(n, grippers));
   } catch (const ModelError& e) {
     std::cerr << "kdl_space_bench: " << e.what() << "\n";
     return 3;
   }
-  if (!checkRoutes()) {
+  if (!checkRoutes() || !bench::checkMimicRoutes()) {
     std::cerr << "kdl_space_bench: the routes disagree: not timing them\n";
     return 4;
   }
   for (const Case& c : cases()) registerCase(c);
+  for (const bench::MimicCase& c : bench::mimicCases()) bench::registerMimicCase(c);
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
 
@@ -798,6 +807,7 @@ int main(int argc, char** argv) {
             << it->second.ours_stats.rejected_steps << ") | " << diff.str() << " |\n";
     }
   }
+  table << bench::mimicTable(time, fmt);
   std::cout << "\n" << table.str();
   if (!markdown.empty()) {
     std::ofstream md(markdown);

@@ -1,5 +1,6 @@
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 
+#include "algorithm/mimic_coupling.hpp"
 #include "algorithm/set_up.hpp"
 #include "detail/multiversion.hpp"
 #include "detail/symmetric6d.hpp"
@@ -16,6 +17,9 @@ struct ForwardDynamicsSolver::BodyData {
   // The topology, beside the numbers (every pass reads it; the model's per-body records are large)
   int parent = -1, joint = -1;     ///< as Body
   bool moving = false;             ///< a movable joint whose brakes are off
+  bool leads = true;               ///< its joint's coordinate's own body (false: a mimic joint's)
+  double armature = 0.0;           ///< of the free system (mimic_coupling.hpp): the coordinate's, on its own body
+  double qdd = 0.0;                ///< last pass: the joint's acceleration, free system
   double mass = 0.0;               ///< [kg]
   detail::Symmetric6d IA;          ///< articulated inertia I^A
   Vector6d V = Vector6d::Zero();   ///< twist
@@ -42,7 +46,6 @@ inline Vector6d rigidTimes(double m, const Vector3d& c, const Matrix3d& I_c, con
 
 ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("ForwardDynamicsSolver: null model");
-  model_->refuseMimic("ForwardDynamicsSolver");
   const std::size_t nb = model_->bodies().size();
   locked_.assign(model_->nj(), false);
   own_ = Kinematics(*model_);
@@ -53,6 +56,13 @@ ForwardDynamicsSolver::ForwardDynamicsSolver(std::shared_ptr<const FloatingModel
     data_[i].joint = b.joint;
     data_[i].moving = b.joint >= 0;
     data_[i].mass = b.mass;
+  }
+  // Mimic joints: every body's joint free in the recursion, the couplings imposed after it.
+  coupling_.emplace_back(*model_);
+  for (std::size_t i = 1; i < nb; ++i) {
+    const int j = data_[i].joint;
+    data_[i].leads = j < 0 || model_->jointBody()[j] == static_cast<int>(i);
+    data_[i].armature = coupling_[0].armature(static_cast<int>(i));
   }
   qddot_.setZero(model_->nj());
 }
@@ -93,7 +103,6 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
   for (const KDL::Wrench& f : f_ext)
     if (!allFinite(f.force) || !allFinite(f.torque)) return E_NOT_FINITE;
   const Vector3d& p_b = kin.p_b;  // the reference point of every spatial quantity
-  const std::vector<double>& armature = model_->armature();
   const double* qdot = velocity.qdot.data.data();
 
   // 1. Outward: twists, bias accelerations, rigid-body inertias and bias forces (Table 7.1's
@@ -146,10 +155,10 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
     }
     const Vector6d& S = kin.S[i];
     b.U = b.IA * S;
-    const double D = S.dot(b.U) + armature[b.joint];
+    const double D = S.dot(b.U) + b.armature;
     if (!(D > 0.0)) return E_NOT_POSITIVE_DEFINITE;
     b.D_inv = 1.0 / D;
-    b.u = tau(b.joint) - S.dot(b.pA);
+    b.u = (b.leads ? tau(b.joint) : 0.0) - S.dot(b.pA);  // a mimic joint's torque is its leader's (T^T tau)
     parent.IA.addMinusRank1(b.IA, b.U, b.D_inv);
     parent.pA += b.pA + b.U * (b.u * b.D_inv);
   }
@@ -165,12 +174,18 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
     const Vector6d& a_parent = data_[b.parent].a;
     if (b.moving) {
       const double qdd = (b.u - b.U.dot(a_parent)) * b.D_inv;
-      qddot_(b.joint) = qdd;
+      b.qdd = qdd;
+      if (b.leads) qddot_(b.joint) = qdd;
       b.a = a_parent + kin.S[i] * qdd;
     } else {
       if (b.joint >= 0) qddot_(b.joint) = 0.0;  // brakes on
+      b.qdd = 0.0;
       b.a = a_parent;
     }
+  }
+
+  if (coupling_[0].rows() > 0) {
+    if (const int rc = couple(kin, A0)) return rc;
   }
 
   // Gravity: the frame's acceleration -g undone; the base origin's classical acceleration.
@@ -182,6 +197,39 @@ KDL_SPACE_MULTIVERSION int ForwardDynamicsSolver::CartToJnt(const Kinematics& ki
   if (!base.allFinite() || !qddot_.allFinite()) return E_NOT_FINITE;
   acceleration.base = base;
   acceleration.qddot.data = qddot_;
+  return E_NOERROR;
+}
+
+}  // namespace kdl_space
+
+namespace kdl_space {
+
+// Mimic joints (algorithm/mimic_coupling.hpp): the free system's accelerations less the
+// couplings' share, a = a_free - M^-1 C^T S^-1 C a_free, from k more passes at zero velocity on
+// the articulated inertias of this state.
+int ForwardDynamicsSolver::couple(const Kinematics& kin, Vector6d& A0) {
+  detail::MimicCoupling& c = coupling_[0];
+  const int rc = c.compute([&](int i) { return data_[i].parent; }, [&](int i) { return data_[i].moving; },
+                           [&](int i) -> const Vector6d& { return kin.S[i]; },
+                           [&](int i) -> const Vector6d& { return data_[i].U; },
+                           [&](int i) { return data_[i].D_inv; },
+                           [&](const auto& P0, auto A0) {  // 6 x k blocks
+                             if (grounded_) {
+                               A0.setZero();
+                               return true;
+                             }
+                             for (Eigen::Index c = 0; c < P0.cols(); ++c) {
+                               Vector6d a;
+                               if (!data_[0].IA.solve(-Vector6d(P0.col(c)), a)) return false;
+                               A0.col(c) = a;
+                             }
+                             return true;
+                           });
+  if (rc != E_NOERROR) return rc;
+  c.solve([&](int i) { return data_[i].qdd; });
+  A0 -= c.baseShare();
+  const std::vector<int>& own = model_->jointBody();
+  for (unsigned int j = 0; j < model_->nj(); ++j) qddot_(j) -= c.qddShare(own[j]);
   return E_NOERROR;
 }
 

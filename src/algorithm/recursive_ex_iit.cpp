@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "algorithm/mimic_coupling.hpp"
 #include "algorithm/set_up.hpp"
 #include "multibody/joint_motion.hpp"
 #include "detail/multiversion.hpp"
@@ -12,7 +13,6 @@ namespace kdl_space {
 
 RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> model) : model_(std::move(model)) {
   if (!model_) throw ModelError("RecursiveExIITSolver: null model");
-  model_->refuseMimic("RecursiveExIITSolver");
   const std::size_t nb = model_->bodies().size();
   own_ = Kinematics(*model_);
   R_.assign(nb, Matrix3d::Identity());
@@ -38,6 +38,24 @@ RecursiveExIITSolver::RecursiveExIITSolver(std::shared_ptr<const FloatingModel> 
   locked_.assign(model_->nj(), false);
   moves_.resize(nb);
   for (std::size_t i = 0; i < nb; ++i) moves_[i] = model_->bodies()[i].joint >= 0;
+  qb_.assign(nb, 0.0);
+  // Mimic joints: every body's joint free in the recursion, the couplings imposed after it
+  // (algorithm/mimic_coupling.hpp); one set of responses per base (free-floating, grounded).
+  couplings_.free = std::make_unique<detail::MimicCoupling>(*model_);
+  couplings_.grounded = std::make_unique<detail::MimicCoupling>(*couplings_.free);
+}
+
+RecursiveExIITSolver::Couplings::Couplings() = default;
+RecursiveExIITSolver::Couplings::~Couplings() = default;
+RecursiveExIITSolver::Couplings::Couplings(const Couplings& other)
+    : free(other.free ? std::make_unique<detail::MimicCoupling>(*other.free) : nullptr),
+      grounded(other.grounded ? std::make_unique<detail::MimicCoupling>(*other.grounded) : nullptr) {}
+RecursiveExIITSolver::Couplings& RecursiveExIITSolver::Couplings::operator=(const Couplings& other) {
+  if (this == &other) return *this;
+  Couplings copy(other);
+  free = std::move(copy.free);
+  grounded = std::move(copy.grounded);
+  return *this;
 }
 
 void RecursiveExIITSolver::setLocked(const std::vector<bool>& locked) {
@@ -71,7 +89,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
   R_ = kin.R;  // the poses, kept for the contact queries (same sizes: no allocation)
   p_ = kin.p;
   S_ = kin.S;
-  const std::vector<double>& armature = model_->armature();
+  const detail::MimicCoupling& free = *couplings_.free;  // per body: the armature of the free system
   // Articulated-body inertias about p_b (world axes, four-lane blocks), leaves first. Body i's
   // is summed in registers: its rigid inertia, the articulated inertia of body i + 1 when that is
   // its child (carried from the step before: along a chain nothing goes through memory), and
@@ -95,7 +113,7 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
     if (i > 0 && moves_[i]) {
       const detail::Lanes S_top = detail::load3(kin.S[i].data()), S_bottom = detail::load3(kin.S[i].data() + 3);
       A.times(kin.S[i], top, bottom);
-      double D = detail::dot(S_top, S_bottom, top, bottom) + armature[j.joint];
+      double D = detail::dot(S_top, S_bottom, top, bottom) + free.armature(static_cast<int>(i));
       if (pending) {
         const double us = detail::dot(S_top, S_bottom, carried_top, carried_bottom), k = carried_Dinv * us;
         top -= k * carried_top;
@@ -125,8 +143,29 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::compute(const Kinematics& kin) 
     else IA_[j.parent] += A;
     carried_Dinv = 0.0;
   }
+  grounded_ready_ = false;
+  if (couplings_.free->rows() > 0) {
+    if (const int rc = couple(Response::FreeFloating)) return rc;
+  }
   computed_ = true;
   return E_NOERROR;
+}
+
+int RecursiveExIITSolver::couple(Response response) {
+  const std::vector<detail::JointMotion>& bodies = model_->motions().bodies;
+  const bool grounded = response == Response::Grounded;
+  if (grounded && grounded_ready_) return E_NOERROR;
+  detail::MimicCoupling& c = grounded ? *couplings_.grounded : *couplings_.free;
+  const int rc = c.compute([&](int i) { return bodies[i].parent; }, [&](int i) { return moves_[i] != 0; },
+                           [&](int i) -> const Vector6d& { return S_[i]; },
+                           [&](int i) -> const Vector6d& { return U_[i]; }, [&](int i) { return Dinv_[i]; },
+                           [&](const auto& P0, auto A0) {  // 6 x k blocks
+                             if (grounded) A0.setZero();  // a base of infinite inertia
+                             else A0.noalias() = (-Omega0_) * P0;
+                             return true;
+                           });
+  grounded_ready_ = grounded && rc == E_NOERROR;
+  return rc;
 }
 
 KDL::Frame RecursiveExIITSolver::bodyPose(int i) const {
@@ -206,6 +245,11 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::G(const Contact& h, Response re
   result.topRightCorner<3, 3>() = e;
   result.bottomLeftCorner<3, 3>() = e.transpose();
   result.bottomRightCorner<3, 3>() = O.bottomRightCorner<3, 3>();
+  if (couplings_.free->rows() > 0) {  // mimic joints: the couplings' share (algorithm/mimic_coupling.hpp)
+    if (const int rc = couple(response)) return rc;
+    (response == Response::Grounded ? *couplings_.grounded : *couplings_.free)
+        .correctG(transfer(R_[h.body] * toEigen(h.offset) + p_[h.body] - p_b_), h.body, result);
+  }
   symmetrize(result);  // symmetric up to round-off: exactly so, as the dense route's
   if (!result.allFinite()) return E_NOT_FINITE;
   G = result;
@@ -265,23 +309,33 @@ KDL_SPACE_MULTIVERSION int RecursiveExIITSolver::velocityJump(const Contact& h, 
     const int parent = b.parent;
     if (!moves_[i]) {
       a_[i] = a_[parent];
-      if (b.joint >= 0) dq_(b.joint) = 0.0;  // braked: exactly no jump
+      qb_[i] = 0.0;  // braked (or fixed): exactly no jump
       continue;
     }
     double Ua;
     if (parent > 0 && moves_[parent]) {
-      const double qdd_parent = parent == static_cast<int>(i) - 1 ? qdd_before : dq_(bodies[parent].joint);
+      const double qdd_parent = parent == static_cast<int>(i) - 1 ? qdd_before : qb_[parent];
       Ua = dot(U_[i], a_[bodies[parent].parent]) + dot(U_[i], S_[parent]) * qdd_parent;
     } else {
       Ua = dot(U_[i], a_[parent]);
     }
     const double qdd = -(Sp_[i] + Ua) * Dinv_[i];
-    dq_(b.joint) = qdd;
+    qb_[i] = qdd;
     qdd_before = qdd;
     detail::store3(load3(a_[parent].data()) + load3(S_[i].data()) * qdd, a_[i].data());
     detail::store3(load3(a_[parent].data() + 3) + load3(S_[i].data() + 3) * qdd, a_[i].data() + 3);
   }
   for (int k = 0; k < count - 1; ++k) Sp_[path_[k]] = 0.0;  // zero off the path, as it was
+  const std::vector<int>& own = model_->jointBody();
+  if (couplings_.free->rows() == 0) {
+    for (unsigned int j = 0; j < model_->nj(); ++j) dq_(j) = qb_[own[j]];
+  } else {  // mimic joints: the couplings' impulses take back C dq (algorithm/mimic_coupling.hpp)
+    if (const int rc = couple(response)) return rc;
+    detail::MimicCoupling& c = response == Response::Grounded ? *couplings_.grounded : *couplings_.free;
+    c.solve([&](int i) { return qb_[i]; });
+    a_[0] -= c.baseShare();
+    for (unsigned int j = 0; j < model_->nj(); ++j) dq_(j) = qb_[own[j]] - c.qddShare(own[j]);
+  }
   if (!a_[0].allFinite() || !dq_.allFinite()) return E_NOT_FINITE;
   d_base_twist = a_[0];  // the twist jump at p_b is the base twist jump
   dqdot.data = dq_;

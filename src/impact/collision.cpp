@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "multibody/mimic_route.hpp"
 #include "detail/text.hpp"
 #include "multibody/model_rules.hpp"
 
@@ -72,7 +73,11 @@ FloatingSide::FloatingSide(std::shared_ptr<const FloatingModel> model, Kinematic
   if (!kin_.valid) refuse("the kinematics", E_NOT_COMPUTED);
   if (response_ == Response::JointsLocked) {
     // eq. 20: no recursion
-  } else if (method == ExIITMethod::Recursive && model_->mimic().empty()) {  // mimic joints: dense
+  } else if (method == ExIITMethod::Recursive &&
+             detail::mimicGStarTakesRecursion(model_->nj(), model_->mimic().size())) {
+    // Mimic joints: the recursion with the couplings as constraints (O(n k + k^3)) where it was
+    // measured faster for G* than the dense route, i.e. few of them (4 k <= n: two grippers on a
+    // long body); else the dense route (a hand, k growing with n: docs/benchmarks.md, "Mimic joints").
     recursive_ = std::make_unique<RecursiveExIITSolver>(model_);
     recursive_->setLocked(locked_);  // sizes checked above
   } else {

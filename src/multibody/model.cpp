@@ -11,6 +11,7 @@
 #include "multibody/joint_motion.hpp"
 #include "detail/text.hpp"
 #include "multibody/model_build.hpp"
+#include "multibody/mimic_route.hpp"
 #include "multibody/model_rules.hpp"
 
 namespace kdl_space {
@@ -135,9 +136,13 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
                mimic_.end());
   build(detail::kdlInertia(links.front().body), armature);
   if (!mimic_.empty())
-    diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: G*, the velocity "
-                                "jumps and the capture take the dense route (the O(n) recursion cannot couple joints)",
-                            "dense_route", Severity::Note});
+    diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: the motion's "
+                                "O(n) recursion imposes the couplings as constraints; G*, the velocity jumps "
+                                "and the capture take " +
+                                    std::string(detail::mimicGStarTakesRecursion(nj(), mimic_.size())
+                                                    ? "it too (few mimic joints: 4 k <= n, faster there)"
+                                                    : "the dense route (many mimic joints: 4 k > n, faster there)"),
+                            "mimic_constraints", Severity::Note});
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
   validate();
@@ -241,8 +246,8 @@ void FloatingModel::refuseMimic(const std::string& who) const {
   std::vector<std::string> names;
   for (const Mimic& m : mimic_) names.push_back(detail::quoted(m.joint));
   throw ModelError(who + ": the model has mimic joints (" + detail::listNames(names) +
-                   "): the O(n) recursion cannot couple joints; use the dense route (FreeFloatingSolver, "
-                   "ExIITMethod::Dense)");
+                   "): coupled joints are not supported here; remove the <mimic> elements to treat them as "
+                   "free joints");
 }
 
 int FloatingModel::jointIndex(const std::string& name) const {

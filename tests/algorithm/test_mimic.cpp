@@ -1,11 +1,16 @@
 // Mimic joints (issue 12, item 5): a joint that follows another is not a coordinate; J*, H*, G*
 // and the velocity jump use the coupled coordinates (J T, T^T H T). Checked against the same
 // robot read without its <mimic> elements, with the coupling written out by hand.
+// Issue 28: the O(n) recursions (RecursiveExIITSolver, ForwardDynamicsSolver) carry the couplings
+// as constraints (src/algorithm/mimic_coupling.hpp): checked against the dense route.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <cmath>
+#include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/algorithm/dense_forward_dynamics.hpp"
@@ -15,6 +20,8 @@
 #include "kdl_space/simulation/simulation.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "generated_chain.hpp"
+#include "multibody/mimic_route.hpp"
 
 namespace kdl_space {
 namespace {
@@ -117,21 +124,158 @@ TEST(Mimic, CoupledCoordinatesEqualTheHandCoupledModel) {
   }
 }
 
-TEST(Mimic, TheRecursionsRefuseACoupledModelByName) {
-  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
-  for (int which = 0; which < 2; ++which) {  // the recursions; the simulation takes the dense route
-    try {
-      if (which == 0) RecursiveExIITSolver solver(coupled);
-      else ForwardDynamicsSolver solver(coupled);
-      ADD_FAILURE() << "a recursion accepted a model with mimic joints";
-    } catch (const ModelError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("'right_finger'"), std::string::npos) << what;
-      EXPECT_NE(what.find("'camera_tilt'"), std::string::npos) << what;
+/// A hand on an arm (issue 28): several mimic joints, one of which follows a mimic joint (the
+/// distal phalanx follows the middle one, which follows the proximal one: the model composes the
+/// chain down to a coordinate), on `fingers` fingers; the thumb's distal joint follows the wrist
+/// (a leader on another branch, and one that is no finger's).
+std::string hand(int fingers) {
+  std::string xml = R"(<?xml version="1.0"?><robot name="h">)" + link("base", 80.0, 0.0) +
+                    joint("shoulder", "base", "upper", "0 0 0.5", "0 0 1") + link("upper", 3.0, 0.2) +
+                    joint("elbow", "upper", "fore", "0.4 0 0", "0 1 0") + link("fore", 2.0, 0.2) +
+                    joint("wrist", "fore", "palm", "0.4 0 0", "1 0 0") + link("palm", 0.6, 0.05);
+  for (int f = 0; f < fingers; ++f) {
+    const std::string n = "f" + std::to_string(f), y = std::to_string(0.03 * f - 0.04);
+    const std::string follow_middle = R"(<mimic joint=")" + n + R"(_proximal" multiplier="0.8" offset="0.05"/>)";
+    const std::string follow_distal = f == 0 ? R"(<mimic joint="wrist" multiplier="-0.3"/>)"
+                                             : R"(<mimic joint=")" + n + R"(_middle" multiplier="1.2" offset="-0.02"/>)";
+    xml += joint(n + "_proximal", "palm", n + "_1", "0.08 " + y + " 0", "0 1 0") + link(n + "_1", 0.05, 0.02) +
+           joint(n + "_middle", n + "_1", n + "_2", "0.04 0 0", "0 1 0", follow_middle) + link(n + "_2", 0.04, 0.015) +
+           joint(n + "_distal", n + "_2", n + "_3", "0.03 0 0", "0 1 0", follow_distal) + link(n + "_3", 0.03, 0.01);
+  }
+  return xml + "</robot>";
+}
+
+/// The models of the O(n)-route tests: the gripper (two mimic joints on two branches) and a
+/// three-finger hand (six, two of them mimics of mimics).
+std::vector<std::shared_ptr<const FloatingModel>> coupledModels() {
+  return {std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf")),
+          std::make_shared<const FloatingModel>(loadUrdfString(hand(3), "hand.urdf"))};
+}
+
+/// A random state of a model (base pose and joint values in [-1, 1]).
+State randomState(std::mt19937& rng, const FloatingModel& model) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  State s(model);
+  s.world_T_base = KDL::Frame(KDL::Rotation::RPY(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+  for (unsigned int j = 0; j < model.nj(); ++j) s.q(j) = u(rng);
+  return s;
+}
+
+TEST(Mimic, TheHandComposesItsChainsOfMimicJoints) {
+  const auto model = coupledModels()[1];
+  EXPECT_EQ(model->nj(), 6u);  // shoulder, elbow, wrist and three proximal joints
+  EXPECT_EQ(model->mimic().size(), 6u);
+  // f1_distal = 1.2 (0.8 q + 0.05) - 0.02 of f1_proximal: the chain composed (model_build).
+  for (const Body& b : model->bodies()) {
+    if (b.name != "f1_3") continue;
+    EXPECT_EQ(b.joint, model->jointIndex("f1_proximal"));
+    EXPECT_NEAR(b.multiplier, 0.96, 1e-15);
+    EXPECT_NEAR(b.offset, 0.04, 1e-15);
+  }
+}
+
+TEST(Mimic, TheRecursiveExIITEqualsTheDenseRoute) {
+  // G* (free-floating) and G (grounded) at contacts on every branch, and the velocity jumps, by
+  // the O(n) recursion with the couplings as constraints against the dense T^T H T route; also
+  // with a braked leader (its followers brake with it) and a braked non-leader.
+  std::mt19937 rng(28);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const auto& model : coupledModels()) {
+    const unsigned int n = model->nj();
+    for (int lock = 0; lock < 3; ++lock) {
+      std::vector<bool> locked(n, false);
+      if (lock == 1) locked[1] = true;      // the elbow: leads the gripper's camera tilt
+      if (lock == 2) locked[n - 1] = true;  // the last coordinate: a finger leading the mimics
+      RecursiveExIITSolver fast(model);
+      FreeFloatingSolver dense(model);
+      fast.setLocked(locked);
+      dense.setLocked(locked);
+      for (int trial = 0; trial < 4; ++trial) {
+        const State s = randomState(rng, *model);
+        ASSERT_EQ(fast.compute(s), 0);
+        ASSERT_EQ(dense.compute(s), 0);
+        for (std::size_t body = 1; body < model->bodies().size(); ++body) {
+          const Contact h{static_cast<int>(body), KDL::Vector(u(rng) * 0.05, u(rng) * 0.05, u(rng) * 0.05)};
+          for (Response response : {Response::FreeFloating, Response::Grounded}) {
+            Matrix6d Gf, Gd;
+            ASSERT_EQ(fast.G(h, response, Gf), 0);
+            ASSERT_EQ(dense.G(h, response, Gd), 0);
+            EXPECT_LT((Gf - Gd).norm(), 1e-10 * Gd.norm())
+                << model->bodies()[body].name << " lock " << lock << "\n" << Gf << "\n\n" << Gd;
+            const Vector6d F = (Vector6d() << u(rng), u(rng), u(rng), u(rng), u(rng), u(rng)).finished();
+            Vector6d d_base, dPL_g;
+            KDL::JntArray dq_fast(n), dq_dense(n);
+            ASSERT_EQ(fast.velocityJump(h, response, F, d_base, dq_fast), 0);
+            ASSERT_EQ(dense.velocityJump(h, response, F, dPL_g, dq_dense), 0);
+            EXPECT_LT((dq_fast.data - dq_dense.data).norm(), 1e-10 * (1.0 + dq_dense.data.norm()))
+                << model->bodies()[body].name << " " << dq_fast.data.transpose() << " vs " << dq_dense.data.transpose();
+            for (unsigned int j = 0; j < n; ++j)
+              if (locked[j]) EXPECT_EQ(dq_fast(j), 0.0);
+            if (response == Response::Grounded) {
+              EXPECT_EQ(d_base, Vector6d::Zero());
+            } else {  // the dense route's momentum jump, as a base twist (both start from rest)
+              KDL::Twist base;
+              ASSERT_EQ(dense.baseTwist(dPL_g, dq_dense, base), 0);
+              EXPECT_LT((d_base - toEigen(base)).norm(), 1e-10 * (1.0 + d_base.norm())) << d_base.transpose();
+            }
+          }
+        }
+      }
     }
   }
+}
+
+TEST(Mimic, TheArticulatedBodyForwardDynamicsEqualsTheDenseRoute) {
+  // ForwardDynamicsSolver (the couplings as constraints) against DenseForwardDynamicsSolver
+  // (checked against the hand-coupled robot below): velocities, torques, wrenches on every body,
+  // gravity, a free-floating and a grounded base, a braked leader.
+  std::mt19937 rng(280);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const auto& model : coupledModels()) {
+    const unsigned int n = model->nj();
+    const std::size_t nb = model->bodies().size();
+    for (int variant = 0; variant < 3; ++variant) {
+      const bool grounded = variant == 1;
+      std::vector<bool> locked(n, false);
+      if (variant == 2) locked[n - 1] = true;
+      ForwardDynamicsSolver fast(model);
+      DenseForwardDynamicsSolver dense(model);
+      fast.setGravity(Vector3d(0.1, 0.0, -9.81));
+      dense.setGravity(Vector3d(0.1, 0.0, -9.81));
+      fast.setGrounded(grounded);
+      dense.setGrounded(grounded);
+      fast.setLocked(locked);
+      dense.setLocked(locked);
+      for (int trial = 0; trial < 5; ++trial) {
+        const State s = randomState(rng, *model);
+        FloatingVelocity v{grounded ? KDL::Twist::Zero()
+                                    : KDL::Twist(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng))),
+                           KDL::JntArray(n)};
+        KDL::JntArray tau(n);
+        for (unsigned int j = 0; j < n; ++j) {
+          v.qdot(j) = locked[j] ? 0.0 : 2.0 * u(rng);
+          tau(j) = u(rng);
+        }
+        std::vector<KDL::Wrench> f_ext(nb);
+        for (KDL::Wrench& w : f_ext) w = KDL::Wrench(KDL::Vector(u(rng), u(rng), u(rng)), KDL::Vector(u(rng), u(rng), u(rng)));
+        FloatingAcceleration af{Vector6d::Zero(), KDL::JntArray(n)}, ad{Vector6d::Zero(), KDL::JntArray(n)};
+        ASSERT_EQ(fast.CartToJnt(s, v, tau, f_ext, af), 0);
+        ASSERT_EQ(dense.CartToJnt(s, v, tau, f_ext, ad), 0);
+        EXPECT_LT((af.qddot.data - ad.qddot.data).norm(), 1e-10 * (1.0 + ad.qddot.data.norm()))
+            << "variant " << variant << ": " << af.qddot.data.transpose() << " vs " << ad.qddot.data.transpose();
+        EXPECT_LT((af.base - ad.base).norm(), 1e-10 * (1.0 + ad.base.norm()))
+            << af.base.transpose() << " vs " << ad.base.transpose();
+        for (unsigned int j = 0; j < n; ++j)
+          if (locked[j]) EXPECT_EQ(af.qddot(j), 0.0);
+      }
+    }
+  }
+}
+
+TEST(Mimic, TheModelSaysHowTheRecursionsCoupleJoints) {
+  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
   int notes = 0;
-  for (const Diagnostic& d : coupled->diagnostics()) notes += d.kind == "mimic_joint" || d.kind == "dense_route";
+  for (const Diagnostic& d : coupled->diagnostics()) notes += d.kind == "mimic_joint" || d.kind == "mimic_constraints";
   EXPECT_EQ(notes, 3);
 }
 
@@ -181,24 +325,24 @@ TEST(Mimic, DenseForwardDynamicsIsTheHandCoupledDynamics) {
 }
 
 TEST(Mimic, TheMotionOfACoupledRobotKeepsItsEnergyAndMomentum) {
-  // In orbit, no torques: the coupled motion conserves energy and momentum (the simulation
-  // takes the dense route by itself).
-  const auto coupled = std::make_shared<const FloatingModel>(loadUrdfString(gripper(true), "mimic.urdf"));
-  Simulator simulator(coupled);
-  SimulationState s{0.0, State(*coupled), FloatingVelocity{KDL::Twist(KDL::Vector(0.01, 0.0, -0.02),
-                                                                      KDL::Vector(0.02, -0.01, 0.03)),
-                                                           KDL::JntArray(3)}};
-  s.velocity.qdot(0) = 0.4;
-  s.velocity.qdot(1) = -0.3;
-  s.velocity.qdot(2) = 0.8;
-  double T0 = 0.0, T1 = 0.0;
-  Vector6d h0, h1;
-  ASSERT_EQ(simulator.energyAndMomentum(s, T0, h0), 0);
-  ASSERT_EQ(simulator.run(s, 2.0, 0.5, [](const SimulationState&) {}), 0);
-  ASSERT_EQ(simulator.energyAndMomentum(s, T1, h1), 0);
-  EXPECT_NEAR(T1, T0, 1e-8 * T0);
-  EXPECT_LT((h1 - h0).norm(), 1e-8 * h0.norm());
-  EXPECT_GT((s.state.q.data).norm(), 0.1);  // it moved
+  // In orbit, no torques: the coupled motion conserves energy and momentum (the simulation runs
+  // the articulated-body recursion with the couplings as constraints; a constraint force that did
+  // work, or a coupling that drifted, would show).
+  for (const auto& coupled : coupledModels()) {
+    Simulator simulator(coupled);
+    SimulationState s{0.0, State(*coupled), FloatingVelocity{KDL::Twist(KDL::Vector(0.01, 0.0, -0.02),
+                                                                        KDL::Vector(0.02, -0.01, 0.03)),
+                                                             KDL::JntArray(coupled->nj())}};
+    for (unsigned int j = 0; j < coupled->nj(); ++j) s.velocity.qdot(j) = 0.8 * std::sin(1.7 * j + 0.4);
+    double T0 = 0.0, T1 = 0.0;
+    Vector6d h0, h1;
+    ASSERT_EQ(simulator.energyAndMomentum(s, T0, h0), 0);
+    ASSERT_EQ(simulator.run(s, 2.0, 0.5, [](const SimulationState&) {}), 0);
+    ASSERT_EQ(simulator.energyAndMomentum(s, T1, h1), 0);
+    EXPECT_NEAR(T1, T0, 1e-8 * T0);
+    EXPECT_LT((h1 - h0).norm(), 1e-8 * h0.norm());
+    EXPECT_GT((s.state.q.data).norm(), 0.1);  // it moved
+  }
 }
 
 TEST(Mimic, JointsThatFollowEachOtherAreRefused) {
@@ -236,6 +380,55 @@ TEST(Mimic, ALeaderThatIsNoMovableJointIsRefusedByLoaderAndCheck) {
     ASSERT_EQ(report.errors.size(), 1u);
     EXPECT_EQ(report.errors[0].kind, "bad_mimic");
     EXPECT_EQ(std::string(e.what()), "bad.urdf: " + describe(report.errors[0]));
+  }
+}
+
+// The capture's route for mimic models (issue 28): the recursion where few joints are mimic
+// (4 k <= n, measured faster: docs/benchmarks.md), the dense route where many are.
+TEST(Mimic, TheCaptureTakesTheRecursionForFewMimicJointsAndTheDenseRouteForMany) {
+  EXPECT_TRUE(detail::mimicGStarTakesRecursion(16, 4));   // grippers N=20: 1.3x faster measured
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(15, 4));  // just beyond the rule
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(6, 4));   // grippers N=10: 0.88x
+  EXPECT_FALSE(detail::mimicGStarTakesRecursion(68, 32)); // hands N=100: 0.7x
+  EXPECT_TRUE(detail::mimicGStarTakesRecursion(7, 0));    // no mimic joint
+  // The model's note says which route its capture takes, on both sides of the rule.
+  const auto note = [](const std::string& urdf) {
+    const FloatingModel model = loadUrdfString(urdf, "generated.urdf");
+    for (const Diagnostic& d : model.diagnostics())
+      if (d.kind == "mimic_constraints") return d.message;
+    return std::string();
+  };
+  EXPECT_NE(note(bench::generatedGrippersUrdf(30)).find("take it too"), std::string::npos)
+      << note(bench::generatedGrippersUrdf(30));
+  EXPECT_NE(note(bench::generatedGrippersUrdf(10)).find("take the dense route"), std::string::npos);
+  EXPECT_NE(note(bench::generatedHandsUrdf(50)).find("take the dense route"), std::string::npos);
+}
+
+TEST(Mimic, ACaptureOnTheRecursiveRouteEqualsTheDenseRoute) {
+  const auto model = std::make_shared<const FloatingModel>(loadUrdfString(bench::generatedGrippersUrdf(30), "g.urdf"));
+  const unsigned int n = model->nj();
+  ASSERT_EQ(model->mimic().size(), 4u);
+  ASSERT_TRUE(detail::mimicGStarTakesRecursion(n, 4));
+  State state(*model);
+  state.world_T_base = KDL::Frame(KDL::Rotation::RPY(0.1, -0.2, 0.3), KDL::Vector(0.3, -0.2, 0.1));
+  FloatingVelocity v{KDL::Twist(KDL::Vector(0.01, -0.005, 0.002), KDL::Vector(0.003, 0.02, -0.01)), KDL::JntArray(n)};
+  for (unsigned int j = 0; j < n; ++j) {
+    state.q(j) = std::sin(1.3 * j + 0.2);
+    v.qdot(j) = 0.1 - 0.02 * (j % 7);
+  }
+  const Contact h = model->contact("tip");
+  Vector6d F;
+  F << 3.0, -2.0, 1.5, 0.4, -0.3, 0.2;
+  for (Response r : {Response::FreeFloating, Response::Grounded}) {
+    SCOPED_TRACE(r == Response::FreeFloating ? "free" : "grounded");
+    FloatingSide fast(model, state, h, v, r, ExIITMethod::Recursive), dense(model, state, h, v, r, ExIITMethod::Dense);
+    EXPECT_LE((fast.G() - dense.G()).norm(), 1e-10 * dense.G().norm());
+    ASSERT_EQ(fast.applyImpulse(F), 0);
+    ASSERT_EQ(dense.applyImpulse(F), 0);
+    EXPECT_LE((fast.after().qdot.data - dense.after().qdot.data).norm(), 1e-10 * (1.0 + dense.after().qdot.data.norm()));
+    EXPECT_LE((toEigen(fast.after().base_twist) - toEigen(dense.after().base_twist)).norm(),
+              1e-10 * (1.0 + toEigen(dense.after().base_twist).norm()));
+    EXPECT_LE((fast.contactTwistAfter() - dense.contactTwistAfter()).norm(), 1e-10 * (1.0 + dense.contactTwistAfter().norm()));
   }
 }
 

@@ -295,7 +295,7 @@ TEST(LockedJointsSide, JointsLockedAcceptsASubset) {
   EXPECT_EQ(subset.G(), all.G());
 }
 
-// A mimic leader braked brakes its follower (the dense route, which every mimic model takes):
+// A mimic leader braked brakes its follower (the dense route, which a capture side of a mimic model takes):
 // the same as the model with both joints fixed.
 TEST(LockedJointsSide, ABrakedMimicLeaderBrakesItsFollower) {
   const std::string urdf = R"(<robot name="m">

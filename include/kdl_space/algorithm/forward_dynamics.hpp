@@ -17,6 +17,9 @@
 #include "kdl_space/multibody/state.hpp"
 
 namespace kdl_space {
+namespace detail {
+class MimicCoupling;  // src/algorithm/mimic_coupling.hpp: mimic joints as constraints
+}
 
 /// Generalized acceleration of a free-floating system, world frame.
 struct FloatingAcceleration {
@@ -39,6 +42,9 @@ struct FloatingAcceleration {
 /// acceleration follows, p_b'' = A_0,v + w x v_b.
 /// Locked joints (brakes on) are fixed joints in steps 2 and 3 (qddot = 0; their torque is
 /// whatever holds them); a locked joint that still moves keeps its velocity product in step 1.
+/// Mimic joints: every joint free in the recursion, then a = a_free - M^-1 C^T S^-1 C a_free from k
+/// more passes on the same articulated inertias (src/algorithm/mimic_coupling.hpp; O(n k + k^3); its
+/// being allocation-free is not yet proved by tests/alloc for such a model).
 /// Workspaces are sized in the constructor; CartToJnt allocates nothing and never throws.
 class KDL_SPACE_EXPORT ForwardDynamicsSolver {
  public:
@@ -91,6 +97,11 @@ class KDL_SPACE_EXPORT ForwardDynamicsSolver {
   Kinematics own_;                 ///< for CartToJnt(State) only
   std::vector<BodyData> data_;     ///< per body
   Eigen::VectorXd qddot_;          ///< joint accelerations before they are returned (n)
+  /// Mimic joints as constraints on the recursion (src/algorithm/mimic_coupling.hpp; one element,
+  /// with no rows for a model without mimic joints).
+  std::vector<detail::MimicCoupling> coupling_;
+  /// The couplings' share taken from qddot_ and the base's acceleration A0 (mimic joints).
+  int couple(const Kinematics& kin, Vector6d& A0);
 };
 
 }  // namespace kdl_space

@@ -18,6 +18,7 @@
 namespace kdl_space {
 namespace detail {
 struct LaneSymmetric6d;  // src/detail/lane_symmetric6d.hpp: a symmetric 6x6 in four-lane blocks
+class MimicCoupling;     // src/algorithm/mimic_coupling.hpp: mimic joints as constraints
 }
 
 /// \brief G* at one contact point and the velocity jump of the whole robot from an impulse there,
@@ -36,6 +37,9 @@ struct LaneSymmetric6d;  // src/detail/lane_symmetric6d.hpp: a symmetric 6x6 in 
 /// -(I^A_0)^-1 p^A_0, and the joints' jumps outward.
 /// Joints braked at the impact (setLocked) are fixed joints to all three: their bodies' articulated
 /// inertias pass to the parent whole, the path skips them, their rate jumps are exactly 0.
+/// Mimic joints: the recursion runs every joint free and imposes the k couplings by their Lagrange
+/// multipliers (src/algorithm/mimic_coupling.hpp): k more passes per compute (per base kind), then
+/// G_c = G - (J Y) S^-1 (J Y)^T and the jumps less the couplings' share; O(n k + k^3).
 /// Compute calls return 0 or an Error code and never throw.
 class KDL_SPACE_EXPORT RecursiveExIITSolver {
  public:
@@ -109,6 +113,20 @@ class KDL_SPACE_EXPORT RecursiveExIITSolver {
   std::vector<Vector6d> a_;                        ///< scratch: velocity jumps per body
   Eigen::VectorXd dq_;                             ///< scratch: joint-rate jumps (n)
   std::vector<double> Sp_;                         ///< scratch: S^T p, the bias force along the joint (zero off the path)
+  std::vector<double> qb_;                         ///< scratch: joint-rate jumps per body (a mimic body's own)
+  /// Mimic joints (none: rows() == 0): the couplings' responses for a free-floating and a grounded
+  /// base (the latter made at its first query after a compute). A copy is a deep copy.
+  struct Couplings {
+    Couplings();
+    Couplings(const Couplings& other);
+    Couplings& operator=(const Couplings& other);
+    ~Couplings();
+    std::unique_ptr<detail::MimicCoupling> free, grounded;
+  };
+  Couplings couplings_;
+  bool grounded_ready_ = false;
+  /// The couplings' responses for `response`'s base at the last compute's state (once per compute).
+  int couple(Response response);
 };
 
 }  // namespace kdl_space

@@ -92,8 +92,8 @@ class KDL_SPACE_EXPORT FloatingModel {
   /// \param armature optional rotor inertia per joint of `tree` (its q_nr order), added to H's
   /// diagonal; kept for the joints that stay coordinates.
   /// \throws ModelError naming the link or joint when the model cannot be used.
-  /// \param mimic joints that follow others: they are not coordinates (J T, T^T H T); the O(n)
-  /// solvers refuse such a model, the dense ones and the capture's sides use the coupling.
+  /// \param mimic joints that follow others: they are not coordinates (J T, T^T H T); the dense
+  /// solvers use the coupling, the O(n) ones impose it as constraints (algorithm/mimic_coupling.hpp).
   FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia& base_inertia,
                 std::vector<double> armature = {}, std::vector<Diagnostic> diagnostics = {},
                 std::vector<Mimic> mimic = {});
@@ -105,7 +105,7 @@ class KDL_SPACE_EXPORT FloatingModel {
   /// The joints that follow others (not coordinates).
   const std::vector<Mimic>& mimic() const { return mimic_; }
   /// \brief Throws ModelError naming `who` and the mimic joints when the model has any: for the
-  /// O(n) recursions, which cannot couple joints (the dense solvers can).
+  /// computations that cannot couple joints (inverse kinematics; the solvers all can).
   void refuseMimic(const std::string& who) const;
   /// Number of movable joints n (the coordinates: mimic joints are not).
   unsigned int nj() const { return static_cast<unsigned int>(joint_names_.size()); }
