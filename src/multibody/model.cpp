@@ -135,14 +135,17 @@ FloatingModel::FloatingModel(const KDL::Tree& tree, const KDL::RigidBodyInertia&
                               }),
                mimic_.end());
   build(detail::kdlInertia(links.front().body), armature);
-  if (!mimic_.empty())
+  // The note's kind says where G* runs: `dense_route` (the kind of this note before the recursion
+  // took mimic joints, kept for the same meaning), `mimic_constraints` when the recursion takes it.
+  if (!mimic_.empty()) {
+    const bool recursion = detail::mimicGStarTakesRecursion(nj(), mimic_.size());
     diagnostics_.push_back({"", std::to_string(mimic_.size()) + " mimic joint(s) follow other joints: the motion's "
                                 "O(n) recursion imposes the couplings as constraints; G*, the velocity jumps "
                                 "and the capture take " +
-                                    std::string(detail::mimicGStarTakesRecursion(nj(), mimic_.size())
-                                                    ? "it too (few mimic joints: 4 k <= n, faster there)"
-                                                    : "the dense route (many mimic joints: 4 k > n, faster there)"),
-                            "mimic_constraints", Severity::Note});
+                                    std::string(recursion ? "it too (few mimic joints: 4 k <= n, faster there)"
+                                                          : "the dense route (many mimic joints: 4 k > n, faster there)"),
+                            recursion ? "mimic_constraints" : "dense_route", Severity::Note});
+  }
   joint_properties_.assign(nj(), JointProperties{});
   checkArmature();
   validate();
