@@ -141,6 +141,9 @@ TEST(LoadScenario, EveryShippedAndTestScenarioLoadsAndSolves) {
       ASSERT_TRUE(s.capture.robot.model);
       ++count;
       if (!s.impact) continue;  // a plain motion: no impact to solve
+      // A robot target's approach: the two touch where the approach ends, not at the start (its
+      // capture there: tests/operation/test_approach_robot_target.cpp).
+      if (s.approach && std::holds_alternative<FloatingSystem>(s.capture.target)) continue;
       const bool point = s.capture.law.kind == ImpactKind::PointImpact || s.capture.law.kind == ImpactKind::FrictionalImpact;
       if (point) EXPECT_TRUE(s.capture.has_normal);
       EXPECT_NO_THROW(solveCapture(s.capture));

@@ -317,10 +317,13 @@ ApproachSpec robotTargetApproach(const Field& approach, const Field& target, con
                               " (the capture joins the two contact points): leave it out or give that");
   const double touch = capture.touch_tolerance;
   const bool given = approach.has("tolerance") && approach.at("tolerance").has("position");
-  if (!given) a.position_tolerance = touch;
-  else if (a.position_tolerance > touch)
+  // Half the touch by default: the approach ends where the distance first falls to its tolerance
+  // (located to round-off), and the capture checks the touch by its own route; at the touch itself
+  // that check could fail by round-off.
+  if (!given) a.position_tolerance = 0.5 * touch;
+  else if (!(a.position_tolerance < touch))
     approach.at("tolerance").at("position").fail(
-        "must be at most " + number(touch) + " m for a robot target: the capture joins the hand to the target's "
+        "must be less than " + number(touch) + " m for a robot target: the capture joins the hand to the target's "
         "contact point, which must touch within " + number(touch) + " m, got " + number(a.position_tolerance));
   return a;
 }
