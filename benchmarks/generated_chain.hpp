@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ostream>
 #include <sstream>
 #include <string>
 
@@ -52,6 +53,15 @@ inline std::string generatedChainUrdf(int N) {
   return u.str();
 }
 
+/// A revolute joint of the generated humanoids (limits +-3 rad, 100 N m, 1 rad/s), yawed at its
+/// origin, with `mimic` (a <mimic> element, or "") inside.
+inline void revoluteJoint(std::ostream& u, const std::string& name, const std::string& parent, const std::string& child,
+                          const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
+  u << "<joint name=\"" << name << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << child
+    << "\"/><origin xyz=\"" << xyz << "\" rpy=\"0 0 " << yaw << "\"/><axis xyz=\"" << axis
+    << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
+}
+
 /// A humanoid's upper body with coupled fingers, N movable joints in all: a 500 kg torso, two arms
 /// of (N - 6F) / 2 revolute joints each (as the chain's links), each arm ending in a hand of
 /// F = max(1, round(N / 12)) three-joint fingers whose middle and distal joints follow the proximal
@@ -66,9 +76,7 @@ inline std::string generatedHandsUrdf(int N) {
   const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
   const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
                          const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
-    u << "<joint name=\"" << name << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << child
-      << "\"/><origin xyz=\"" << xyz << "\" rpy=\"0 0 " << yaw << "\"/><axis xyz=\"" << axis
-      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
+    revoluteJoint(u, name, parent, child, xyz, yaw, axis, mimic);
   };
   for (int side = 0; side < 2; ++side) {
     const std::string s = side == 0 ? "r" : "l";
@@ -116,9 +124,7 @@ inline std::string generatedGrippersUrdf(int N) {
   const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
   const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
                          const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
-    u << "<joint name=\"" << name << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << child
-      << "\"/><origin xyz=\"" << xyz << "\" rpy=\"0 0 " << yaw << "\"/><axis xyz=\"" << axis
-      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
+    revoluteJoint(u, name, parent, child, xyz, yaw, axis, mimic);
   };
   for (int side = 0; side < 2; ++side) {
     const std::string s = side == 0 ? "r" : "l";
