@@ -53,7 +53,9 @@ class MimicCoupling {
     u_.setZero(k, nb);
     row_.setZero(k);
     S_.setZero(k, k);
-    llt_ = Eigen::LLT<Eigen::MatrixXd>(k);
+    // Sized here, so that compute() allocates nothing later. Not `llt_ = LLT(k)`: Eigen 3.4's
+    // LLT(size) leaves its info unset and the move assignment reads it (UBSan: an invalid enum).
+    llt_.compute(Eigen::MatrixXd::Identity(k, k));
     c_.setZero(k);
     lambda_.setZero(k);
     Y_.setZero(6, k);
