@@ -87,10 +87,15 @@ class Probe {
     return out;
   }
   /// Splits the joined state into each side's own state and velocity, and their momenta.
-  void split(const SimulationState& s, FloatingVelocity& rv, FloatingVelocity& tv, Vector6d& h_r, Vector6d& h_t) {
+  void split(const SimulationState& s, FloatingSystem& r_end, FloatingSystem& t_end, Vector6d& h_r, Vector6d& h_t) {
     const FloatingModel& rm = *robot_.model;
     const FloatingModel& tm = *target_.model;
-    State rs(rm), ts(tm);
+    r_end = robot_;
+    t_end = target_;
+    State& rs = r_end.state;
+    State& ts = t_end.state;
+    FloatingVelocity& rv = r_end.velocity;
+    FloatingVelocity& tv = t_end.velocity;
     rs.world_T_base = s.state.world_T_base;
     rv = FloatingVelocity(rm);
     rv.base_twist = s.velocity.base_twist;
@@ -135,10 +140,15 @@ bool braked(const FloatingSystem& side, unsigned int j) {
   return side.response == Response::JointsLocked || (j < side.locked.size() && side.locked[j]);
 }
 
-}  // namespace
+/// The impulse on the robot from its momentum h_before to h (the moment moved to p).
+Vector6d impulseAbout(const Vector6d& h, const Vector6d& h_before, const Vector3d& p) {
+  const Vector6d dh = h - h_before;
+  return (Vector6d() << dh.head<3>(), dh.tail<3>() - p.cross(dh.head<3>())).finished();
+}
 
-CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const FloatingSystem& target,
-                                             const CompliantGrasp& grasp, const SimulationOptions& options) {
+CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& target, const CompliantGrasp& grasp,
+                             const CompliantRun& run) {
+  const SimulationOptions& options = run.options;
   checkGrasp(grasp);
   if (robot.response == Response::Grounded || target.response == Response::Grounded)
     throw InputError("law.type: a compliant capture joins two free-floating systems (a grounded side is not supported)");
@@ -151,6 +161,7 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   opt.grounded = false;
   opt.gravity = Vector3d::Zero();  // the contact's time scale: gravity changes nothing in it
   Simulator sim(js.model, opt);
+  sim.setCancelPoll(run.cancelled);
   for (unsigned int j = 0; j < robot.model->nj(); ++j)
     if (braked(robot, j)) sim.setJointControl(js.robot_joints[j], {JointControl::Mode::Locked});
   for (unsigned int j = 0; j < target.model->nj(); ++j)
@@ -191,9 +202,21 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   double prev_speed2 = s0;
   bool at_min = false;
   ContactEnd end = ContactEnd::TimedOut;
+  // The robot's momentum and contact point before the contact: the impulse so far is its change.
+  Kinematics rkin(*robot.model);
+  MomentumSolver rmom(robot.model);
+  if (forwardKinematics(*robot.model, robot.state, rkin) || rmom.compute(rkin, robot.velocity))
+    throw InputError("robot: the state before the contact cannot be computed");
+  const Vector6d h_robot_before = rmom.momentum();
+  const Vector3d p = rkin.point(robot.contact);
+  FloatingSystem r_now, t_now;
   const auto observe = [&](const SimulationState& x) {
     ContactSample c = probe.sample(x, 0.0);
+    Vector6d h_r, h_t;
+    probe.split(x, r_now, t_now, h_r, h_t);
+    c.impulse = impulseAbout(h_r, h_robot_before, p);
     res.history.push_back(c);
+    if (run.observer) run.observer(sim, x, c);
   };
   sim.setStopCondition([&](const SimulationState& x) {
     const double v2 = probe.relativeSpeed2(x);
@@ -241,9 +264,8 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   res.dissipated = -s.work.controller - res.spring_energy;
   std::optional<Vector6d> lock_from;  // the robot's momentum before the lock
   if (end == ContactEnd::Caught) {
-    FloatingVelocity rv, tv;
     Vector6d h_r, h_t;
-    probe.split(s, rv, tv, h_r, h_t);
+    probe.split(s, r_now, t_now, h_r, h_t);
     lock_from = h_r;
     for (int k = 0; k < 6; ++k) sim.setJointControl(js.grasp_joints[k], {JointControl::Mode::Locked});
     if (const int rc = sim.engageBrakes(s))
@@ -254,22 +276,30 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
   res.lock_loss = T_end - res.energy_after;
   js.state = s.state;
   js.velocity = s.velocity;
-  probe.split(s, res.robot_after, res.target_after, res.robot_momentum_after, res.target_momentum_after);
-
+  probe.split(s, res.robot_end, res.target_end, res.robot_momentum_after, res.target_momentum_after);
+  res.robot_after = res.robot_end.velocity;
+  res.target_after = res.target_end.velocity;
   // The impulse on the robot: its momentum's change, the moment moved to its contact point at
   // the start.
-  Kinematics rkin(*robot.model);
-  MomentumSolver rmom(robot.model);
-  if (forwardKinematics(*robot.model, robot.state, rkin) || rmom.compute(rkin, robot.velocity))
-    throw InputError("robot: the state before the contact cannot be computed");
-  const Vector6d dh = res.robot_momentum_after - rmom.momentum();
-  const Vector3d p = rkin.point(robot.contact);
-  res.impulse << dh.head<3>(), dh.tail<3>() - p.cross(dh.head<3>());
-  if (lock_from) {
-    const Vector6d dl = res.robot_momentum_after - *lock_from;
-    res.lock_impulse << dl.head<3>(), dl.tail<3>() - p.cross(dl.head<3>());
-  }
+  res.impulse = impulseAbout(res.robot_momentum_after, h_robot_before, p);
+  if (lock_from) res.lock_impulse = impulseAbout(res.robot_momentum_after, *lock_from, p);
   return res;
+}
+
+}  // namespace
+
+CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const FloatingSystem& target,
+                                             const CompliantGrasp& grasp, const SimulationOptions& options) {
+  CompliantRun run;
+  run.options = options;
+  return solve(robot, target, grasp, run);
+}
+
+CompliantCaptureResult solveCompliantCapture(const CaptureProblem& problem, const CompliantGrasp& grasp,
+                                             const CompliantRun& run) {
+  const auto* target = std::get_if<FloatingSystem>(&problem.target);
+  if (!target) throw InputError("target: a compliant capture of a rigid target is not supported yet");
+  return solve(problem.robot, *target, grasp, run);
 }
 
 }  // namespace kdl_space

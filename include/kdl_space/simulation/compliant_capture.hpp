@@ -4,10 +4,12 @@
 // contact opens (docs/COMPLIANT.md). As the stiffness grows it tends to the impulsive capture.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <vector>
 
 #include "kdl_space/export.hpp"
+#include "kdl_space/impact/capture.hpp"
 #include "kdl_space/impact/joined_system.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 
@@ -46,6 +48,9 @@ struct ContactSample {
   double t = 0.0;                        ///< [s] since the start of the contact
   Vector6d wrench = Vector6d::Zero();    ///< on the robot: (f; n about its contact point), world
   Vector6d deflection = Vector6d::Zero();  ///< the grasp's six coordinates (x, y, z, rz, ry, rx)
+  /// The impulse on the robot so far: its own momentum's change since the start of the contact
+  /// (exact, not a quadrature of `wrench`), the moment about its contact point at the start.
+  Vector6d impulse = Vector6d::Zero();
 };
 
 /// How the contact ended.
@@ -65,6 +70,10 @@ struct CompliantCaptureResult {
   /// once; not in `history`), the moment about the same point. Zero unless caught.
   Vector6d lock_impulse = Vector6d::Zero();
   FloatingVelocity robot_after, target_after;  ///< each side's base twist and rates at the end
+  /// Each side at the end of the contact as a system of its own (its model, state, velocity after
+  /// the lock, contact and brakes): what moves on after a bounce. A rigid target is the free body
+  /// of one link the contact joined (its model: one body at the CoM, the target frame's axes).
+  FloatingSystem robot_end, target_end;
   /// The joined system at the end (the grasp's joints braked if caught: its velocity after the lock).
   JoinedSystem joined;
   Vector6d momentum_before = Vector6d::Zero(), momentum_after = Vector6d::Zero();  ///< both sides
@@ -90,5 +99,24 @@ struct CompliantCaptureResult {
 KDL_SPACE_EXPORT CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const FloatingSystem& target,
                                                               const CompliantGrasp& grasp,
                                                               const SimulationOptions& options = {});
+
+/// Sees every output sample of the contact in time order: the joined system's simulator and
+/// state (t from 0 at the touch), and the sample. It may throw (the exception propagates).
+using ContactObserver = std::function<void(Simulator& sim, const SimulationState& x, const ContactSample& sample)>;
+
+/// How to run a compliant contact.
+struct CompliantRun {
+  SimulationOptions options;  ///< the integrator's (grounded and gravity are ignored)
+  /// Simulator::setCancelPoll of the contact's run (empty: never): a true ends it with an
+  /// InputError naming E_CANCELLED; a poll that throws stops it there (propagates).
+  std::function<bool()> cancelled;
+  ContactObserver observer;  ///< empty: none
+};
+
+/// \brief The compliant capture of the problem's target, free-floating or rigid (a rigid target is
+/// one free body: its mass and inertia at its CoM, its twist problem.target's). The problem's law
+/// and touch tolerance are not used (the grasp's spring-damper is the law). \throws as above.
+KDL_SPACE_EXPORT CompliantCaptureResult solveCompliantCapture(const CaptureProblem& problem, const CompliantGrasp& grasp,
+                                                              const CompliantRun& run = {});
 
 }  // namespace kdl_space
