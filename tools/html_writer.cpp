@@ -340,7 +340,7 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
   Json data = {{"title", title}, {"note", note}, {"links", links}, {"frameCount", times_.size()},
                {"stride", data_.size() / times_.size()}, {"frames", base64(data_.data(), data_.size() * sizeof(float))},
                {"times", base64(times_.data(), times_.size() * sizeof(double))}, {"phases", phases_},
-               {"phaseNames", {"approach", "contact", "after", "motion"}}};
+               {"phaseNames", {"approach", "contact", "after", "motion", "compliant contact"}}};
   // Each mesh file once (a mesh several links use is stored once), base64.
   data["meshes"] = Json::array();
   bool stl = false, dae = false;
@@ -394,7 +394,7 @@ void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_f
       for (std::size_t i = 0; i < names.size(); ++i)
         if (names[i] == robot[j]) series_joints_[j] = static_cast<int>(i);
   }
-  if (!series_phase0_ || (x.phase == Phase::Post && series_phase_ != Phase::Post)) {
+  if (!series_phase0_ || ((x.phase == Phase::Post || x.phase == Phase::Contact) && series_phase_ != x.phase)) {
     series_phase0_ = true, series_phase_ = x.phase, series_T0_ = x.T;
   }
   series_at_ = f.size();

@@ -15,14 +15,15 @@
 namespace kdl_space::python {
 namespace {
 
-/// The samples (the approach's, then the motion's), column by column.
+/// The samples (the approach's, a compliant contact's, then the motion's), column by column.
 py::dict samplesDict(const OperationResult& r) {
   std::vector<const MotionSample*> rows;
   for (const MotionSample& x : r.approach_samples) rows.push_back(&x);
+  for (const MotionSample& x : r.contact_samples) rows.push_back(&x);
   for (const MotionSample& x : r.samples) rows.push_back(&x);
   const Eigen::Index k = static_cast<Eigen::Index>(rows.size()), n = r.model->nj();
   Eigen::MatrixXd t(k, 1), p(k, 3), quat(k, 4), twist(k, 6), q(k, n), qd(k, n), tau(k, n), h(k, 6), T(k, 1),
-      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1);
+      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1), contact(k, 6);
   py::list phase;
   for (Eigen::Index i = 0; i < k; ++i) {
     const MotionSample& x = *rows[static_cast<std::size_t>(i)];
@@ -30,7 +31,7 @@ py::dict samplesDict(const OperationResult& r) {
     p.row(i) = x.p.transpose(), quat.row(i) = x.quat.transpose(), twist.row(i) = x.twist.transpose();
     q.row(i) = x.q.transpose(), qd.row(i) = x.qd.transpose(), tau.row(i) = x.tau.transpose();
     h.row(i) = x.h.transpose(), wrench.row(i) = x.base_wrench.transpose(), work.row(i) = x.work.transpose();
-    impulse.row(i) = x.impulse.transpose();
+    impulse.row(i) = x.impulse.transpose(), contact.row(i) = x.contact_wrench.transpose();
     phase.append(toString(x.phase));
   }
   py::dict d;
@@ -49,6 +50,7 @@ py::dict samplesDict(const OperationResult& r) {
   d["work"] = toNumpy(work);
   d["impulse"] = toNumpy(impulse);
   d["grasp_distance"] = toNumpy(distance, true);
+  d["contact_wrench"] = toNumpy(contact);
   return d;
 }
 
@@ -128,9 +130,10 @@ void bindOperation(py::module_& m) {
         py::arg("max_output_rows") = std::uint64_t{10'000'000}, py::arg("check_gains") = true,
         "The scenario's capture operation as `kdl_space simulate` runs it: the approach (if any), the capture at "
         "the contact instant, the system after it and `duration` s of its motion (None: the scenario's). Returns "
-        "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
-        "'samples': the approach's and the motion's samples as NumPy arrays (t, phase, base_position, "
-        "base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, work, impulse, grasp_distance; "
+        "the dict `kdl_space simulate --json` prints (keys capture, compliant, approach, target_motion, simulation) "
+        "with 'samples': the approach's, a compliant contact's (phase 'contact') and the motion's samples as NumPy "
+        "arrays (t, phase, base_position, base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, "
+        "work, impulse, grasp_distance, contact_wrench: the compliant contact's (f; n) on the robot, NaN outside it; "
         "joint_names); an OperationResult (a dict) whose to_html(path) writes the run's 3-D page. `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
         "`observer(t, phase, q, qdot)` sees every sample. With control_rate and check_gains the controller is "
