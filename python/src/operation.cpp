@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 
+#include "capture.hpp"
 #include "capture_types.hpp"
 #include "conversions.hpp"
 #include "html.hpp"
@@ -121,9 +122,60 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
   return operationResultOf(d, std::make_shared<const Scenario>(sc), std::move(r));  // a dict with to_html
 }
 
+/// The scenario's compliant law (or a stiff gripper's defaults), each keyword overriding it.
+CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damping, py::object damping_time,
+                       py::object catch_tolerance, py::object max_duration, py::object normal) {
+  CompliantGrasp g = sc.compliant.value_or(CompliantGrasp{});
+  if (!stiffness.is_none()) g.stiffness = vec6(stiffness, "stiffness");
+  if (!damping.is_none() && !damping_time.is_none())
+    throw py::value_error("damping, damping_time: give one (D per axis, or D = damping_time * stiffness)");
+  if (!damping.is_none()) g.damping = vec6(damping, "damping");
+  if (!damping_time.is_none()) g.damping_time = py::cast<double>(damping_time), g.damping.reset();
+  if (!catch_tolerance.is_none()) g.catch_tolerance = py::cast<double>(catch_tolerance);
+  if (!max_duration.is_none()) g.max_duration = py::cast<double>(max_duration);
+  if (!normal.is_none()) {
+    const Vector3d n = vec3(normal, "normal");
+    if (!(n.norm() > 1e-12)) throw py::value_error("normal: has zero length");
+    g.normal = n.normalized();
+  }
+  return g;
+}
+
+py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object damping, py::object damping_time,
+                          py::object catch_tolerance, py::object max_duration, py::object normal) {
+  const Scenario& sc = ps.scenario;
+  if (!sc.impact) throw py::value_error("scenario: a plain motion has no target to capture");
+  const CompliantGrasp g = graspOf(sc, stiffness, damping, damping_time, catch_tolerance, max_duration, normal);
+  CompliantCaptureResult c;
+  {
+    py::gil_scoped_release nogil;
+    CompliantRun run;
+    run.options = sc.simulation.options;
+    if (run.options.integrator == Integrator::RK4) run.options.integrator = Integrator::DormandPrince54;
+    run.cancelled = SignalPoll();
+    try {
+      c = solveCompliantCapture(sc.capture, g, run);
+    } catch (const Error& e) {
+      e.rethrowWithContext(sc.file + ": ");
+    }
+  }
+  return py::module_::import("json").attr("loads")(cli::compliantJson(c).dump());
+}
+
 }  // namespace
 
 void bindOperation(py::module_& m) {
+  m.def("solve_compliant_capture", &solveCompliant, py::arg("scenario"), py::kw_only(), py::arg("stiffness") = py::none(),
+        py::arg("damping") = py::none(), py::arg("damping_time") = py::none(), py::arg("catch_tolerance") = py::none(),
+        py::arg("max_duration") = py::none(), py::arg("normal") = py::none(),
+        "The compliant capture of the scenario's target at the scenario's states (docs/COMPLIANT.md): the two "
+        "systems joined at the grasp by a spring-damper, the contact integrated until it is caught or opens. The "
+        "law is the scenario's `law: {type: compliant, ...}` (or a stiff gripper's defaults), each keyword "
+        "overriding it: stiffness and damping per axis (x, y, z [N/m, N s/m]; about x, y, z [N m/rad, N m s/rad]) "
+        "of the robot's contact link, damping_time (D = damping_time * stiffness) [s], catch_tolerance, "
+        "max_duration [s], normal (a one-sided contact). Returns the dict of `kdl_space capture --json`'s "
+        "'compliant' (end, duration, peak_force, impulse, each side's velocities after, energies, history); "
+        "solve_capture(scenario) is its impulsive limit. InputError for a parameter out of range.");
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
         py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,
         py::arg("observer") = py::none(), py::arg("controller") = py::none(), py::arg("control_rate") = py::none(),
