@@ -12,6 +12,7 @@
 
 #include "capture.hpp"
 #include "html_page.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "scene_writer.hpp"
 
@@ -477,17 +478,24 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
   }
   // Not part of the system that moves: at the contact instant where the capture problem has it;
   // after a point impact it drifts on by itself (driftingTargetBase).
+  // A compliant contact that opened: held where the touch found it during the contact (a few
+  // milliseconds), then drifting from where the contact's end left it.
   const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
-  if (target_at_contact_.empty() && other) {
-    Kinematics target_kin(*other->model);
-    if (forwardKinematics(*other->model, other->state, target_kin) == E_NOERROR)
-      for (std::size_t i = 0; i < links.size(); ++i) target_at_contact_.push_back(target_kin.pose(static_cast<int>(i)));
-  }
-  const bool at_contact = x.t <= so_far.t_capture && target_at_contact_.size() == links.size();
+  const bool bounced = so_far.compliant && !so_far.joined;
+  const auto linkPoses = [&](const FloatingSystem& s, std::vector<KDL::Frame>& poses) {
+    Kinematics target_kin(*s.model);
+    if (forwardKinematics(*s.model, s.state, target_kin) == E_NOERROR)
+      for (std::size_t i = 0; i < links.size(); ++i) poses.push_back(target_kin.pose(static_cast<int>(i)));
+  };
+  if (target_at_contact_.empty() && other) linkPoses(*other, target_at_contact_);
+  if (target_after_contact_.empty() && bounced) linkPoses(so_far.compliant->target_end, target_after_contact_);
+  const std::vector<KDL::Frame>& from = bounced ? target_after_contact_ : target_at_contact_;
+  const double t_apart = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  const bool at_contact = x.t <= t_apart && target_at_contact_.size() == links.size();
   const std::optional<KDL::Frame> moved = at_contact ? std::nullopt : driftingTargetBase(so_far, x.t);
   for (std::size_t i = 0; i < links.size(); ++i)
     if (at_contact) pushPose(f, target_at_contact_[i]);
-    else if (moved) pushPose(f, *moved * target_at_contact_[i]);
+    else if (moved && from.size() == links.size()) pushPose(f, *moved * from[i]);
     else pushHidden(f);
 }
 
@@ -497,11 +505,23 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
 /// its momentum kept). Returns world_new_T_world_at_contact at time t, or none (not drawn).
 std::optional<KDL::Frame> HtmlWriter::driftingTargetBase(const OperationResult& so_far, double t) {
   const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
-  if (!other || !so_far.capture || !so_far.capture->floating_target || so_far.joined || t < so_far.t_capture)
-    return std::nullopt;
+  const bool bounced = so_far.compliant && !so_far.joined;  // a compliant contact that opened
+  const double t0 = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  if (!other || so_far.joined || t < t0) return std::nullopt;
+  if (!bounced && (!so_far.capture || !so_far.capture->floating_target)) return std::nullopt;
   if (!drift_) {
     try {
-      const RigidTarget whole = rigidSubtree(*other->model, other->state, 0, so_far.capture->floating_target->after.base_twist);
+      FloatingSystem from = bounced ? so_far.compliant->target_end : *other;
+      if (!bounced) from.velocity = so_far.capture->floating_target->after;
+      RigidTarget whole = rigidSubtree(*from.model, from.state, 0, from.velocity.base_twist);
+      // The frozen body keeps the target's momentum (P; L): its CoM at P / m, turning at
+      // I^-1 (L - c x P) (the base's own twist would ignore what the joint rates carry).
+      Kinematics kin(*from.model);
+      MomentumSolver momentum(from.model);
+      if (forwardKinematics(*from.model, from.state, kin) || momentum.compute(kin, from.velocity)) return std::nullopt;
+      const Vector6d h = momentum.momentum();
+      const RigidBody body = whole.toWorld();
+      whole.twist << h.head<3>() / body.mass, body.I_com.ldlt().solve(h.tail<3>() - body.com.cross(h.head<3>()));
       drift_.emplace(whole);
       drift_start_ = whole.pose;
     } catch (const Error&) {
@@ -509,7 +529,7 @@ std::optional<KDL::Frame> HtmlWriter::driftingTargetBase(const OperationResult& 
     }
   }
   RigidTarget now;
-  if (drift_->at(t - so_far.t_capture, now) != E_NOERROR) return std::nullopt;
+  if (drift_->at(t - t0, now) != E_NOERROR) return std::nullopt;
   return now.pose * drift_start_.Inverse();
 }
 
