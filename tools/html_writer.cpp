@@ -246,8 +246,9 @@ std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const Moti
   }
   if (!target_) return f;
   // The target's frame: tumbling before the capture; then held by the hand, joined (its body's
-  // inertia box), or tumbling on from the capture.
-  const bool after = x.phase == Phase::Post && so_far.capture;
+  // inertia box; a compliant contact's rows too when caught: its system holds the body), or
+  // tumbling on from the capture (from a compliant contact's end, when it opened).
+  const bool after = so_far.capture && (x.phase == Phase::Post || (x.phase == Phase::Contact && so_far.joined));
   RigidTarget now = *target_;
   if (!after) {
     if (tumble_->at(x.t, now) != E_NOERROR) { pushHidden(f); return f; }
@@ -267,12 +268,19 @@ std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const Moti
     pushPose(f, kin.pose(hand) * *hand_T_target_);
     return f;
   }
+  const bool bounced = so_far.compliant.has_value();  // not joined: the contact opened
   if (!after_) {
     RigidTarget separated = *at_contact;
     separated.twist = so_far.capture->target_twist_after;
+    if (bounced) {  // its one-body system: the base frame at the CoM, the target frame's axes
+      const FloatingSystem& end = so_far.compliant->target_end;
+      separated.pose = end.state.world_T_base * KDL::Frame(toKDL(Vector3d(-at_contact->com)));
+      separated.twist = toEigen(end.velocity.base_twist);
+    }
     after_.emplace(separated);
   }
-  if (after_->at(x.t - so_far.t_capture, now) != E_NOERROR) pushHidden(f); else pushPose(f, now.pose);
+  const double t0 = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  if (after_->at(x.t - t0, now) != E_NOERROR) pushHidden(f); else pushPose(f, now.pose);
   return f;
 }
 
