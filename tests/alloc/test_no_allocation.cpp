@@ -331,7 +331,8 @@ TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
       options.integrator = integrator;
       // RK4's fixed step: under the callback's damping c = 0.1 N m s, stable for h < 2.785 lambda / c,
       // lambda the least eigenvalue of H; the generated fingers' lambda of 1.1e-4 kg m^2 (grippers14,
-      // hands12, hands24 at random states) asks for h < 3.1e-3 s (at 0.01 s: E_NOT_FINITE).
+      // hands12, hands24 at random states) asks for h < 3.1e-3 s (at 0.01 s grippers14 and hands24
+      // end in E_NOT_FINITE).
       options.step = model->mimic().empty() ? 0.01 : 1e-3;
       options.grounded = grounded;
       Simulator sim(model, options);
