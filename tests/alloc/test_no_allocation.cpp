@@ -330,7 +330,7 @@ TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
       SimulationOptions options;
       options.integrator = integrator;
       // RK4's fixed step: under the callback's damping c = 0.1 N m s, stable for h < 2.785 lambda / c,
-      // lambda the least eigenvalue of H; the generated fingers' lambda of 1.1e-4 kg m^2 (grippers14,
+      // lambda the least eigenvalue of H; the generated fingers' lambda, down to 1.1e-4 kg m^2 (grippers14,
       // hands12, hands24 at random states) asks for h < 3.1e-3 s (at 0.01 s grippers14 and hands24
       // end in E_NOT_FINITE).
       options.step = model->mimic().empty() ? 0.01 : 1e-3;
