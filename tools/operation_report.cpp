@@ -244,7 +244,10 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   if (record.samples == 0) return;  // stopped at the capture
   if (r.capture) {
     const std::string& contact_link = r.at_contact.robot.model->bodies()[r.at_contact.robot.contact.body].name;
-    out << "\nAfter the " << (r.compliant ? "compliant contact (from t = " + detail::number(r.t_capture + r.compliant->duration) + " s)" : std::string("impact")) << ": "
+    const std::string after = r.compliant ? "compliant contact (from t = " +
+                                                detail::number(r.t_capture + r.compliant->duration) + " s)"
+                                          : std::string("impact");
+    out << "\nAfter the " << after << ": "
         << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by " +
                            (r.joined->grasp == GraspJoint::Rigid       ? "a fixed joint"
                             : r.joined->grasp == GraspJoint::Spherical ? "a ball joint (grasp_rz, grasp_ry, grasp_rx)"
