@@ -62,6 +62,38 @@ inline void revoluteJoint(std::ostream& u, const std::string& name, const std::s
     << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"1\"/>" << mimic << "</joint>\n";
 }
 
+/// The generated humanoids' upper body: a 500 kg torso, two arms of `arm_joints[0]` (right, side
+/// "r") and `arm_joints[1]` (left, "l") revolute joints (as the chain's links), each arm ending in
+/// what `hand(u, side, wrist)` writes (wrist: the arm's last link, or "base" for an arm of no
+/// joint), and a massless `tip` link at `tip_xyz` from link `tip_parent`. The finger layout is
+/// `hand`'s: generatedHandsUrdf and generatedGrippersUrdf differ only there and in the arm lengths.
+template <class Hand>
+std::string humanoidUrdf(const std::string& robot, const int (&arm_joints)[2], const Hand& hand,
+                         const std::string& tip_parent, const std::string& tip_xyz) {
+  std::ostringstream u;
+  u << "<?xml version=\"1.0\"?>\n<robot name=\"" << robot << "\">\n";
+  u << "<link name=\"base\">" << inertial(500.0, 1.6, 1.4, 1.2, 0.2, "0.02 -0.01 0.03") << "</link>\n";
+  const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
+  for (int side = 0; side < 2; ++side) {
+    const std::string s = side == 0 ? "r" : "l";
+    const int arm = arm_joints[side];
+    std::string parent = "base";
+    for (int i = 1; i <= arm; ++i) {
+      const std::string child = s + "_link" + std::to_string(i);
+      revoluteJoint(u, s + "_joint" + std::to_string(i), parent, child,
+                    i == 1 ? (side == 0 ? "0 -0.8 0.5" : "0 0.8 0.5") : "0.3 0 0", 0.1 * (i % 3), axes[i % 3], "");
+      u << "<link name=\"" << child << "\">" << inertial(4.0 + 2.0 * (arm - i) / std::max(1, arm - 1), 0.3, 0.08, 0.08,
+                                                        0.1 + 0.01 * i, "0.15 0.01 0")
+        << "</link>\n";
+      parent = child;
+    }
+    hand(u, s, parent);
+  }
+  u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"" << tip_parent << "\"/><child link=\"tip\"/><origin xyz=\""
+    << tip_xyz << "\" rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
+  return u.str();
+}
+
 /// A humanoid's upper body with coupled fingers, N movable joints in all: a 500 kg torso, two arms
 /// of (N - 6F) / 2 revolute joints each (as the chain's links), each arm ending in a hand of
 /// F = max(1, round(N / 12)) three-joint fingers whose middle and distal joints follow the proximal
@@ -70,44 +102,23 @@ inline void revoluteJoint(std::ostream& u, const std::string& name, const std::s
 inline std::string generatedHandsUrdf(int N) {
   const int F = std::max(1, static_cast<int>(std::lround(N / 12.0)));
   const int arm = std::max(1, (N - 6 * F) / 2);
-  std::ostringstream u;
-  u << "<?xml version=\"1.0\"?>\n<robot name=\"hands" << N << "\">\n";
-  u << "<link name=\"base\">" << inertial(500.0, 1.6, 1.4, 1.2, 0.2, "0.02 -0.01 0.03") << "</link>\n";
-  const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
-  const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
-                         const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
-    revoluteJoint(u, name, parent, child, xyz, yaw, axis, mimic);
-  };
-  for (int side = 0; side < 2; ++side) {
-    const std::string s = side == 0 ? "r" : "l";
-    std::string parent = "base";
-    for (int i = 1; i <= arm; ++i) {
-      const std::string child = s + "_link" + std::to_string(i);
-      joint(s + "_joint" + std::to_string(i), parent, child, i == 1 ? (side == 0 ? "0 -0.8 0.5" : "0 0.8 0.5") : "0.3 0 0",
-            0.1 * (i % 3), axes[i % 3], "");
-      u << "<link name=\"" << child << "\">" << inertial(4.0 + 2.0 * (arm - i) / std::max(1, arm - 1), 0.3, 0.08, 0.08,
-                                                        0.1 + 0.01 * i, "0.15 0.01 0")
-        << "</link>\n";
-      parent = child;
-    }
+  const auto hand = [F](std::ostream& u, const std::string& s, const std::string& wrist) {
     for (int f = 0; f < F; ++f) {
       const std::string p = s + "_f" + std::to_string(f), y = std::to_string(0.02 * f - 0.01 * F);
-      std::string previous = parent;
+      std::string previous = wrist;
       const char* names[3] = {"_proximal", "_middle", "_distal"};
       for (int k = 0; k < 3; ++k) {
         const std::string child = p + "_" + std::to_string(k + 1);
         const std::string mimic = k == 0 ? "" : "<mimic joint=\"" + p + names[0] + "\" multiplier=\"" +
                                                     (k == 1 ? "0.9" : "0.7") + "\" offset=\"0.01\"/>";
-        joint(p + names[k], previous, child, k == 0 ? "0.32 " + y + " 0" : "0.04 0 0", 0.0, "0 1 0", mimic);
+        revoluteJoint(u, p + names[k], previous, child, k == 0 ? "0.32 " + y + " 0" : "0.04 0 0", 0.0, "0 1 0", mimic);
         u << "<link name=\"" << child << "\">" << inertial(0.05 - 0.01 * k, 0.04, 0.015, 0.015, 0.2, "0.02 0 0")
           << "</link>\n";
         previous = child;
       }
     }
-  }
-  u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"r_f0_3\"/><child link=\"tip\"/><origin xyz=\"0.03 0 0\" "
-       "rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
-  return u.str();
+  };
+  return humanoidUrdf("hands" + std::to_string(N), {arm, arm}, hand, "r_f0_3", "0.03 0 0");
 }
 
 /// A humanoid's upper body with few coupled fingers, N movable joints in all: a 500 kg torso, two
@@ -118,39 +129,18 @@ inline std::string generatedHandsUrdf(int N) {
 /// beyond the right gripper's first distal phalanx.
 inline std::string generatedGrippersUrdf(int N) {
   const int arms = std::max(2, N - 8);
-  std::ostringstream u;
-  u << "<?xml version=\"1.0\"?>\n<robot name=\"grippers" << N << "\">\n";
-  u << "<link name=\"base\">" << inertial(500.0, 1.6, 1.4, 1.2, 0.2, "0.02 -0.01 0.03") << "</link>\n";
-  const char* axes[3] = {"0 0 1", "0 1 0", "1 0 0"};
-  const auto joint = [&](const std::string& name, const std::string& parent, const std::string& child,
-                         const std::string& xyz, double yaw, const char* axis, const std::string& mimic) {
-    revoluteJoint(u, name, parent, child, xyz, yaw, axis, mimic);
-  };
-  for (int side = 0; side < 2; ++side) {
-    const std::string s = side == 0 ? "r" : "l";
-    const int arm = side == 0 ? arms - arms / 2 : arms / 2;
-    std::string parent = "base";
-    for (int i = 1; i <= arm; ++i) {
-      const std::string child = s + "_link" + std::to_string(i);
-      joint(s + "_joint" + std::to_string(i), parent, child, i == 1 ? (side == 0 ? "0 -0.8 0.5" : "0 0.8 0.5") : "0.3 0 0",
-            0.1 * (i % 3), axes[i % 3], "");
-      u << "<link name=\"" << child << "\">" << inertial(4.0 + 2.0 * (arm - i) / std::max(1, arm - 1), 0.3, 0.08, 0.08,
-                                                        0.1 + 0.01 * i, "0.15 0.01 0")
-        << "</link>\n";
-      parent = child;
-    }
+  const auto gripper = [](std::ostream& u, const std::string& s, const std::string& wrist) {
     for (int f = 0; f < 2; ++f) {
       const std::string p = s + "_finger" + std::to_string(f);
-      joint(p + "_proximal", parent, p + "_1", f == 0 ? "0.32 0.03 0" : "0.32 -0.03 0", 0.0, f == 0 ? "0 0 1" : "0 0 -1", "");
+      revoluteJoint(u, p + "_proximal", wrist, p + "_1", f == 0 ? "0.32 0.03 0" : "0.32 -0.03 0", 0.0,
+                    f == 0 ? "0 0 1" : "0 0 -1", "");
       u << "<link name=\"" << p << "_1\">" << inertial(0.08, 0.05, 0.02, 0.02, 0.2, "0.025 0 0") << "</link>\n";
-      joint(p + "_distal", p + "_1", p + "_2", "0.05 0 0", 0.0, "0 0 1",
-            "<mimic joint=\"" + p + "_proximal\" multiplier=\"0.6\" offset=\"0.01\"/>");
+      revoluteJoint(u, p + "_distal", p + "_1", p + "_2", "0.05 0 0", 0.0, "0 0 1",
+                    "<mimic joint=\"" + p + "_proximal\" multiplier=\"0.6\" offset=\"0.01\"/>");
       u << "<link name=\"" << p << "_2\">" << inertial(0.05, 0.04, 0.015, 0.015, 0.2, "0.02 0 0") << "</link>\n";
     }
-  }
-  u << "<joint name=\"tip_joint\" type=\"fixed\"><parent link=\"r_finger0_2\"/><child link=\"tip\"/><origin xyz=\"0.04 0 0\" "
-       "rpy=\"0 0 0\"/></joint>\n<link name=\"tip\"/>\n</robot>\n";
-  return u.str();
+  };
+  return humanoidUrdf("grippers" + std::to_string(N), {arms - arms / 2, arms / 2}, gripper, "r_finger0_2", "0.04 0 0");
 }
 
 }  // namespace kdl_space::bench

@@ -330,6 +330,22 @@ Study captureStudy(const Case& c) {
   return st;
 }
 
+/// Registers `name`: the forward dynamics of the case by `Solver` (ours or the dense route; they
+/// differ in nothing else), alternating between the case's states.
+template <class Solver>
+void registerForwardDynamics(const std::string& name, const Case* cp) {
+  benchmark::RegisterBenchmark(name.c_str(), [cp](benchmark::State& st) {
+    Solver fd(cp->model);
+    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
+    const std::vector<KDL::Wrench> none;
+    std::size_t i = 0;
+    for (auto _ : st) {
+      fd.CartToJnt(cp->at(i++), cp->velocity, cp->tau, none, a);
+      benchmark::DoNotOptimize(a.qddot.data.data());
+    }
+  });
+}
+
 void registerCase(const Case& c) {
   const std::string n = c.name;
   const Case* cp = &c;
@@ -489,26 +505,8 @@ void registerCase(const Case& c) {
         ->Unit(benchmark::kMillisecond);
   // Forward dynamics: base and joint accelerations from state, velocity and torques, forward
   // kinematics included, by three routes (checked equal in checkRoutes()).
-  benchmark::RegisterBenchmark((n + "/ours_forward_dynamics").c_str(), [cp](benchmark::State& st) {
-    ForwardDynamicsSolver fd(cp->model);
-    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
-    const std::vector<KDL::Wrench> none;
-    std::size_t i = 0;
-    for (auto _ : st) {
-      fd.CartToJnt(cp->at(i++), cp->velocity, cp->tau, none, a);
-      benchmark::DoNotOptimize(a.qddot.data.data());
-    }
-  });
-  benchmark::RegisterBenchmark((n + "/crb_forward_dynamics").c_str(), [cp](benchmark::State& st) {
-    test::CrbForwardDynamics fd(cp->model);
-    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
-    const std::vector<KDL::Wrench> none;
-    std::size_t i = 0;
-    for (auto _ : st) {
-      fd.CartToJnt(cp->at(i++), cp->velocity, cp->tau, none, a);
-      benchmark::DoNotOptimize(a.qddot.data.data());
-    }
-  });
+  registerForwardDynamics<ForwardDynamicsSolver>(n + "/ours_forward_dynamics", cp);
+  registerForwardDynamics<test::CrbForwardDynamics>(n + "/crb_forward_dynamics", cp);
 #ifdef KDL_SPACE_WITH_DART
   benchmark::RegisterBenchmark((n + "/DART_forward_dynamics").c_str(), [cp](benchmark::State& st) {
     DartRoute dart(*cp);

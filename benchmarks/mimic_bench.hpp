@@ -84,46 +84,37 @@ inline bool checkMimicRoutes() {
   return true;
 }
 
-inline void registerMimicCase(const MimicCase& c) {
+/// \brief Registers `<case>/<method>`: a `Solver` built from the case's model, then per iteration
+/// `step(solver, case, state, out)`, alternating between the case's two configurations; `out` a
+/// copy of `out0`, made before the timing. The four routes of a case differ only in `Solver`
+/// and in what they compute (G* or the forward dynamics).
+template <class Solver, class Out, class Step>
+void registerMimicRoute(const MimicCase& c, const std::string& method, const Out& out0, Step step) {
   const MimicCase* cp = &c;
-  benchmark::RegisterBenchmark((c.name + "/mimic_recursive_G_star").c_str(), [cp](benchmark::State& st) {
-    RecursiveExIITSolver solver(cp->model);
-    Matrix6d G;
+  benchmark::RegisterBenchmark((c.name + "/" + method).c_str(), [cp, out0, step](benchmark::State& st) {
+    Solver solver(cp->model);
+    Out out = out0;
     std::size_t i = 0;
-    for (auto _ : st) {
-      solver.compute(cp->state[i++ & 1]);
-      solver.G_star(cp->contact, G);
-      benchmark::DoNotOptimize(G.data());
-    }
+    for (auto _ : st) step(solver, *cp, cp->state[i++ & 1], out);
   });
-  benchmark::RegisterBenchmark((c.name + "/mimic_dense_G_star").c_str(), [cp](benchmark::State& st) {
-    FreeFloatingSolver solver(cp->model);
-    Matrix6d G;
-    std::size_t i = 0;
-    for (auto _ : st) {
-      solver.compute(cp->state[i++ & 1]);
-      solver.G_star(cp->contact, G);
-      benchmark::DoNotOptimize(G.data());
-    }
-  });
-  benchmark::RegisterBenchmark((c.name + "/mimic_recursive_forward_dynamics").c_str(), [cp](benchmark::State& st) {
-    ForwardDynamicsSolver solver(cp->model);
-    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
-    std::size_t i = 0;
-    for (auto _ : st) {
-      solver.CartToJnt(cp->state[i++ & 1], cp->velocity, cp->tau, {}, a);
-      benchmark::DoNotOptimize(a.qddot.data.data());
-    }
-  });
-  benchmark::RegisterBenchmark((c.name + "/mimic_dense_forward_dynamics").c_str(), [cp](benchmark::State& st) {
-    DenseForwardDynamicsSolver solver(cp->model);
-    FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(cp->model->nj())};
-    std::size_t i = 0;
-    for (auto _ : st) {
-      solver.CartToJnt(cp->state[i++ & 1], cp->velocity, cp->tau, {}, a);
-      benchmark::DoNotOptimize(a.qddot.data.data());
-    }
-  });
+}
+
+inline void registerMimicCase(const MimicCase& c) {
+  const auto G_star = [](auto& solver, const MimicCase& mc, const State& s, Matrix6d& G) {
+    solver.compute(s);
+    solver.G_star(mc.contact, G);
+    benchmark::DoNotOptimize(G.data());
+  };
+  const auto forward_dynamics = [](auto& solver, const MimicCase& mc, const State& s, FloatingAcceleration& a) {
+    solver.CartToJnt(s, mc.velocity, mc.tau, {}, a);
+    benchmark::DoNotOptimize(a.qddot.data.data());
+  };
+  const Matrix6d G = Matrix6d::Zero();
+  const FloatingAcceleration a{Vector6d::Zero(), KDL::JntArray(c.model->nj())};
+  registerMimicRoute<RecursiveExIITSolver>(c, "mimic_recursive_G_star", G, G_star);
+  registerMimicRoute<FreeFloatingSolver>(c, "mimic_dense_G_star", G, G_star);
+  registerMimicRoute<ForwardDynamicsSolver>(c, "mimic_recursive_forward_dynamics", a, forward_dynamics);
+  registerMimicRoute<DenseForwardDynamicsSolver>(c, "mimic_dense_forward_dynamics", a, forward_dynamics);
 }
 
 /// The section's table from the medians (time(case, method) in ns, < 0 if not run).

@@ -233,15 +233,23 @@ Json compliantJson(const CompliantCaptureResult& c) {
   const char* ends[3] = {"caught", "opened", "timed_out"};
   Json history;
   std::vector<double> t;
-  std::vector<Json> wrench, deflection;
+  std::vector<Json> wrench, deflection, impulse;
   for (const ContactSample& s : c.history) {
     t.push_back(s.t);
     wrench.push_back(toJson(s.wrench));
     deflection.push_back(toJson(s.deflection));
+    impulse.push_back(toJson(s.impulse));
   }
   history["t"] = t;
   history["wrench"] = wrench;  // on the robot, (f; n about its contact point), world
   history["deflection"] = deflection;  // x, y, z, rz, ry, rx of the grasp
+  history["impulse"] = impulse;  // on the robot so far (its momentum's change), as `impulse`
+  const auto side = [](const FloatingSystem& end, const FloatingVelocity& after, const Vector6d& momentum) {
+    return Json{{"base_twist_after", twist(after.base_twist)},
+                {"qdot_after", toJson(after.qdot.data)},
+                {"joint_names", end.model ? Json(end.model->jointNames()) : Json::array()},
+                {"momentum_after", toJson(momentum)}};  // its own, (P; L about the world origin)
+  };
   return Json{{"end", ends[static_cast<int>(c.end)]},
               {"duration", c.duration},
               {"peak_force", c.peak_force},
@@ -249,8 +257,8 @@ Json compliantJson(const CompliantCaptureResult& c) {
               {"peak_force_wrench", toJson(c.peak_force_wrench)},
               {"impulse", toJson(c.impulse)},
               {"lock_impulse", toJson(c.lock_impulse)},
-              {"robot", Json{{"base_twist_after", twist(c.robot_after.base_twist)}, {"qdot_after", toJson(c.robot_after.qdot.data)}}},
-              {"target", Json{{"base_twist_after", twist(c.target_after.base_twist)}, {"qdot_after", toJson(c.target_after.qdot.data)}}},
+              {"robot", side(c.robot_end, c.robot_after, c.robot_momentum_after)},
+              {"target", side(c.target_end, c.target_after, c.target_momentum_after)},
               {"momentum_before", toJson(c.momentum_before)},
               {"momentum_after", toJson(c.momentum_after)},
               {"energy_before", c.energy_before},

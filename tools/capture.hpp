@@ -57,6 +57,11 @@ void warnOnStderr(const std::vector<Diagnostic>& warnings);
 
 /// The readable summary.
 void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);
+/// The `compliant` object of the capture and simulate JSON (law type compliant): what the contact
+/// gave, in the terms of captureJson's keys, and its history as columns.
+Json compliantJson(const CompliantCaptureResult& contact);
+/// The compliant contact's summary beside `limit`, the impulsive capture of the same contact.
+void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& contact, const CaptureResult& limit);
 
 CLI::App* addCapture(CLI::App& app, CaptureOptions& options);
 /// The picture of the impact instant: one snapshot "impact" (the robot at its state, its

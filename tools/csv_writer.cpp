@@ -7,8 +7,8 @@
 
 namespace kdl_space::cli {
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control)
-    : file_(path, "--csv"), base_control_(base_control) {
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact)
+    : file_(path, "--csv"), base_control_(base_control), contact_(contact) {
   out_.open(file_.tmp());
   if (!out_) throw InputError("--csv " + path + ": cannot write in its folder");
   out_ << std::setprecision(17);
@@ -18,7 +18,9 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
   out_ << ",P_x,P_y,P_z,L_x,L_y,L_z,kinetic_energy";
   for (const auto& j : joints) out_ << ",tau_" << j;
   if (base_control_) out_ << ",base_control_fx,base_control_fy,base_control_fz,base_control_nx,base_control_ny,base_control_nz";
-  out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity,phase,grasp_distance\n";
+  out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity,phase,grasp_distance";
+  if (contact_) out_ << ",contact_fx,contact_fy,contact_fz,contact_nx,contact_ny,contact_nz";
+  out_ << '\n';
 }
 
 void CsvWriter::write(const MotionSample& s) {
@@ -37,6 +39,11 @@ void CsvWriter::write(const MotionSample& s) {
   for (int i = 0; i < 6; ++i) out_ << ',' << s.work(i);
   out_ << ',' << toString(s.phase) << ',';
   if (!std::isnan(s.grasp_distance)) out_ << s.grasp_distance;  // empty outside the approach
+  if (contact_)  // empty outside the contact
+    for (int i = 0; i < 6; ++i) {
+      out_ << ',';
+      if (!std::isnan(s.contact_wrench(i))) out_ << s.contact_wrench(i);
+    }
   out_ << '\n';
   if (!out_) failed();  // a buffer that could not be flushed sets badbit
   ++rows_;

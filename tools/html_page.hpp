@@ -214,7 +214,7 @@ function kdlSpacePlots(K, D, times, slider, phaseColours) {
 function kdlSpaceMain() {
  'use strict';
  var K = window.kdlSpace, D = window.KDL_DATA;
- var PHASE_COLOURS = ['#4c78a8', '#d62728', '#59a14f', '#9c9c9c'];
+ var PHASE_COLOURS = ['#4c78a8', '#d62728', '#59a14f', '#9c9c9c', '#f28e2b'];
  function decode(text, Type) {
    var bytes = atob(text), raw = new Uint8Array(bytes.length);
    for (var i = 0; i < bytes.length; ++i) raw[i] = bytes.charCodeAt(i);

@@ -12,6 +12,7 @@
 
 #include "capture.hpp"
 #include "html_page.hpp"
+#include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "scene_writer.hpp"
 
@@ -245,8 +246,9 @@ std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const Moti
   }
   if (!target_) return f;
   // The target's frame: tumbling before the capture; then held by the hand, joined (its body's
-  // inertia box), or tumbling on from the capture.
-  const bool after = x.phase == Phase::Post && so_far.capture;
+  // inertia box; a compliant contact's rows too when caught: its system holds the body), or
+  // tumbling on from the capture (from a compliant contact's end, when it opened).
+  const bool after = so_far.capture && (x.phase == Phase::Post || (x.phase == Phase::Contact && so_far.joined));
   RigidTarget now = *target_;
   if (!after) {
     if (tumble_->at(x.t, now) != E_NOERROR) { pushHidden(f); return f; }
@@ -266,12 +268,19 @@ std::vector<float> HtmlWriter::frameOf(const OperationResult& so_far, const Moti
     pushPose(f, kin.pose(hand) * *hand_T_target_);
     return f;
   }
+  const bool bounced = so_far.compliant.has_value();  // not joined: the contact opened
   if (!after_) {
     RigidTarget separated = *at_contact;
     separated.twist = so_far.capture->target_twist_after;
+    if (bounced) {  // its one-body system: the base frame at the CoM, the target frame's axes
+      const FloatingSystem& end = so_far.compliant->target_end;
+      separated.pose = end.state.world_T_base * KDL::Frame(toKDL(Vector3d(-at_contact->com)));
+      separated.twist = toEigen(end.velocity.base_twist);
+    }
     after_.emplace(separated);
   }
-  if (after_->at(x.t - so_far.t_capture, now) != E_NOERROR) pushHidden(f); else pushPose(f, now.pose);
+  const double t0 = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  if (after_->at(x.t - t0, now) != E_NOERROR) pushHidden(f); else pushPose(f, now.pose);
   return f;
 }
 
@@ -340,7 +349,7 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
   Json data = {{"title", title}, {"note", note}, {"links", links}, {"frameCount", times_.size()},
                {"stride", data_.size() / times_.size()}, {"frames", base64(data_.data(), data_.size() * sizeof(float))},
                {"times", base64(times_.data(), times_.size() * sizeof(double))}, {"phases", phases_},
-               {"phaseNames", {"approach", "contact", "after", "motion"}}};
+               {"phaseNames", {"approach", "contact", "after", "motion", "compliant contact"}}};
   // Each mesh file once (a mesh several links use is stored once), base64.
   data["meshes"] = Json::array();
   bool stl = false, dae = false;
@@ -394,7 +403,7 @@ void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_f
       for (std::size_t i = 0; i < names.size(); ++i)
         if (names[i] == robot[j]) series_joints_[j] = static_cast<int>(i);
   }
-  if (!series_phase0_ || (x.phase == Phase::Post && series_phase_ != Phase::Post)) {
+  if (!series_phase0_ || ((x.phase == Phase::Post || x.phase == Phase::Contact) && series_phase_ != x.phase)) {
     series_phase0_ = true, series_phase_ = x.phase, series_T0_ = x.T;
   }
   series_at_ = f.size();
@@ -477,17 +486,24 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
   }
   // Not part of the system that moves: at the contact instant where the capture problem has it;
   // after a point impact it drifts on by itself (driftingTargetBase).
+  // A compliant contact that opened: held where the touch found it during the contact (a few
+  // milliseconds), then drifting from where the contact's end left it.
   const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
-  if (target_at_contact_.empty() && other) {
-    Kinematics target_kin(*other->model);
-    if (forwardKinematics(*other->model, other->state, target_kin) == E_NOERROR)
-      for (std::size_t i = 0; i < links.size(); ++i) target_at_contact_.push_back(target_kin.pose(static_cast<int>(i)));
-  }
-  const bool at_contact = x.t <= so_far.t_capture && target_at_contact_.size() == links.size();
+  const bool bounced = so_far.compliant && !so_far.joined;
+  const auto linkPoses = [&](const FloatingSystem& s, std::vector<KDL::Frame>& poses) {
+    Kinematics target_kin(*s.model);
+    if (forwardKinematics(*s.model, s.state, target_kin) == E_NOERROR)
+      for (std::size_t i = 0; i < links.size(); ++i) poses.push_back(target_kin.pose(static_cast<int>(i)));
+  };
+  if (target_at_contact_.empty() && other) linkPoses(*other, target_at_contact_);
+  if (target_after_contact_.empty() && bounced) linkPoses(so_far.compliant->target_end, target_after_contact_);
+  const std::vector<KDL::Frame>& from = bounced ? target_after_contact_ : target_at_contact_;
+  const double t_apart = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  const bool at_contact = x.t <= t_apart && target_at_contact_.size() == links.size();
   const std::optional<KDL::Frame> moved = at_contact ? std::nullopt : driftingTargetBase(so_far, x.t);
   for (std::size_t i = 0; i < links.size(); ++i)
     if (at_contact) pushPose(f, target_at_contact_[i]);
-    else if (moved) pushPose(f, *moved * target_at_contact_[i]);
+    else if (moved && from.size() == links.size()) pushPose(f, *moved * from[i]);
     else pushHidden(f);
 }
 
@@ -497,11 +513,23 @@ void HtmlWriter::pushFloatingTarget(std::vector<float>& f, const OperationResult
 /// its momentum kept). Returns world_new_T_world_at_contact at time t, or none (not drawn).
 std::optional<KDL::Frame> HtmlWriter::driftingTargetBase(const OperationResult& so_far, double t) {
   const auto* other = std::get_if<FloatingSystem>(&so_far.at_contact.target);
-  if (!other || !so_far.capture || !so_far.capture->floating_target || so_far.joined || t < so_far.t_capture)
-    return std::nullopt;
+  const bool bounced = so_far.compliant && !so_far.joined;  // a compliant contact that opened
+  const double t0 = so_far.t_capture + (bounced ? so_far.compliant->duration : 0.0);
+  if (!other || so_far.joined || t < t0) return std::nullopt;
+  if (!bounced && (!so_far.capture || !so_far.capture->floating_target)) return std::nullopt;
   if (!drift_) {
     try {
-      const RigidTarget whole = rigidSubtree(*other->model, other->state, 0, so_far.capture->floating_target->after.base_twist);
+      FloatingSystem from = bounced ? so_far.compliant->target_end : *other;
+      if (!bounced) from.velocity = so_far.capture->floating_target->after;
+      RigidTarget whole = rigidSubtree(*from.model, from.state, 0, from.velocity.base_twist);
+      // The frozen body keeps the target's momentum (P; L): its CoM at P / m, turning at
+      // I^-1 (L - c x P) (the base's own twist would ignore what the joint rates carry).
+      Kinematics kin(*from.model);
+      MomentumSolver momentum(from.model);
+      if (forwardKinematics(*from.model, from.state, kin) || momentum.compute(kin, from.velocity)) return std::nullopt;
+      const Vector6d h = momentum.momentum();
+      const RigidBody body = whole.toWorld();
+      whole.twist << h.head<3>() / body.mass, body.I_com.ldlt().solve(h.tail<3>() - body.com.cross(h.head<3>()));
       drift_.emplace(whole);
       drift_start_ = whole.pose;
     } catch (const Error&) {
@@ -509,7 +537,7 @@ std::optional<KDL::Frame> HtmlWriter::driftingTargetBase(const OperationResult& 
     }
   }
   RigidTarget now;
-  if (drift_->at(t - so_far.t_capture, now) != E_NOERROR) return std::nullopt;
+  if (drift_->at(t - t0, now) != E_NOERROR) return std::nullopt;
   return now.pose * drift_start_.Inverse();
 }
 

@@ -126,6 +126,8 @@ class HtmlWriter {
   std::shared_ptr<const FloatingModel> target_model_;  ///< a free-floating target's model, or none
   std::map<std::string, std::vector<LinkVisual>> target_visuals_;  ///< of its URDF (target.urdf)
   std::vector<KDL::Frame> target_at_contact_;  ///< its links (world) at the contact instant
+  /// A compliant contact that opened: its links (world) at the contact's end, where it drifts from.
+  std::vector<KDL::Frame> target_after_contact_;
   std::vector<int> target_index_;              ///< its link -> body in model_ when joined (-1: none)
   const FloatingModel* target_index_for_ = nullptr;  ///< the system target_index_ is for
 
@@ -137,7 +139,8 @@ class HtmlWriter {
   /// without one: its box of inertia); empty when no link of it has a visual (the page then draws
   /// the target's box of inertia).
   Json rigidTargetVisualsJson() const;
-  /// A free-floating target separated by a point impact, drifting as one rigid body (c).
+  /// A free-floating target separated by a point impact (or a compliant contact that opened: from
+  /// the contact's end), drifting as one rigid body with its momentum (c).
   std::optional<KDL::Frame> driftingTargetBase(const OperationResult& so_far, double t);
   std::optional<FreeRigidMotion> drift_;
   KDL::Frame drift_start_;

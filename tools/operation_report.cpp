@@ -158,6 +158,13 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                                                 {"of", "base"}};
   }
   j["target_motion"] = targetMotionJson(r);
+  if (r.compliant) {  // the contact that lasted, beside its impulsive limit (`capture`)
+    j["compliant"] = compliantJson(*r.compliant);
+    j["compliant"]["t_start"] = r.t_capture;
+    j["compliant"]["t_end"] = r.t_capture + r.compliant->duration;
+  } else {
+    j["compliant"] = nullptr;
+  }
   // The robot's configuration at the capture (the contact instant of an approach).
   // The pose an approach started from first, then the configuration at the capture, then what the
   // motion found (a sampled controller's gains, a stiff servo).
@@ -177,7 +184,9 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"base_twist", toJson(last.twist)},
                          {"q", toJson(last.q)},
                          {"qdot", toJson(last.qd)}};
-  const Json joined = r.joined ? Json{{"grasp", r.joined->grasp == GraspJoint::Rigid ? "rigid" : "spherical"},
+  const Json joined = r.joined ? Json{{"grasp", r.joined->grasp == GraspJoint::Rigid       ? "rigid"
+                                                : r.joined->grasp == GraspJoint::Spherical ? "spherical"
+                                                                                           : "compliant"},
                                       {"target_prefix", r.joined->target_prefix},
                                       {"target_joint_signs", targetSigns(*r.joined, r.model)},
                                       {"min_chart_margin", r.min_chart_margin}}
@@ -223,6 +232,7 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
     printCaptureSummary(out, sc, *r.capture);
     printWarnings(out, captureWarnings(sc, r.at_contact));
   }
+  if (r.compliant && r.capture) printCompliantSummary(out, *r.compliant, *r.capture);
   if (sc.simulation.base_control.on()) {
     const BaseControl& c = sc.simulation.base_control;
     out << "Base control acts " << (c.in_approach && c.after_capture ? "in the approach and after the capture"
@@ -234,9 +244,11 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   if (record.samples == 0) return;  // stopped at the capture
   if (r.capture) {
     const std::string& contact_link = r.at_contact.robot.model->bodies()[r.at_contact.robot.contact.body].name;
-    out << "\nAfter the impact: "
-        << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by a " +
-                           (r.joined->grasp == GraspJoint::Rigid ? "fixed joint" : "ball joint (grasp_rz, grasp_ry, grasp_rx)")
+    out << "\nAfter the " << (r.compliant ? "compliant contact (from t = " + detail::number(r.t_capture + r.compliant->duration) + " s)" : std::string("impact")) << ": "
+        << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by " +
+                           (r.joined->grasp == GraspJoint::Rigid       ? "a fixed joint"
+                            : r.joined->grasp == GraspJoint::Spherical ? "a ball joint (grasp_rz, grasp_ry, grasp_rx)"
+                                                                       : "six grasp joints braked at their deflection (grasp_x ... grasp_rx)")
             : r.payload_attached ? "the target is attached to link '" + contact_link + "'"
             : r.target_motion    ? std::string("the target separates; both move on")
                                  : std::string("the target separates; the robot alone"));

@@ -47,7 +47,9 @@ PlotWriter::PlotWriter(const AtomicFile& out, std::vector<std::string> joints, c
 }
 
 void PlotWriter::add(const MotionSample& s) {
-  if (rows_ == 0 || (s.phase == Phase::Post && phase0_ != Phase::Post)) {
+  // Each simulation (the approach, a compliant contact, the motion after) counts its work from
+  // its own start: the balance restarts with it.
+  if (rows_ == 0 || ((s.phase == Phase::Post || s.phase == Phase::Contact) && phase0_ != s.phase)) {
     phase0_ = s.phase, h0_ = s.h, T0_ = s.T;
     if (rows_ == 0) t_first_ = s.t;
   }

@@ -86,7 +86,7 @@ struct Streams {
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
     if (!o.csv.empty()) {
-      if (!csv) csv.emplace(o.csv, joints, sc.simulation.base_control.on());
+      if (!csv) csv.emplace(o.csv, joints, sc.simulation.base_control.on(), sc.compliant.has_value());
       csv->write(x);
     }
     if (plot_file) {

@@ -66,7 +66,8 @@ Phase phaseOf(const std::string& name) {
   if (name == "capture") return Phase::Capture;
   if (name == "post") return Phase::Post;
   if (name == "motion") return Phase::Motion;
-  throw py::value_error("to_html: samples['phase']: '" + name + "' is not approach, capture, post or motion");
+  if (name == "contact") return Phase::Contact;
+  throw py::value_error("to_html: samples['phase']: '" + name + "' is not approach, capture, post, motion or contact");
 }
 
 using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 
+#include "capture.hpp"
 #include "capture_types.hpp"
 #include "conversions.hpp"
 #include "html.hpp"
@@ -15,14 +16,15 @@
 namespace kdl_space::python {
 namespace {
 
-/// The samples (the approach's, then the motion's), column by column.
+/// The samples (the approach's, a compliant contact's, then the motion's), column by column.
 py::dict samplesDict(const OperationResult& r) {
   std::vector<const MotionSample*> rows;
   for (const MotionSample& x : r.approach_samples) rows.push_back(&x);
+  for (const MotionSample& x : r.contact_samples) rows.push_back(&x);
   for (const MotionSample& x : r.samples) rows.push_back(&x);
   const Eigen::Index k = static_cast<Eigen::Index>(rows.size()), n = r.model->nj();
   Eigen::MatrixXd t(k, 1), p(k, 3), quat(k, 4), twist(k, 6), q(k, n), qd(k, n), tau(k, n), h(k, 6), T(k, 1),
-      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1);
+      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1), contact(k, 6);
   py::list phase;
   for (Eigen::Index i = 0; i < k; ++i) {
     const MotionSample& x = *rows[static_cast<std::size_t>(i)];
@@ -30,7 +32,7 @@ py::dict samplesDict(const OperationResult& r) {
     p.row(i) = x.p.transpose(), quat.row(i) = x.quat.transpose(), twist.row(i) = x.twist.transpose();
     q.row(i) = x.q.transpose(), qd.row(i) = x.qd.transpose(), tau.row(i) = x.tau.transpose();
     h.row(i) = x.h.transpose(), wrench.row(i) = x.base_wrench.transpose(), work.row(i) = x.work.transpose();
-    impulse.row(i) = x.impulse.transpose();
+    impulse.row(i) = x.impulse.transpose(), contact.row(i) = x.contact_wrench.transpose();
     phase.append(toString(x.phase));
   }
   py::dict d;
@@ -49,6 +51,7 @@ py::dict samplesDict(const OperationResult& r) {
   d["work"] = toNumpy(work);
   d["impulse"] = toNumpy(impulse);
   d["grasp_distance"] = toNumpy(distance, true);
+  d["contact_wrench"] = toNumpy(contact);
   return d;
 }
 
@@ -119,18 +122,70 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
   return operationResultOf(d, std::make_shared<const Scenario>(sc), std::move(r));  // a dict with to_html
 }
 
+/// The scenario's compliant law (or a stiff gripper's defaults), each keyword overriding it.
+CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damping, py::object damping_time,
+                       py::object catch_tolerance, py::object max_duration, py::object normal) {
+  CompliantGrasp g = sc.compliant.value_or(CompliantGrasp{});
+  if (!stiffness.is_none()) g.stiffness = vec6(stiffness, "stiffness");
+  if (!damping.is_none() && !damping_time.is_none())
+    throw py::value_error("damping, damping_time: give one (D per axis, or D = damping_time * stiffness)");
+  if (!damping.is_none()) g.damping = vec6(damping, "damping");
+  if (!damping_time.is_none()) g.damping_time = py::cast<double>(damping_time), g.damping.reset();
+  if (!catch_tolerance.is_none()) g.catch_tolerance = py::cast<double>(catch_tolerance);
+  if (!max_duration.is_none()) g.max_duration = py::cast<double>(max_duration);
+  if (!normal.is_none()) {
+    const Vector3d n = vec3(normal, "normal");
+    if (!(n.norm() > 1e-12)) throw py::value_error("normal: has zero length");
+    g.normal = n.normalized();
+  }
+  return g;
+}
+
+py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object damping, py::object damping_time,
+                          py::object catch_tolerance, py::object max_duration, py::object normal) {
+  const Scenario& sc = ps.scenario;
+  if (!sc.impact) throw py::value_error("scenario: a plain motion has no target to capture");
+  const CompliantGrasp g = graspOf(sc, stiffness, damping, damping_time, catch_tolerance, max_duration, normal);
+  CompliantCaptureResult c;
+  {
+    py::gil_scoped_release nogil;
+    CompliantRun run;
+    run.options = sc.simulation.options;
+    if (run.options.integrator == Integrator::RK4) run.options.integrator = Integrator::DormandPrince54;
+    run.cancelled = SignalPoll();
+    try {
+      c = solveCompliantCapture(sc.capture, g, run);
+    } catch (const Error& e) {
+      e.rethrowWithContext(sc.file + ": ");
+    }
+  }
+  return py::module_::import("json").attr("loads")(cli::compliantJson(c).dump());
+}
+
 }  // namespace
 
 void bindOperation(py::module_& m) {
+  m.def("solve_compliant_capture", &solveCompliant, py::arg("scenario"), py::kw_only(), py::arg("stiffness") = py::none(),
+        py::arg("damping") = py::none(), py::arg("damping_time") = py::none(), py::arg("catch_tolerance") = py::none(),
+        py::arg("max_duration") = py::none(), py::arg("normal") = py::none(),
+        "The compliant capture of the scenario's target at the scenario's states (docs/COMPLIANT.md): the two "
+        "systems joined at the grasp by a spring-damper, the contact integrated until it is caught or opens. The "
+        "law is the scenario's `law: {type: compliant, ...}` (or a stiff gripper's defaults), each keyword "
+        "overriding it: stiffness and damping per axis (x, y, z [N/m, N s/m]; about x, y, z [N m/rad, N m s/rad]) "
+        "of the robot's contact link, damping_time (D = damping_time * stiffness) [s], catch_tolerance, "
+        "max_duration [s], normal (a one-sided contact). Returns the dict of `kdl_space capture --json`'s "
+        "'compliant' (end, duration, peak_force, impulse, each side's velocities after, energies, history); "
+        "solve_capture(scenario) is its impulsive limit. InputError for a parameter out of range.");
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
         py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,
         py::arg("observer") = py::none(), py::arg("controller") = py::none(), py::arg("control_rate") = py::none(),
         py::arg("max_output_rows") = std::uint64_t{10'000'000}, py::arg("check_gains") = true,
         "The scenario's capture operation as `kdl_space simulate` runs it: the approach (if any), the capture at "
         "the contact instant, the system after it and `duration` s of its motion (None: the scenario's). Returns "
-        "the dict `kdl_space simulate --json` prints (keys capture, approach, target_motion, simulation) with "
-        "'samples': the approach's and the motion's samples as NumPy arrays (t, phase, base_position, "
-        "base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, work, impulse, grasp_distance; "
+        "the dict `kdl_space simulate --json` prints (keys capture, compliant, approach, target_motion, simulation) "
+        "with 'samples': the approach's, a compliant contact's (phase 'contact') and the motion's samples as NumPy "
+        "arrays (t, phase, base_position, base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, "
+        "work, impulse, grasp_distance, contact_wrench: the compliant contact's (f; n) on the robot, NaN outside it; "
         "joint_names); an OperationResult (a dict) whose to_html(path) writes the run's 3-D page. `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
         "`observer(t, phase, q, qdot)` sees every sample. With control_rate and check_gains the controller is "

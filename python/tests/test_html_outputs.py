@@ -451,3 +451,46 @@ def test_a_free_floating_target_drifts_as_a_rigid_body_after_a_point_impact(tmp_
     assert np.linalg.norm(v1) > 1e-4
     # float32 positions of a few metres (some 3e-7 m each), over the frames' time apart
     assert np.allclose(v1, v2, atol=2e-6 / min(times[1] - times[0], times[2] - times[1])), (v1, v2)
+
+
+@needs_browser
+def test_a_target_that_bounced_off_a_compliant_hand_drifts_from_the_contacts_end(tmp_path, cli):
+    """A compliant contact that opened (issue 28): the page draws the free-floating target drifting
+    from where the contact left it, its CoM at the speed of its own momentum after the contact
+    (the JSON's compliant.target.momentum_after over its mass), not moving with the hand as the
+    impulsive capture beside it would have it."""
+    import kdl_space
+    urdf = SOURCE_DIR / "urdf" / "spacedyn_twolink.urdf"
+    touch = kdl_space.load_scenario(str(SCENARIOS / "robot_to_robot_capture.yaml"))
+    limit = kdl_space.solve_capture(touch)
+    closing = limit.floating_target.contact_twist_before[:3] - limit.robot.contact_twist_before[:3]
+    normal = -closing / np.linalg.norm(closing)  # from the robot toward the target: the target closes in
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text((SCENARIOS / "robot_to_robot_capture.yaml").read_text()
+                        .replace("../urdf/space_arm7.urdf", str(ARM)).replace("../urdf/spacedyn_twolink.urdf", str(urdf))
+                        .replace("type: capture", "type: compliant\n  damping_time: 1.0e-6\n  normal: [%r, %r, %r]" % tuple(normal)))
+    page = tmp_path / "p.html"
+    done = run_cli(cli, "simulate", scenario, "--duration", "2", "--html", page, "--json")
+    assert done.returncode == 0, done.stderr
+    contact = json.loads(done.stdout)["compliant"]
+    assert contact["end"] == "opened"
+    data = page_data(page)
+    names = [link["name"] for link in data["targetLinks"]]
+    masses = urdf_masses(urdf)
+    mass = sum(m for link, (m, c) in masses.items() if link in names)
+    n = data["frameCount"]
+    got = [selftest(page, k) for k in (n // 2, n - 1)]
+    assert got[0]["errors"] == [], got[0]["errors"]
+    coms = []
+    for g in got:
+        poses = g["targetLinkPoses"]
+        assert all(p is not None for p in poses)
+        coms.append(sum(m * (pose_matrix(poses[names.index(link)]) @ np.append(c, 1))[:3]
+                        for link, (m, c) in masses.items() if link in names) / mass)
+    v = (coms[1] - coms[0]) / (got[1]["time"] - got[0]["time"])
+    expected = np.array(contact["target"]["momentum_after"][:3]) / mass
+    # It bounced: the contact's impulse is not the rigid capture's (which would keep it in the hand).
+    f, f_limit = np.array(contact["impulse"][:3]), np.array(limit.impulse.F[:3])
+    assert np.linalg.norm(f - f_limit) > 0.1 * np.linalg.norm(f_limit), (f, f_limit)
+    # float32 positions of a few metres (some 3e-7 m each), over the frames' time apart
+    assert np.allclose(v, expected, atol=2e-6 / (got[1]["time"] - got[0]["time"])), (v, expected)

@@ -69,6 +69,9 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
     # tests/cli/test_cli_approach_robot_target.cpp, which captures from them).
     if now.get("approach"):
         assert set(now["approach"].pop("states_at_contact")) == {"t", "robot", "target"}
+    # ... and a compliant capture's contact (issue 28): null for the golden files' laws (its
+    # values: test_compliant_operation below, tests/cli/test_cli_compliant_simulate.cpp).
+    assert now.pop("compliant") is None
     # The adaptive step controller's own statistics follow its error estimates, differences of two
     # solutions that cancel all but their last digits: a change of the dynamics' round-off (issue
     # 28 kept a zero-mass body's inertia in the O(n) sums) moves its step sizes (the largest by up to 1e-4, the smallest, a retry after a
@@ -207,3 +210,43 @@ def test_sampled_controller_beyond_its_hold_and_a_stiff_servo_are_warned():
             assert "joint7" in [w["element"] for w in warned]
         except kdl_space.InputError as e:
             assert "sampled at 200 Hz" in str(e)
+
+
+def test_compliant_capture_in_the_operation_and_alone():
+    """A compliant capture (issue 28): run_operation integrates the contact (its samples, phase
+    'contact', with the wrench on the robot) and the joined motion after it; both sides' momentum is
+    kept from the contact's start to the end (the momentum column of a joined system: both sides);
+    the dict gives the contact beside its impulsive limit. solve_compliant_capture converges to
+    solve_capture as the stiffness grows (D = damping_time K: first order in 1/K)."""
+    scenario = kdl_space.load_scenario(str(SCENARIOS["compliant_capture"]))
+    r = kdl_space.run_operation(scenario, duration=0.5)
+    c = r["compliant"]
+    assert c["end"] == "caught" and r["capture"] is not None
+    assert r["simulation"]["target_joined"]["grasp"] == "compliant"
+    samples = r["samples"]
+    phases = np.array(samples["phase"])
+    contact = phases == "contact"
+    assert contact.sum() == len(c["history"]["t"])
+    np.testing.assert_array_equal(samples["contact_wrench"][contact], np.array(c["history"]["wrench"]))
+    assert np.all(np.isnan(samples["contact_wrench"][~contact]))
+    np.testing.assert_allclose(samples["t"][contact], c["t_start"] + np.array(c["history"]["t"]), rtol=0, atol=1e-12)
+    # From the touch on: one system's momentum (the joined one), an internal force, then free.
+    first = int(np.argmax(contact))
+    h = samples["momentum"][first:]
+    np.testing.assert_allclose(h, np.broadcast_to(h[0], h.shape), rtol=0, atol=1e-12 * np.linalg.norm(h[0]))
+    np.testing.assert_allclose(c["momentum_after"], c["momentum_before"], rtol=0, atol=1e-12 * np.linalg.norm(c["momentum_before"]))
+
+    # Alone, at the scenario's states (robot_to_robot_capture: the two systems at their touch).
+    touch = kdl_space.load_scenario(str(SCENARIOS["robot_to_robot_capture"]))
+    limit = np.array(kdl_space.solve_capture(touch).impulse.F)
+    errors = []
+    for K in (1e9, 1e10, 1e11):  # docs/COMPLIANT.md: beta = 10 ms, the contact lasts ~ m / (beta K)
+        stiffness = [K, K, K, K / 100, K / 100, K / 100]
+        c = kdl_space.solve_compliant_capture(touch, stiffness=stiffness, damping_time=1e-2)
+        errors.append(np.linalg.norm(np.array(c["impulse"]) - limit) / np.linalg.norm(limit))
+    assert math.log10(errors[1] / errors[2]) >= 0.9, errors
+    assert errors[2] < 1e-6, errors
+    with pytest.raises(kdl_space.InputError, match="law.stiffness"):
+        kdl_space.solve_compliant_capture(touch, stiffness=[1e6, 1e6, 0, 1e4, 1e4, 1e4])
+    with pytest.raises(ValueError, match="damping"):
+        kdl_space.solve_compliant_capture(touch, damping=[1] * 6, damping_time=1e-3)

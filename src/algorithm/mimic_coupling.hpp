@@ -86,7 +86,7 @@ class MimicCoupling {
         P(parent(b)) += P(i);
         continue;
       }
-      row_.noalias() = -(P(i).transpose() * S(b));
+      row_.noalias() = -P(i).transpose() * S(b);  // not -(A * b): that evaluates the product into a heap temporary
       for (const Tau& t : tau_[i]) row_(t.row) += t.sign;
       u_.col(i) = row_;
       row_ *= Dinv(b);

@@ -58,21 +58,15 @@ std::string simulationFailure(int rc, const SimulationSpec& spec, const MotionRe
   }
 }
 
-/// The robot's joint j in `model` (the same model, or the robot with a payload, or joined).
-unsigned int jointIn(const FloatingModel& model, const FloatingModel& robot, unsigned int j) {
-  return static_cast<unsigned int>(model.jointIndex(robot.jointNames()[j]));
-}
-
-/// The approach's samples in the joints of the system after the capture: a target that joined
-/// brought joints, NaN in the approach's rows.
-void widenApproachSamples(const FloatingModel& robot, OperationResult& r) {
-  const FloatingModel& model = *r.model;
-  if (model.nj() == robot.nj()) return;
-  for (MotionSample& x : r.approach_samples) {
+/// Samples of the system `from` in the joints of the system after the capture, by name: a target
+/// that joined brought joints (NaN in the approach's rows); one that bounced off took its own.
+void samplesIn(const FloatingModel& model, const FloatingModel& from, std::vector<MotionSample>& samples) {
+  if (&model == &from) return;
+  for (MotionSample& x : samples) {
     Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nj(), NAN), qd = q, tau = q;
-    for (unsigned int j = 0; j < robot.nj(); ++j) {
-      const unsigned int k = jointIn(model, robot, j);
-      q(k) = x.q(j), qd(k) = x.qd(j), tau(k) = x.tau(j);
+    for (unsigned int j = 0; j < from.nj(); ++j) {
+      const int k = model.jointIndex(from.jointNames()[j]);
+      if (k >= 0) q(k) = x.q(j), qd(k) = x.qd(j), tau(k) = x.tau(j);
     }
     x.q = q, x.qd = qd, x.tau = tau;
   }
@@ -82,6 +76,8 @@ void widenApproachSamples(const FloatingModel& robot, OperationResult& r) {
 /// brakes, the controls of simulation.target_joints); with hold_servos the PD joints hold.
 void setModesAfter(const Scenario& sc, const CaptureProblem& problem, const OperationResult& r, bool hold_servos,
                    Simulator& sim) {
+  if (r.joined && r.joined->grasp == GraspJoint::Compliant)  // caught: the grasp locked at its deflection
+    for (const int j : r.joined->grasp_joints) sim.setJointControl(static_cast<unsigned int>(j), {JointControl::Mode::Locked});
   if (r.joined)
     if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) {
       const JoinedSystem& joint = *r.joined;
@@ -155,22 +151,40 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     r.model = r.joined ? r.joined->model : inScenario(sc, [&] { return attachTarget(problem, *capture); });
   }
   r.payload_attached = r.model != problem.robot.model;
-  widenApproachSamples(*problem.robot.model, r);
+  SimulationState s;
+  s.t = t_capture;
+  s.state = r.joined ? r.joined->state : problem.robot.state;
+  s.velocity = r.joined ? r.joined->velocity : capture ? capture->robot.after : problem.robot.velocity;
+  // A free-floating target that separated after a point impact moves on by itself.
+  std::optional<FloatingSystem> separated;
+  if (const auto* target = std::get_if<FloatingSystem>(&problem.target))
+    if (!r.joined && capture && capture->floating_target) {
+      separated = *target;
+      separated->velocity = capture->floating_target->after;
+    }
+  operation::runMotion(sc, problem, s, separated, o, r);
+}
+
+namespace operation {
+
+void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationState s,
+               const std::optional<FloatingSystem>& separated, const OperationOptions& o, OperationResult& r) {
+  samplesIn(*r.model, *problem.robot.model, r.approach_samples);
+  if (r.compliant) samplesIn(*r.model, *r.compliant->joined.model, r.contact_samples);
+  const double t_start = s.t;
   r.record = MotionRecord{};
   r.record.model = r.model;
   r.record.output_step = r.output_step;
-  r.record.t_start = r.record.t_reached = t_capture;
-  if (o.observer)
+  r.record.t_start = r.record.t_reached = t_start;
+  if (o.observer) {
     for (const MotionSample& x : r.approach_samples) o.observer(r, x);
+    for (const MotionSample& x : r.contact_samples) o.observer(r, x);
+  }
   if (!o.motion) return;
 
   std::unique_ptr<Simulator> simulator = operation::simulatorFor(sc, r.model, false);
   Simulator& sim = *simulator;
   sim.setCancelPoll(o.cancelled);
-  SimulationState s;
-  s.t = t_capture;
-  s.state = r.joined ? r.joined->state : problem.robot.state;
-  s.velocity = r.joined ? r.joined->velocity : capture ? capture->robot.after : problem.robot.velocity;
   setModesAfter(sc, problem, r, o.hold_servos, sim);
   checkStart(sc, sim, s);
   const SimulationState start = s;
@@ -192,7 +206,7 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
     if (o.observer) o.observer(r, smp);
     if (o.keep_samples) r.samples.push_back(std::move(smp));
   };
-  const int rc = runSampled(sim, s, t_capture + r.duration, r.output_step, o.controller, o.control_rate, observer);
+  const int rc = runSampled(sim, s, t_start + r.duration, r.output_step, o.controller, o.control_rate, observer);
   r.end = s;
   r.record.takeFrom(sim);
   r.record.t_reached = s.t;
@@ -207,7 +221,7 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   if (rc == E_CANCELLED) {
     std::ostringstream why;
     why << std::setprecision(6) << sc.file << ": the simulation was cancelled at t = " << s.t << " s of "
-        << t_capture + r.duration << " s";
+        << t_start + r.duration << " s";
     throw OperationError(why.str(), rc, std::make_shared<const OperationResult>(r));
   }
   if (rc || observer_rc) {
@@ -218,10 +232,11 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
       if (d.kind == "sampled_gain_unstable") why << "; " << d.message;
     throw OperationError(why.str(), rc ? rc : observer_rc, std::make_shared<const OperationResult>(r));
   }
-  if (!r.joined)
-    r.target_motion =
-        operation::separatedTarget(sc, problem, capture, t_capture, t_capture + r.duration, r.output_step, o.cancelled);
+  if (separated)
+    r.target_motion = operation::separatedTarget(sc, *separated, t_start, t_start + r.duration, r.output_step, o.cancelled);
 }
+
+}  // namespace operation
 
 double estimatedOutputRows(const Scenario& sc, const OperationOptions& o) {
   const double output_step = o.output_step.value_or(sc.simulation.output_step);
@@ -235,12 +250,6 @@ double estimatedOutputRows(const Scenario& sc, const OperationOptions& o) {
 
 OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& o) {
   using operation::inScenario;
-  // The compliant contact is integrated by kdl_space capture (solveCompliantCapture); the motion
-  // after it is not wired into the operation yet: refused rather than run as an impulsive one.
-  if (sc.compliant)
-    throw InputError(sc.file + ": law.type: compliant: the motion after a compliant capture is not simulated yet; "
-                     "run kdl_space capture (it integrates the contact beside the impulsive capture), or give "
-                     "law.type capture");
   OperationResult r;
   r.duration = o.duration.value_or(sc.simulation.duration);
   r.output_step = o.output_step.value_or(sc.simulation.output_step);
@@ -255,7 +264,8 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
   std::optional<CaptureResult> capture;
   if (sc.impact) capture = inScenario(sc, [&] { return solveCapture(r.at_contact); });
   const CaptureProblem at_contact = r.at_contact;
-  runMotionAfterCapture(sc, at_contact, capture, r.t_capture, o, r);
+  if (sc.compliant) operation::compliantCapture(sc, at_contact, capture, o, r);  // its limit beside it
+  else runMotionAfterCapture(sc, at_contact, capture, r.t_capture, o, r);
   return r;
 }
 

@@ -10,6 +10,7 @@ const char* toString(Phase phase) {
     case Phase::Capture: return "capture";
     case Phase::Post: return "post";
     case Phase::Motion: return "motion";
+    case Phase::Contact: return "contact";
   }
   return "?";
 }

@@ -134,25 +134,16 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
     throw OperationError(approachFailure(sc, outcome.record), E_NOERROR, std::make_shared<const OperationResult>(result));
 }
 
-std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
-                                            const std::optional<CaptureResult>& capture, double t0, double t_end,
-                                            double output_step, const std::function<bool()>& cancelled) {
-  const auto* target = std::get_if<FloatingSystem>(&problem.target);
-  if (!target || !capture || !capture->floating_target) return std::nullopt;
-  SimulationOptions options = sc.simulation.options;
-  options.grounded = target->response == Response::Grounded;
-  Simulator sim(target->model, options);
+TargetMotion separatedTarget(const Scenario& sc, const FloatingSystem& target, double t0, double t_end,
+                             double output_step, const std::function<bool()>& cancelled) {
+  std::unique_ptr<Simulator> simulator = inScenario(sc, [&] { return targetSimulator(sc, target); });
+  Simulator& sim = *simulator;
   sim.setCancelPoll(cancelled);
-  JointControl locked;
-  locked.mode = JointControl::Mode::Locked;
-  for (unsigned int j = 0; j < target->model->nj(); ++j)
-    if (target->response == Response::JointsLocked || (!target->locked.empty() && target->locked[j]))
-      sim.setJointControl(j, locked);
   TargetMotion m;
   m.end.t = t0;
-  m.end.state = target->state;
-  m.end.velocity = capture->floating_target->after;
-  if (options.grounded) m.end.velocity.base_twist = KDL::Twist::Zero();
+  m.end.state = target.state;
+  m.end.velocity = target.velocity;
+  if (sim.options().grounded) m.end.velocity.base_twist = KDL::Twist::Zero();
   Vector6d h0 = Vector6d::Zero();
   int observer_rc = E_NOERROR;
   const auto observer = [&](const SimulationState& x) {

@@ -17,12 +17,26 @@ namespace kdl_space::operation {
 void approach(const Scenario& sc, double output_step, const std::function<bool()>& cancelled, OperationResult& result,
               SimulationState& s);
 
-/// \brief A free-floating target that separated after a point impact, moved on by itself from
-/// t0 to t_end (its own modes: braked joints stay braked; gravity as the robot's); nothing
-/// unless such a target separated.
-std::optional<TargetMotion> separatedTarget(const Scenario& sc, const CaptureProblem& problem,
-                                            const std::optional<CaptureResult>& capture, double t0, double t_end,
-                                            double output_step, const std::function<bool()>& cancelled);
+/// \brief A free-floating target that separated (after a point impact, or a compliant contact
+/// that opened), moved on by itself from its state and velocity at t0 to t_end (targetSimulator:
+/// its brakes and servos; gravity as the robot's; a grounded target held).
+TargetMotion separatedTarget(const Scenario& sc, const FloatingSystem& target, double t0, double t_end,
+                             double output_step, const std::function<bool()>& cancelled);
+
+/// \brief The motion after the capture (runMotionAfterCapture's, and a compliant capture's): the
+/// approach's and the contact's samples put in result.model's joints and given to the observer,
+/// then result.model's motion from s (its t the start) for result.duration, and `separated`'s by
+/// itself. result's model, joined, duration and output_step are set.
+void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationState s,
+               const std::optional<FloatingSystem>& separated, const OperationOptions& options, OperationResult& result);
+
+/// \brief The compliant capture (sc.compliant) at the contact instant result.t_capture: the
+/// contact integrated (its samples to result.contact_samples), then what moves on after it (the
+/// joined system if caught, the robot and the target apart if it opened) by runMotion. `limit`,
+/// the impulsive capture of the same contact, goes to result.capture. \throws OperationError (a
+/// contact that neither caught nor opened, a cancelled run), InputError in the scenario's terms.
+void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const std::optional<CaptureResult>& limit,
+                      const OperationOptions& options, OperationResult& result);
 
 /// \brief A free-floating target's own simulator (the scenario's simulation options; its brakes:
 /// target.mode, target.locked; its servos: simulation.target_joints; a grounded target held).

@@ -259,6 +259,10 @@ Study loadStudy(const std::string& path) {
   }
   const Scenario& sc = st.scenario;
   if (!sc.impact) top.at("scenario").fail("is a plain motion: a study samples captures (give the scenario a target and a law)");
+  if (sc.compliant)  // not its impulsive limit in disguise
+    top.at("scenario").fail("has law type compliant: a study samples the paper's impulsive captures (give law.type "
+                            "capture, the compliant contact's limit; kdl_space capture and simulate integrate the "
+                            "compliant contact)");
   if (sc.approach)
     top.at("scenario").fail("has an approach: a study samples the captures themselves (remove the approach; vary "
                             "`timing` for when along the tumble the hand closes)");

@@ -166,10 +166,19 @@ TEST(NoAllocation, RosenbrockStep) {
 
 class EveryComputeCall : public ::testing::TestWithParam<std::string> {};
 
-/// A bundled model, or "chainN": a generated N-link chain (large n exercises Eigen's blocked paths).
+/// A bundled model, or "chainN": a generated N-link chain (large n exercises Eigen's blocked paths),
+/// or a generated humanoid with mimic finger joints, N movable joints: "handsN" (a third of them
+/// mimic) or "grippersN" (four mimic).
 std::shared_ptr<const FloatingModel> load(const std::string& name) {
   if (name.rfind("chain", 0) == 0)
     return std::make_shared<const FloatingModel>(loadUrdfString(bench::generatedChainUrdf(std::stoi(name.substr(5))), name));
+  for (const auto& [prefix, urdf] : {std::pair{std::string("hands"), &bench::generatedHandsUrdf},
+                                     std::pair{std::string("grippers"), &bench::generatedGrippersUrdf}})
+    if (name.rfind(prefix, 0) == 0) {
+      auto model = std::make_shared<const FloatingModel>(loadUrdfString(urdf(std::stoi(name.substr(prefix.size()))), name));
+      if (model->mimic().empty()) ADD_FAILURE() << name << ": no mimic joints, nothing of mimic_coupling.hpp is run";
+      return model;
+    }
   return std::make_shared<const FloatingModel>(loadUrdfFile(urdfDir() + "/" + name));
 }
 
@@ -320,7 +329,11 @@ TEST_P(EveryComputeCall, SimulatorRunAllocatesNothing) {
       SCOPED_TRACE(std::string(grounded ? "grounded, " : "free, ") + std::to_string(static_cast<int>(integrator)));
       SimulationOptions options;
       options.integrator = integrator;
-      options.step = 0.01;
+      // RK4's fixed step: under the callback's damping c = 0.1 N m s, stable for h < 2.785 lambda / c,
+      // lambda the least eigenvalue of H; the generated fingers' lambda, down to 1.1e-4 kg m^2 (grippers14,
+      // hands12, hands24 at random states) asks for h < 3.1e-3 s (at 0.01 s grippers14 and hands24
+      // end in E_NOT_FINITE).
+      options.step = model->mimic().empty() ? 0.01 : 1e-3;
       options.grounded = grounded;
       Simulator sim(model, options);
       JointControl hold{JointControl::Mode::PD, 10.0, 5.0, 0.2};
@@ -407,6 +420,12 @@ TEST_P(EveryComputeCall, SampledControllerCallsAllocateNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Models, EveryComputeCall,
                          ::testing::Values("space_arm7.urdf", "dual_arm.urdf", "chain50", "chain100"));
+// Mimic joints: RecursiveExIITSolver's and ForwardDynamicsSolver's compute run the couplings'
+// constraint passes (src/algorithm/mimic_coupling.hpp: k x k Cholesky, 6 x k blocks per body) and
+// Simulator::run runs them at every derivative; k = 4 (grippers14, hands12: 6 x 4 blocks, Eigen's
+// coefficient-based products) and k = 8 (hands24: 6 x 6 by 6 x 8, Eigen's blocked product, taken
+// from 6 + 6 + k = 20 on).
+INSTANTIATE_TEST_SUITE_P(MimicModels, EveryComputeCall, ::testing::Values("grippers14", "hands12", "hands24"));
 
 }  // namespace
 }  // namespace kdl_space::test

@@ -16,6 +16,7 @@
 #include "kdl_space/simulation/approach.hpp"
 #include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "rigid_targets.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {
@@ -24,15 +25,6 @@ namespace {
 using ModelPtr = std::shared_ptr<const FloatingModel>;
 
 ModelPtr arm() { return std::make_shared<const FloatingModel>(loadUrdfFile(urdfDir() + "/space_arm7.urdf")); }
-
-RigidTarget box(const Vector3d& position, const Vector6d& twist) {
-  RigidTarget t;
-  t.mass = 50.0;
-  t.inertia = Vector3d(2.1, 2.6, 3.0).asDiagonal();
-  t.pose = KDL::Frame(KDL::Rotation::RPY(0.3, -0.2, 0.5), toKDL(position));
-  t.twist = twist;
-  return t;
-}
 
 SimulationState startState(const FloatingModel& model) {
   SimulationState s;

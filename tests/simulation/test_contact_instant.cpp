@@ -17,6 +17,7 @@
 
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "kdl_space/simulation/approach.hpp"
+#include "rigid_targets.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {
@@ -196,16 +197,6 @@ struct BrakedArm {
     return sim;
   }
 };
-
-/// A box target (CoM at its frame's origin) at `position`, turned, with `twist` (v of the CoM; w).
-RigidTarget box(const Vector3d& position, const Vector6d& twist) {
-  RigidTarget t;
-  t.mass = 50.0;
-  t.inertia = Vector3d(2.1, 2.6, 3.0).asDiagonal();
-  t.pose = KDL::Frame(KDL::Rotation::RPY(0.3, -0.2, 0.5), toKDL(position));
-  t.twist = twist;
-  return t;
-}
 
 /// The first t >= 0 with |a + b t + c t^2 / 2| = r, for |a| > r (bisection to round-off on the
 /// closed form, after a scan fine enough not to step over the first root).

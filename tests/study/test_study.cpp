@@ -391,6 +391,8 @@ TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
       {"scenario: missing.yaml\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n", "missing.yaml"},
       {"scenario: " + kScenarios + "approach_tumbling_box.yaml\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n",
        "scenario: has an approach"},
+      {"scenario: " + kScenarios + "compliant_capture.yaml\nsamples: 10\nseed: 1\ninputs: {timing: {uniform: [0, 1]}}\n",
+       "scenario: has law type compliant"},
       {"scenario: " + kScenarios + "robot_to_robot_capture.yaml\nsamples: 10\nseed: 1\ninputs: {target.mass: {uniform: [1, 2]}}\n",
        "the target is a free-floating system"},
       {"scenario: " + kScenarios + "robot_to_robot_capture.yaml\nsamples: 10\nseed: 1\ninputs: {robot.q.joint2: {uniform: [0, 0.1]}}\n"

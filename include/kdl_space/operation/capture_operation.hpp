@@ -1,8 +1,9 @@
 // The capture operation as one call: from a scenario, the approach (the hand reaches the grasp
-// point on the moving target), the capture at the contact instant (the paper's impulsive law), the
-// system that moves on after it (the robot with a payload, the captured robot joined into one
-// tree, or both sides apart) and its motion: what `kdl_space simulate` runs, what a study's motion
-// after a capture runs, and `kdl_space.run_operation` in Python.
+// point on the moving target), the capture at the contact instant (the paper's impulsive law, or a
+// compliant contact integrated over its duration), the system that moves on after it (the robot
+// with a payload, the captured robot joined into one tree, or both sides apart) and its motion:
+// what `kdl_space simulate` runs, what a study's motion after a capture runs, and
+// `kdl_space.run_operation` in Python.
 #pragma once
 
 #include <functional>
@@ -16,6 +17,7 @@
 #include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/operation/motion_record.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/simulation/compliant_capture.hpp"
 #include "kdl_space/simulation/sampled_control.hpp"
 
 namespace kdl_space {
@@ -32,9 +34,10 @@ struct OperationOptions {
   /// whatever the scenario's set points: a study's motion after a capture.
   bool hold_servos = false;
   /// Every output sample in time order, with the result so far (its `model` is the system the
-  /// sample's joints belong to). The approach's samples come once the capture has told which
-  /// system moves on (the target's joints, if it joins, are NaN in them). It may throw: the run
-  /// stops there and the exception propagates.
+  /// sample's joints belong to). The approach's samples (and a compliant contact's) come once the
+  /// capture has told which system moves on (the target's joints, if it joins, are NaN in the
+  /// approach's; a target that bounced off is not in the contact's). It may throw: the run stops
+  /// there and the exception propagates.
   std::function<void(const OperationResult& so_far, const MotionSample& sample)> observer;
   bool keep_samples = true;  ///< keep the samples in the result (false: the observer and the record only)
   /// A controller of the motion after the capture (its torques add to the scenario's joint modes),
@@ -51,8 +54,10 @@ struct OperationOptions {
 
 /// \brief How many output samples a run of the operation can produce at most: the approach's (if
 /// the scenario has one and options.approach: approach.max_duration / output_step + 1) and the
-/// motion's (if options.motion: duration / output_step + 1). For a caller that keeps or writes
-/// them to refuse a run too large before it starts (a double: it may exceed any integer).
+/// motion's (if options.motion: duration / output_step + 1). A compliant contact's samples, at its
+/// own finer step, are not counted (they come as its time scale requires). For a caller that
+/// keeps or writes them to refuse a run too large before it starts (a double: it may exceed any
+/// integer).
 KDL_SPACE_EXPORT double estimatedOutputRows(const Scenario& scenario, const OperationOptions& options = {});
 
 /// What the approach did.
@@ -81,17 +86,27 @@ struct TargetMotion {
 
 /// Everything the operation did (what `kdl_space simulate --json` prints).
 struct KDL_SPACE_EXPORT OperationResult {
-  double duration = 0.0;     ///< of the motion after the capture [s]
+  double duration = 0.0;     ///< of the motion after the capture (after the contact, if compliant) [s]
   double output_step = 0.0;  ///< [s]
   std::optional<ApproachOutcome> approach;
   /// The capture problem at the contact instant (after an approach: the states then).
   CaptureProblem at_contact;
-  std::optional<CaptureResult> capture;  ///< unset for a plain motion
+  /// Unset for a plain motion. With a compliant law: the impulsive capture of the same contact
+  /// (its limit as the stiffness grows), beside `compliant`; what moves on comes from `compliant`.
+  std::optional<CaptureResult> capture;
+  /// A compliant capture (law type compliant): the contact integrated from t_capture over its
+  /// duration (solveCompliantCapture). Caught: the joined system (the grasp's six joints braked at
+  /// their deflection) moves on; opened: the robot alone, a free-floating target by itself
+  /// (target_motion). The motion after starts at its end, t_capture + compliant->duration.
+  std::optional<CompliantCaptureResult> compliant;
   std::optional<JoinedSystem> joined;    ///< the captured target joined to the robot's tree
   std::shared_ptr<const FloatingModel> model;  ///< what moves after the capture
   bool payload_attached = false;  ///< model is the robot with the target as a payload, or joined
   double t_capture = 0.0;         ///< the contact instant (0 without an approach) [s]
   std::vector<MotionSample> approach_samples;  ///< the last one: the contact instant
+  /// A compliant contact's samples (Phase::Contact, kept whatever keep_samples: they come before
+  /// the system after it is known), in the joints of `model`.
+  std::vector<MotionSample> contact_samples;
   std::vector<MotionSample> samples;           ///< of the motion after the capture (keep_samples)
   /// The motion's records and aggregates (also without kept samples; none without a motion:
   /// record.samples is 0)

@@ -15,9 +15,10 @@ enum class Phase {
   Capture,   ///< the approach's last sample: the contact instant, before the impact
   Post,      ///< after the impact
   Motion,    ///< a plain motion (a scenario without an impact)
+  Contact,   ///< during a compliant capture's contact (law type compliant), after the touch
 };
 
-/// The phase's name in the CSV and the JSON: "approach", "capture", "post", "motion".
+/// The phase's name in the CSV and the JSON: "approach", "capture", "post", "motion", "contact".
 KDL_SPACE_EXPORT const char* toString(Phase phase);
 
 struct MotionSample {
@@ -35,6 +36,9 @@ struct MotionSample {
   Vector6d impulse = Vector6d::Zero();  ///< external, since the start of the run
   Phase phase = Phase::Post;
   double grasp_distance = std::numeric_limits<double>::quiet_NaN();  ///< hand to grasp point [m] (approach)
+  /// The compliant contact's wrench on the robot (f; n about its contact point), world [N, N m]
+  /// (ContactSample::wrench): Phase::Contact only, NaN in the other phases.
+  Vector6d contact_wrench = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 /// \brief The sample of a state of `sim`'s run (its energy and momentum computed in O(n)).

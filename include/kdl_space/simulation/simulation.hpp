@@ -122,7 +122,8 @@ struct Stiffness {
 /// Each evaluation of the derivative is O(n): one forwardKinematics, the base twist from the
 /// momentum (MomentumSolver::baseTwist) and the articulated-body forward dynamics
 /// (ForwardDynamicsSolver), all reading the same Kinematics; no n x n matrix is built (except by
-/// the Rosenbrock method, whose Jacobian is (13 + 2n)^2, and for a model with mimic joints).
+/// the Rosenbrock method, whose Jacobian is (13 + 2n)^2; mimic joints are constraints on the
+/// recursion, O(n k + k^3) for k of them).
 /// The joint torque is the control's (PD, callback; limited to the effort limit) plus friction.
 /// Hard stops (LimitMode::Stop) are located in time within 1e-10 of the limit, where the joint's
 /// rate is stopped by an internal impulse (momentum unchanged; the energy lost is counted in
@@ -278,7 +279,7 @@ class KDL_SPACE_EXPORT Simulator {
   std::shared_ptr<const FloatingModel> model_;
   Kinematics kin_;             ///< the state of the last unpack() / energyAndMomentum()
   MomentumSolver momentum_;
-  /// The articulated-body recursion; the dense route for a model with mimic joints.
+  /// The articulated-body recursion (mimic joints as constraints on it: src/simulation/dynamics.hpp).
   std::unique_ptr<detail::Dynamics> dynamics_;
   SimulationOptions options_;
   std::vector<JointControl> controls_;

@@ -1,0 +1,85 @@
+// The compliant capture inside the operation (law type compliant, issue 28): the contact
+// integrated over its duration from the contact instant, then what moves on after it.
+#include <iomanip>
+#include <sstream>
+
+#include "detail/text.hpp"
+#include "operation/phases.hpp"
+
+namespace kdl_space::operation {
+namespace {
+
+/// The contact's integrator: the scenario's options, but an adaptive one (a fixed rk4 step chosen
+/// for the motion would not resolve a contact of a few milliseconds).
+SimulationOptions contactOptions(const Scenario& sc) {
+  SimulationOptions options = sc.simulation.options;
+  if (options.integrator == Integrator::RK4) options.integrator = Integrator::DormandPrince54;
+  return options;
+}
+
+}  // namespace
+
+void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const std::optional<CaptureResult>& limit,
+                      const OperationOptions& o, OperationResult& r) {
+  r.duration = o.duration.value_or(sc.simulation.duration);
+  r.output_step = o.output_step.value_or(sc.simulation.output_step);
+  r.at_contact = problem;
+  r.capture = limit;
+  r.model = problem.robot.model;
+  const double t0 = r.t_capture;
+  CompliantRun run;
+  run.options = contactOptions(sc);
+  bool cancelled = false;
+  run.cancelled = [&] { return cancelled = o.cancelled && o.cancelled(); };
+  int sample_rc = E_NOERROR;
+  run.observer = [&](Simulator& sim, const SimulationState& x, const ContactSample& c) {
+    MotionSample smp;
+    if (const int rc = sampleOf(sim, x, Phase::Contact, smp)) sample_rc = rc;
+    smp.t += t0;
+    smp.contact_wrench = c.wrench;
+    r.contact_samples.push_back(std::move(smp));
+  };
+  try {
+    r.compliant = solveCompliantCapture(problem, *sc.compliant, run);
+  } catch (const OperationError&) {
+    throw;
+  } catch (const Error& e) {
+    r.compliant.reset();
+    if (cancelled)
+      throw OperationError(sc.file + ": the simulation was cancelled in the compliant contact, after t = " +
+                               detail::number(t0) + " s",
+                           E_CANCELLED, std::make_shared<const OperationResult>(r));
+    e.rethrowWithContext(sc.file + ": ");
+  }
+  const CompliantCaptureResult& c = *r.compliant;
+  while (!r.contact_samples.empty() && r.contact_samples.back().t > t0 + c.duration)  // one looked past the end
+    r.contact_samples.pop_back();
+  if (sample_rc)
+    throw OperationError(sc.file + ": the compliant contact's samples cannot be evaluated: " + strError(sample_rc),
+                         sample_rc, std::make_shared<const OperationResult>(r));
+  if (c.end == ContactEnd::TimedOut) {
+    std::ostringstream why;
+    why << std::setprecision(6) << sc.file << ": law.max_duration: the compliant contact was neither caught nor opened in "
+        << sc.compliant->max_duration << " s (relative speed still above law.catch_tolerance = "
+        << sc.compliant->catch_tolerance << " of its start): raise law.max_duration, the damping "
+        << "(law.damping_time or law.damping), or law.catch_tolerance";
+    throw OperationError(why.str(), E_NOERROR, std::make_shared<const OperationResult>(r));
+  }
+  SimulationState s;
+  s.t = t0 + c.duration;
+  std::optional<FloatingSystem> separated;
+  if (c.end == ContactEnd::Caught) {  // the grasp locked at its deflection: one system moves on
+    r.joined = c.joined;
+    r.model = c.joined.model;
+    s.state = c.joined.state;
+    s.velocity = c.joined.velocity;
+  } else {  // opened: the robot alone; a free-floating target by itself
+    s.state = c.robot_end.state;
+    s.velocity = c.robot_end.velocity;
+    if (std::holds_alternative<FloatingSystem>(problem.target)) separated = c.target_end;
+  }
+  r.payload_attached = r.model != problem.robot.model;
+  runMotion(sc, problem, s, separated, o, r);
+}
+
+}  // namespace kdl_space::operation
