@@ -317,7 +317,7 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
   std::optional<CompliantCaptureResult> compliant;
   if (sc.compliant)
     compliant = inScenario(sc, [&] {
-      return solveCompliantCapture(sc.capture.robot, std::get<FloatingSystem>(sc.capture.target), *sc.compliant);
+      return solveCompliantCapture(sc.capture, *sc.compliant);
     });
   if (!o.scene.empty()) {
     AtomicFile scene(o.scene, "--scene");

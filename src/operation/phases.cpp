@@ -5,6 +5,7 @@
 
 #include "detail/text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
+#include "kdl_space/impact/rigid_body_system.hpp"
 #include "kdl_space/operation/overlap_check.hpp"
 
 namespace kdl_space::operation {
@@ -133,25 +134,6 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
     throw OperationError(approachFailure(sc, outcome.record), E_NOERROR, std::make_shared<const OperationResult>(result));
 }
 
-namespace {
-/// A rigid target as a free-floating system of one body (no joints), its frame at the CoM with
-/// the inertia's axes of the target's frame: what a ball joint can join to the robot.
-FloatingSystem oneBody(const RigidTarget& t, const Vector3d& contact_point, const Vector6d& twist_at_com) {
-  const Matrix3d& I = t.inertia;
-  FloatingSystem s;
-  s.model = std::make_shared<const FloatingModel>(
-      KDL::Tree("target"), KDL::RigidBodyInertia(t.mass, KDL::Vector::Zero(),
-                                                 KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2))));
-  s.state = State(*s.model);
-  s.state.world_T_base = KDL::Frame(t.pose.M, t.pose * toKDL(t.com));
-  s.velocity = FloatingVelocity(*s.model);
-  s.velocity.base_twist = toTwist(twist_at_com);
-  s.contact = Contact{0, s.state.world_T_base.Inverse() * toKDL(contact_point)};
-  return s;
-}
-
-}  // namespace
-
 TargetMotion separatedTarget(const Scenario& sc, const FloatingSystem& target, double t0, double t_end,
                              double output_step, const std::function<bool()>& cancelled) {
   std::unique_ptr<Simulator> simulator = inScenario(sc, [&] { return targetSimulator(sc, target); });
@@ -207,7 +189,7 @@ std::optional<JoinedSystem> joinedAfterCapture(const CaptureProblem& problem, co
                        problem.touch_tolerance);
   if (grasp == GraspJoint::Rigid) return std::nullopt;  // the payload route (attachTarget)
   const RigidTarget& rigid = std::get<RigidTarget>(problem.target);
-  FloatingSystem body = operation::oneBody(rigid, capture.contact_point, capture.target_twist_before);
+  FloatingSystem body = rigidBodySystem(rigid, capture.contact_point, capture.target_twist_before);
   FloatingVelocity after = body.velocity;
   after.base_twist = toTwist(capture.target_twist_after);
   return joinAtGrasp(problem.robot, capture.robot.after, body, after, grasp, problem.touch_tolerance);

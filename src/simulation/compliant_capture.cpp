@@ -3,18 +3,22 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "kdl_space/algorithm/momentum.hpp"
+#include "kdl_space/impact/rigid_body_system.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/spatial/errors.hpp"
 #include "detail/text.hpp"
+#include "simulation/compliant_probe.hpp"
 
 namespace kdl_space {
 namespace {
 
-/// The grasp joints' order is (x, y, z, rz, ry, rx); the law's axes are (x, y, z, about x, y, z).
-constexpr int kAxisOf[6] = {0, 1, 2, 5, 4, 3};
+using detail::kAxisOf;
+using detail::Probe;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void checkPositive(const Vector6d& v, const std::string& field, bool zero_ok) {
   for (int k = 0; k < 6; ++k)
@@ -37,104 +41,6 @@ void checkGrasp(const CompliantGrasp& g) {
     throw InputError("law.normal: must be a finite non-zero vector");
 }
 
-/// Reads the joined state at the samples: the grasp's wrench, the sides' own momenta.
-class Probe {
- public:
-  Probe(const JoinedSystem& js, const FloatingSystem& robot, const FloatingSystem& target, const Vector6d& K,
-        const Vector6d& D)
-      : js_(js), robot_(robot), target_(target), K_(K), D_(D), kin_(*js.model), rkin_(*robot.model),
-        tkin_(*target.model), rmom_(robot.model), tmom_(target.model) {
-    const FloatingModel& m = *js.model;
-    for (int k = 0; k < 6; ++k)
-      for (std::size_t b = 0; b < m.bodies().size(); ++b)
-        if (m.bodies()[b].joint == js.grasp_joints[k]) body_[k] = static_cast<int>(b);
-    robot_contact_ = robot.contact;  // the robot's bodies keep their indices in the joined model
-    target_base_ = m.bodyIndex(js.target_prefix + target.model->bodies()[0].name);
-  }
-  /// tau on the grasp joints (model order of the grasp: x, y, z, rz, ry, rx).
-  double torque(int k, const SimulationState& s) const {
-    const int j = js_.grasp_joints[k], a = kAxisOf[k];
-    return -K_(a) * s.state.q(j) - D_(a) * s.velocity.qdot(j);
-  }
-  double relativeSpeed2(const SimulationState& s) const {
-    double sum = 0.0;
-    for (int k = 0; k < 6; ++k) sum += K_(kAxisOf[k]) * std::pow(s.velocity.qdot(js_.grasp_joints[k]), 2);
-    return sum;
-  }
-  double springEnergy(const State& st) const {
-    double V = 0.0;
-    for (int k = 0; k < 6; ++k) V += 0.5 * K_(kAxisOf[k]) * std::pow(st.q(js_.grasp_joints[k]), 2);
-    return V;
-  }
-  /// The sample: the wrench W on the target's side of the grasp solves S^T W = tau (the massless
-  /// grasp links pass it on unchanged); the robot gets -W, moved to its contact point.
-  ContactSample sample(const SimulationState& s, double t0) {
-    ContactSample out;
-    out.t = s.t - t0;
-    if (forwardKinematics(*js_.model, s.state, kin_)) throw InputError("contact: the joined state cannot be computed");
-    Matrix6d S;
-    Vector6d tau;
-    for (int k = 0; k < 6; ++k) {
-      S.col(k) = kin_.S[body_[k]];
-      tau(k) = torque(k, s);
-      out.deflection(k) = s.state.q(js_.grasp_joints[k]);
-    }
-    const Vector6d W = S.transpose().fullPivLu().solve(tau);
-    const Vector3d f = -W.head<3>();
-    const Vector3d n_b = -W.tail<3>();  // about the base origin p_b
-    const Vector3d p_c = kin_.point(robot_contact_);
-    out.wrench << f, n_b - (p_c - kin_.p_b).cross(f);
-    return out;
-  }
-  /// Splits the joined state into each side's own state and velocity, and their momenta.
-  void split(const SimulationState& s, FloatingSystem& r_end, FloatingSystem& t_end, Vector6d& h_r, Vector6d& h_t) {
-    const FloatingModel& rm = *robot_.model;
-    const FloatingModel& tm = *target_.model;
-    r_end = robot_;
-    t_end = target_;
-    State& rs = r_end.state;
-    State& ts = t_end.state;
-    FloatingVelocity& rv = r_end.velocity;
-    FloatingVelocity& tv = t_end.velocity;
-    rs.world_T_base = s.state.world_T_base;
-    rv = FloatingVelocity(rm);
-    rv.base_twist = s.velocity.base_twist;
-    for (unsigned int j = 0; j < rm.nj(); ++j) {
-      rs.q(j) = s.state.q(js_.robot_joints[j]);
-      rv.qdot(j) = s.velocity.qdot(js_.robot_joints[j]);
-    }
-    if (forwardKinematics(*js_.model, s.state, kin_)) throw InputError("contact: the joined state cannot be computed");
-    MomentumSolver jm(js_.model);
-    if (jm.compute(kin_, s.velocity)) throw InputError("contact: the joined velocity cannot be computed");
-    Vector6d base_twist;
-    jm.contactTwist(Contact{target_base_, KDL::Vector::Zero()}, base_twist);
-    ts.world_T_base = kin_.pose(target_base_);
-    tv = FloatingVelocity(tm);
-    tv.base_twist = KDL::Twist(KDL::Vector(base_twist(0), base_twist(1), base_twist(2)),
-                               KDL::Vector(base_twist(3), base_twist(4), base_twist(5)));
-    for (unsigned int j = 0; j < tm.nj(); ++j) {
-      ts.q(j) = js_.target_joint_sign[j] * s.state.q(js_.target_joints[j]);
-      tv.qdot(j) = js_.target_joint_sign[j] * s.velocity.qdot(js_.target_joints[j]);
-    }
-    if (forwardKinematics(rm, rs, rkin_) || rmom_.compute(rkin_, rv) || forwardKinematics(tm, ts, tkin_) ||
-        tmom_.compute(tkin_, tv))
-      throw InputError("contact: a side's state after the contact cannot be computed");
-    h_r = rmom_.momentum();
-    h_t = tmom_.momentum();
-  }
-
- private:
-  const JoinedSystem& js_;
-  const FloatingSystem& robot_;
-  const FloatingSystem& target_;
-  Vector6d K_, D_;
-  Kinematics kin_, rkin_, tkin_;
-  MomentumSolver rmom_, tmom_;
-  int body_[6] = {0, 0, 0, 0, 0, 0};
-  Contact robot_contact_;
-  int target_base_ = -1;
-};
-
 /// Braked joints of one side (its `locked`, or all with Response::JointsLocked).
 bool braked(const FloatingSystem& side, unsigned int j) {
   return side.response == Response::JointsLocked || (j < side.locked.size() && side.locked[j]);
@@ -144,6 +50,47 @@ bool braked(const FloatingSystem& side, unsigned int j) {
 Vector6d impulseAbout(const Vector6d& h, const Vector6d& h_before, const Vector3d& p) {
   const Vector6d dh = h - h_before;
   return (Vector6d() << dh.head<3>(), dh.tail<3>() - p.cross(dh.head<3>())).finished();
+}
+
+/// What the end criteria are measured against: the relative speed^2 at the touch, and a force.
+struct EndScales {
+  double speed2 = 0.0;  ///< s0 = qdot^T K qdot at the touch
+  double force = 1.0;   ///< [N]: the spring's force after the slowest time scale at the touch's speed
+};
+
+/// The contact's end criteria at a state, each > 0 while the contact goes on and crossing to <= 0
+/// where it ends; +inf where inactive. All are functions of the state alone (no accelerations),
+/// as the stop event needs, and normalised (dimensionless, ~1 at the touch).
+struct EndCriteria {
+  double speed = kInf;    ///< the relative speed over its start, minus catch_tolerance
+  double closing = kInf;  ///< without a normal: dV/dt of the springs, scaled (the hand closes while > 0)
+  double opening = kInf;  ///< with a normal: -n^T f, f the force on the robot (it pushes while > 0)
+  double least() const { return std::min(speed, std::min(closing, opening)); }
+};
+
+EndCriteria endCriteria(Probe& probe, const CompliantGrasp& grasp, const EndScales& at, const SimulationState& x) {
+  EndCriteria c;
+  if (at.speed2 == 0.0) {  // no relative motion at the touch: caught there
+    c.speed = -1.0;
+    return c;
+  }
+  // (a) caught: sqrt(qdot^T K qdot) <= catch_tolerance * its start.
+  c.speed = std::sqrt(probe.relativeSpeed2(x) / at.speed2) - grasp.catch_tolerance;
+  if (!grasp.normal) {
+    // (b) caught: the first maximum of the springs' energy V = 1/2 q^T K q, where dV/dt = q^T K qdot
+    // falls to 0: the hand has stopped closing (the relative motion's first rest in the springs'
+    // metric). Scaled by sqrt(2 V s0) (Cauchy-Schwarz: within the relative speed's ratio): it tends
+    // to 1 at the touch, where V = 0 and dV/dt = 0 (the spring not yet loaded: positive).
+    const double V = probe.springEnergy(x.state);
+    c.closing = V > 0.0 ? probe.springPower(x) / std::sqrt(2.0 * V * at.speed2) : 1.0;
+  } else if (x.t > 0.0) {
+    // (c) opened: the force on the robot would pull it toward the target, n^T f >= 0. (At the
+    // touch with no damping f = 0: positive there; it pushes once the spring is loaded.)
+    c.opening = -grasp.normal->normalized().dot(probe.sample(x, 0.0).wrench.head<3>()) / at.force;
+  } else {
+    c.opening = 1.0;
+  }
+  return c;
 }
 
 CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& target, const CompliantGrasp& grasp,
@@ -180,8 +127,8 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   // period, or its rate's relaxation when overdamped; m the apparent inertia the grasp joint
   // meets) among the axes that carry at least 1e-3 of the relative motion (K qdot^2): they decide
   // when it is caught. (A light, heavily damped axis relaxes within the first samples; the
-  // integrator's steps resolve it.) With D = beta K every tau_a is ~ 1/K, so the catch is located
-  // to ~ 1/K as the stiffness grows.
+  // integrator's steps resolve it.) The samples are the force history's; the end of the contact
+  // is located between them.
   const double s0 = probe.relativeSpeed2(s);
   double scale = 0.0;
   for (int k = 0; k < 6; ++k) {
@@ -196,12 +143,9 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   if (scale == 0.0) scale = grasp.max_duration;
   scale = std::min(scale, grasp.max_duration);
   const double dt = scale / 40.0;
+  // (The steps end at the outputs: the end criteria, sampled at the steps' ends, are seen at least
+  // this often.)
 
-  const double tol2 = grasp.catch_tolerance * grasp.catch_tolerance * s0;
-  SimulationState prev = s;
-  double prev_speed2 = s0;
-  bool at_min = false;
-  ContactEnd end = ContactEnd::TimedOut;
   // The robot's momentum and contact point before the contact: the impulse so far is its change.
   Kinematics rkin(*robot.model);
   MomentumSolver rmom(robot.model);
@@ -218,33 +162,23 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
     res.history.push_back(c);
     if (run.observer) run.observer(sim, x, c);
   };
-  sim.setStopCondition([&](const SimulationState& x) {
-    const double v2 = probe.relativeSpeed2(x);
-    if (s0 == 0.0 || v2 <= tol2) {
-      end = ContactEnd::Caught;
-      return true;
-    }
-    // The first minimum below half the speed; a contact with a normal waits for the tolerance.
-    if (!grasp.normal && v2 > prev_speed2 && prev_speed2 < 0.25 * s0) {
-      end = ContactEnd::Caught;
-      at_min = true;
-      return true;
-    }
-    if (grasp.normal && x.t > 0.0 && grasp.normal->normalized().dot(res.history.back().wrench.head<3>()) > 0.0) {
-      end = ContactEnd::Opened;
-      return true;
-    }
-    prev = x;
-    prev_speed2 = v2;
-    return false;
-  });
+  // The end of the contact, located between the steps (the simulator's stop event, to 1e-10 s):
+  // the first zero of the least of the active criteria (endCriteria).
+  const EndScales scales{s0, std::sqrt(K.maxCoeff() * s0) * scale};
+  sim.setStopEvent([&](const SimulationState& x) { return endCriteria(probe, grasp, scales, x).least(); });
   if (const int rc = sim.run(s, grasp.max_duration, dt, observe))
     throw InputError(std::string("contact: the integration failed at t = ") + detail::number(s.t) + " s: " +
                      strError(rc));
   res.steps = sim.stats().accepted_steps;
-  if (at_min) {  // the minimum was the sample before: the contact ends there
-    s = prev;
-    res.history.pop_back();
+  ContactEnd end = ContactEnd::TimedOut;
+  if (std::isfinite(sim.stats().event_time)) {  // which criterion ended it: the least at the end
+    const EndCriteria c = endCriteria(probe, grasp, scales, s);
+    if (c.opening <= std::min(c.speed, c.closing)) {
+      end = ContactEnd::Opened;
+    } else {
+      end = ContactEnd::Caught;
+      res.catch_rule = c.speed <= c.closing ? CatchRule::Tolerance : CatchRule::SpringMaximum;
+    }
   }
   res.end = end;
   res.duration = s.t;
@@ -297,9 +231,14 @@ CompliantCaptureResult solveCompliantCapture(const FloatingSystem& robot, const 
 
 CompliantCaptureResult solveCompliantCapture(const CaptureProblem& problem, const CompliantGrasp& grasp,
                                              const CompliantRun& run) {
-  const auto* target = std::get_if<FloatingSystem>(&problem.target);
-  if (!target) throw InputError("target: a compliant capture of a rigid target is not supported yet");
-  return solve(problem.robot, *target, grasp, run);
+  if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) return solve(problem.robot, *target, grasp, run);
+  // A rigid target: one free body touched where the robot's contact point is.
+  const FloatingSystem& robot = problem.robot;
+  Kinematics kin(*robot.model);
+  if (forwardKinematics(*robot.model, robot.state, kin))
+    throw InputError("robot: the state before the contact cannot be computed");
+  const RigidTarget& rigid = std::get<RigidTarget>(problem.target);
+  return solve(robot, rigidBodySystem(rigid, kin.point(robot.contact), rigid.twist), grasp, run);
 }
 
 }  // namespace kdl_space

@@ -249,9 +249,16 @@ TEST(LoadScenario, CompliantLawRefusals) {
             "law.stiffness: expected a list of 6 numbers, got a list of 3");
   EXPECT_EQ(tail(refusal(withLaw("key.yaml", "{type: compliant, restitution: 0.5}"))).substr(0, 29),
             "law.restitution: unknown fiel");
-  EXPECT_EQ(tail(refusal(withLaw("rigid.yaml", "{type: compliant}", true))),
-            "law.type: compliant joins two free-floating systems: give the target's urdf with movable joints (a "
-            "rigid target is not supported yet)");
+}
+
+// A rigid target takes the compliant law too (one free body joined at the grasp).
+TEST(LoadScenario, CompliantLawOnARigidTarget) {
+  const Scenario s = loadScenario(withLaw("rigid.yaml", "{type: compliant, damping_time: 0.002}", true));
+  ASSERT_TRUE(s.compliant);
+  EXPECT_EQ(s.compliant->damping_time, 0.002);
+  EXPECT_EQ(s.capture.law.kind, ImpactKind::Capture);  // the impulsive limit beside it
+  ASSERT_TRUE(std::holds_alternative<RigidTarget>(s.capture.target));
+  EXPECT_EQ(std::get<RigidTarget>(s.capture.target).mass, 50.0);
 }
 
 

@@ -27,15 +27,17 @@ struct CompliantGrasp {
   /// empty. With beta fixed the contact lasts ~ m / (beta K) and the capture converges to the
   /// impulsive one at first order in 1/K (with a fixed damping ratio: order 1/2).
   double damping_time = 1e-3;
-  /// The relative motion is caught when its speed sqrt(qdot^T K qdot) over the grasp joints falls
-  /// below catch_tolerance times its value at the start of the contact, or at its first local
-  /// minimum once it has fallen below half of it (the motion has stopped closing; not with a
-  /// `normal`), both checked at the output samples.
+  /// The relative motion is caught at the first instant where its speed sqrt(qdot^T K qdot) over
+  /// the grasp joints falls to catch_tolerance times its value at the touch, or (without a
+  /// `normal`) where the springs' energy V = 1/2 q^T K q reaches its first maximum (dV/dt = q^T K
+  /// qdot falls to 0: the hand has stopped closing). Both are located between the integrator's
+  /// steps (Simulator::setStopEvent, to 1e-10 s), not at the output samples.
   double catch_tolerance = 1e-3;
   double max_duration = 1.0;  ///< [s]: the contact ends (neither caught nor opened) after this
   /// Unit normal from the robot's contact point toward the target (world, at the start): if
-  /// given, the contact is one-sided until the catch: it opens (a bounce) as soon as the force on
-  /// the robot would pull it toward the target (n^T f > 0), and it is caught only when the relative
+  /// given, the contact is one-sided until the catch: it opens (a bounce) at the first instant the
+  /// force on the robot would pull it toward the target (n^T f >= 0, located as the catch), and it
+  /// is caught only when the relative
   /// speed falls below catch_tolerance (the fingers close on a target that has come to rest in
   /// the hand; not at a minimum). Empty: the grasp holds from the touch (a closed gripper).
   std::optional<Vector3d> normal;
@@ -56,13 +58,23 @@ struct ContactSample {
 /// How the contact ended.
 enum class ContactEnd { Caught, Opened, TimedOut };
 
+/// Which criterion caught the relative motion (CompliantGrasp::catch_tolerance): its speed fell to
+/// the tolerance, or the springs' energy reached its first maximum. None unless caught.
+enum class CatchRule { None, Tolerance, SpringMaximum };
+
 /// Everything about an integrated compliant capture (world frame; momentum about the origin).
 struct CompliantCaptureResult {
   ContactEnd end = ContactEnd::TimedOut;
-  double duration = 0.0;                 ///< [s]
+  CatchRule catch_rule = CatchRule::None;  ///< what caught it (end == Caught)
+  /// [s]: the located instant of the catch or the opening (within 1e-10 s after it, plus the
+  /// integration's error), max_duration if timed out
+  double duration = 0.0;
   double peak_force = 0.0, peak_moment = 0.0;  ///< largest |f|, |n| of the samples [N], [N m]
   Vector6d peak_force_wrench = Vector6d::Zero();  ///< the sample's wrench where |f| peaks
-  std::vector<ContactSample> history;    ///< the samples, from the start to the end
+  /// The output samples, from the start to the end: every multiple of the output step (a
+  /// fortieth of the slowest time scale), then the located end (its spacing to the one before is
+  /// shorter).
+  std::vector<ContactSample> history;
   /// The impulse on the robot: its own momentum's change over the contact, (f; n about the
   /// robot's contact point at the start), as CaptureResult::impulse.F.
   Vector6d impulse = Vector6d::Zero();
@@ -90,8 +102,10 @@ struct CompliantCaptureResult {
 /// \brief Integrates the compliant capture of the free-floating `target` by `robot` from their
 /// states and velocities (before the contact): joinAtGrasp(..., GraspJoint::Compliant), the torque
 /// tau = -K q - D qdot on the six grasp joints (an internal force: the momentum is an invariant
-/// of the integrator), output samples at a fortieth of the fastest axis' time scale, until the
-/// catch (the grasp joints braked by engageBrakes: momentum kept), the opening or max_duration.
+/// of the integrator), output samples at a fortieth of the slowest time scale of the axes that
+/// carry the relative motion, until the catch (the grasp joints braked by engageBrakes: momentum
+/// kept), the opening or max_duration; the catch and the opening are located between the
+/// integrator's steps (CompliantGrasp::catch_tolerance, normal).
 /// Joints braked on either side (FloatingSystem::locked, Response::JointsLocked) stay braked.
 /// A set-up call: \throws InputError ("law.stiffness: ..." etc. for a parameter that is not
 /// finite and > 0, joinAtGrasp's errors, "contact: ..." with the simulator's code when the
@@ -114,8 +128,11 @@ struct CompliantRun {
 };
 
 /// \brief The compliant capture of the problem's target, free-floating or rigid (a rigid target is
-/// one free body: its mass and inertia at its CoM, its twist problem.target's). The problem's law
-/// and touch tolerance are not used (the grasp's spring-damper is the law). \throws as above.
+/// one free body, rigidBodySystem (impact/rigid_body_system.hpp): its mass and inertia at its CoM,
+/// the target frame's axes, its twist RigidTarget::twist, touched at the robot's contact point).
+/// The problem's law and touch tolerance are not used (the grasp's spring-damper is the law).
+/// \throws as above, and InputError ("target.mass: ...") for a rigid target whose mass is not
+/// finite and > 0.
 KDL_SPACE_EXPORT CompliantCaptureResult solveCompliantCapture(const CaptureProblem& problem, const CompliantGrasp& grasp,
                                                               const CompliantRun& run = {});
 

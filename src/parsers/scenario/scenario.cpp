@@ -390,12 +390,7 @@ Scenario loadScenario(const std::string& path) {
     if (s.grasp_solution) s.grasp_frame = pose(robot.at("grasp").at("target_frame"));
     if (target.has("grasp")) target.at("grasp").fail("the grasp frame is the robot's field: robot.grasp.target_frame");
     s.capture.law = law(top.at("law"), s.capture.has_normal);
-    if (top.at("law").at("type").text() == "compliant") {
-      s.compliant = compliantLaw(top.at("law"));
-      if (!std::holds_alternative<FloatingSystem>(s.capture.target))
-        top.at("law").at("type").fail("compliant joins two free-floating systems: give the target's urdf with movable "
-                                      "joints (a rigid target is not supported yet)");
-    }
+    if (top.at("law").at("type").text() == "compliant") s.compliant = compliantLaw(top.at("law"));
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
   }
