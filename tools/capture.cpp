@@ -250,7 +250,9 @@ Json compliantJson(const CompliantCaptureResult& c) {
                 {"joint_names", end.model ? Json(end.model->jointNames()) : Json::array()},
                 {"momentum_after", toJson(momentum)}};  // its own, (P; L about the world origin)
   };
+  const char* rules[3] = {nullptr, "tolerance", "spring_maximum"};  // what caught it (null unless caught)
   return Json{{"end", ends[static_cast<int>(c.end)]},
+              {"catch_rule", c.catch_rule == CatchRule::None ? Json(nullptr) : Json(rules[static_cast<int>(c.catch_rule)])},
               {"duration", c.duration},
               {"peak_force", c.peak_force},
               {"peak_moment", c.peak_moment},
@@ -272,8 +274,10 @@ Json compliantJson(const CompliantCaptureResult& c) {
 
 void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& c, const CaptureResult& r) {
   const char* ends[3] = {"caught (the grasp locked)", "opened (a bounce)", "timed out (law.max_duration)"};
+  const char* rules[3] = {"", ": the relative speed fell below law.catch_tolerance",
+                          ": the springs' energy passed its maximum (the hand stopped closing)"};
   out << "\nCompliant contact (law.type compliant; the impulsive capture above is its limit):\n"
-      << "  end " << ends[static_cast<int>(c.end)] << " after " << c.duration << " s (" << c.history.size()
+      << "  end " << ends[static_cast<int>(c.end)] << rules[static_cast<int>(c.catch_rule)] << " after " << c.duration << " s (" << c.history.size()
       << " samples, " << c.steps << " steps)\n"
       << "  peak force " << c.peak_force << " N, peak moment " << c.peak_moment << " N m\n"
       << "  impulse (f; n)   " << row(c.impulse) << "\n"
