@@ -7,11 +7,13 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_common.hpp"
 #include "scene_writer.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario_errors.hpp"
 
 namespace kdl_space::cli {
 
@@ -28,11 +30,7 @@ struct CaptureOptions {
 /// ...").
 template <typename F>
 auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const kdl_space::Error& e) {
-    e.rethrowWithContext(scenario.file + ": ");
-  }
+  return inScenarioFile(scenario, std::forward<F>(f));
 }
 
 /// The files a scenario makes a run read: the scenario, the robot's URDF, the target's URDF.

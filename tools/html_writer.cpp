@@ -174,17 +174,27 @@ void HtmlWriter::readMesh(const std::string& link, LinkVisual& v) {
 }
 
 // --- The meshes a page reads, as inputs no output may replace (issue 25's rule) ----------------
-std::vector<InputFile> meshInputs(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
+PageVisuals readPageVisuals(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
+  PageVisuals visuals;
+  if (!sc.robot_urdf.empty()) visuals.robot = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  if (!sc.target_urdf.empty()) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
+  return visuals;
+}
+
+std::vector<InputFile> meshInputs(const PageVisuals& visuals) {
   std::vector<InputFile> inputs;
-  const std::pair<const std::string&, const char*> urdfs[] = {{sc.robot_urdf, "link "}, {sc.target_urdf, "the target's link "}};
-  for (const auto& [urdf, whose] : urdfs) {
-    if (urdf.empty()) continue;
-    for (const auto& [link, list] : readUrdfVisuals(urdf, mesh_search_path))
+  const std::pair<const std::map<std::string, std::vector<LinkVisual>>&, const char*> urdfs[] = {
+      {visuals.robot, "link "}, {visuals.target, "the target's link "}};
+  for (const auto& [read, whose] : urdfs)
+    for (const auto& [link, list] : read)
       for (const LinkVisual& v : list)
         if (v.shape == LinkVisual::Shape::Mesh && !v.mesh_path.empty())
           inputs.push_back({"the mesh " + v.mesh_file + " of " + whose + link, v.mesh_path});
-  }
   return inputs;
+}
+
+std::vector<InputFile> meshInputs(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
+  return meshInputs(readPageVisuals(sc, mesh_search_path));
 }
 
 void checkHtmlLibrary(const std::string& option, const std::string& path) {
@@ -194,14 +204,28 @@ void checkHtmlLibrary(const std::string& option, const std::string& path) {
                        "; Debian package libjs-three; tools/deps.sh installs it)");
 }
 
+namespace {
+/// The visuals a page of `sc` draws, for a run that has not read them: the target's only when the
+/// page draws them (HtmlWriter::drawsTargetVisuals).
+PageVisuals visualsToDraw(const Scenario& sc, const std::vector<std::string>& mesh_search_path, bool target) {
+  PageVisuals visuals;
+  if (!sc.robot_urdf.empty()) visuals.robot = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  if (target) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
+  return visuals;
+}
+}  // namespace
+
 HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_search_path, double frames_per_second,
                        std::size_t max_frames)
+    : HtmlWriter(sc, visualsToDraw(sc, mesh_search_path, drawsTargetVisuals(sc)), frames_per_second, max_frames) {}
+
+HtmlWriter::HtmlWriter(const Scenario& sc, PageVisuals visuals, double frames_per_second, std::size_t max_frames)
     : sc_(sc), step_(1.0 / frames_per_second), max_frames_(std::max<std::size_t>(2, max_frames)) {
   const FloatingModel& robot = *sc.capture.robot.model;
   for (const Body& b : robot.bodies()) links_.push_back(b.name);
-  if (!sc.robot_urdf.empty()) visuals_ = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  visuals_ = std::move(visuals.robot);
   readMeshes();
-  readTargetVisuals(mesh_search_path);
+  useTargetVisuals(std::move(visuals.target));
   warnOnStderr(warnings_);
   if (sc.impact)
     if (const auto* rigid = std::get_if<RigidTarget>(&sc.capture.target)) {
@@ -211,7 +235,7 @@ HtmlWriter::HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_
   // A free-floating target: its links, drawn from its URDF's visuals (or their boxes of inertia).
   if (sc.impact)
     if (const auto* other = std::get_if<FloatingSystem>(&sc.capture.target)) {
-      target_model_ = other->model;  // its visuals: readTargetVisuals
+      target_model_ = other->model;  // its visuals: useTargetVisuals
     }
 }
 
@@ -578,10 +602,14 @@ void HtmlWriter::writeTargetAndGrasp(Json& data, const OperationResult& r) const
 
 // --- The target's URDF visuals (issue 27, item 2) ------------------------------------------------
 
-void HtmlWriter::readTargetVisuals(const std::vector<std::string>& mesh_search_path) {
-  if (!sc_.impact || sc_.target_urdf.empty()) return;
-  if (!sc_.rigid_target_system && !std::holds_alternative<FloatingSystem>(sc_.capture.target)) return;
-  target_visuals_ = readUrdfVisuals(sc_.target_urdf, mesh_search_path);
+bool HtmlWriter::drawsTargetVisuals(const Scenario& sc) {
+  if (!sc.impact || sc.target_urdf.empty()) return false;
+  return sc.rigid_target_system || std::holds_alternative<FloatingSystem>(sc.capture.target);
+}
+
+void HtmlWriter::useTargetVisuals(std::map<std::string, std::vector<LinkVisual>> visuals) {
+  if (!drawsTargetVisuals(sc_)) return;
+  target_visuals_ = std::move(visuals);
   for (auto& [link, list] : target_visuals_)
     for (LinkVisual& v : list) readMesh("target " + link, v);
 }

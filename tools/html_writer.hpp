@@ -40,6 +40,17 @@ CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
 /// tool reads the environment; the library is given the list (resolveMeshFile).
 std::vector<std::string> meshSearchPath(const std::vector<std::string>& mesh_path_options);
 
+/// \brief The URDF visuals a page of a scenario draws, read once per run (readUrdfVisuals) and
+/// handed to meshInputs and HtmlWriter: the robot's, and the target's when the scenario names
+/// its URDF (the page draws them for a rigid target read from a URDF or a free-floating one).
+struct PageVisuals {
+  std::map<std::string, std::vector<LinkVisual>> robot, target;
+};
+/// Reads `sc`'s URDFs' visuals, their meshes resolved through `mesh_search_path` (meshSearchPath).
+PageVisuals readPageVisuals(const Scenario& sc, const std::vector<std::string>& mesh_search_path);
+/// The mesh files of `visuals` (read by readPageVisuals): as meshInputs below, without reading again.
+std::vector<InputFile> meshInputs(const PageVisuals& visuals);
+
 /// \brief The mesh files a page of `sc` embeds (issue 25's rule: no output replaces what the run
 /// reads): every mesh visual of the robot's URDF and, when the scenario names one, the target's,
 /// resolved through `mesh_search_path` as HtmlWriter resolves them (a mesh not found is not read,
@@ -59,6 +70,8 @@ class HtmlWriter {
   /// file and what to do (warnings() keeps them for the JSON). `frames_per_second`: the display rate.
   explicit HtmlWriter(const Scenario& sc, const std::vector<std::string>& mesh_search_path = {},
                       double frames_per_second = 30.0, std::size_t max_frames = 3000);
+  /// The same from the visuals read already for the run (readPageVisuals): no URDF read again.
+  HtmlWriter(const Scenario& sc, PageVisuals visuals, double frames_per_second = 30.0, std::size_t max_frames = 3000);
   /// One sample of the run; `so_far.model` is the system it belongs to.
   void add(const OperationResult& so_far, const MotionSample& x);
   /// One sample kept whatever the display rate (a capture's instant: before and after at one time).
@@ -132,9 +145,12 @@ class HtmlWriter {
   const FloatingModel* target_index_for_ = nullptr;  ///< the system target_index_ is for
 
   // --- The target's URDF visuals (a rigid target read from a URDF, a free-floating target) -----
-  /// Reads target_urdf's visuals (its meshes through `mesh_search_path`, into meshes_ as the
-  /// robot's; warnings name the link as "target LINK").
-  void readTargetVisuals(const std::vector<std::string>& mesh_search_path);
+  /// Whether the page draws the target's URDF visuals: a rigid target read from a URDF, or a
+  /// free-floating target, captured.
+  static bool drawsTargetVisuals(const Scenario& sc);
+  /// Keeps target_urdf's visuals (read by readPageVisuals) when the page draws them, and reads
+  /// their meshes into meshes_ as the robot's (warnings name the link as "target LINK").
+  void useTargetVisuals(std::map<std::string, std::vector<LinkVisual>> visuals);
   /// A rigid target read from a URDF: its subtree's links' visuals in the target's frame (a link
   /// without one: its box of inertia); empty when no link of it has a visual (the page then draws
   /// the target's box of inertia).

@@ -77,11 +77,12 @@ struct Streams {
   std::unique_ptr<AtomicFile> html_file;
   std::optional<HtmlWriter> html;  ///< the page's frames, decimated as the samples come
 
-  Streams(const SimulateOptions& o, const Scenario& sc) {
+  /// `visuals`: the URDF visuals the run read for --html (readPageVisuals), not read again.
+  Streams(const SimulateOptions& o, const Scenario& sc, PageVisuals visuals = {}) {
     if (!o.plot.empty()) plot_file = std::make_unique<AtomicFile>(o.plot, "--plot");
     if (!o.html.empty()) {
       html_file = std::make_unique<AtomicFile>(o.html, "--html");
-      html.emplace(sc, meshSearchPath(o.mesh_path));
+      html.emplace(sc, std::move(visuals));
     }
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
@@ -182,8 +183,9 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   checkOutputs(o);
   const Scenario sc = loadScenario(o.scenario);
   std::vector<InputFile> inputs = scenarioInputs(sc);  // the URDFs it names too
-  if (!o.html.empty())  // and the meshes the page embeds
-    for (InputFile& mesh : meshInputs(sc, meshSearchPath(o.mesh_path))) inputs.push_back(std::move(mesh));
+  // The URDFs' visuals, read once for the run: the meshes the page embeds are inputs too.
+  PageVisuals visuals = o.html.empty() ? PageVisuals{} : readPageVisuals(sc, meshSearchPath(o.mesh_path));
+  for (InputFile& mesh : meshInputs(visuals)) inputs.push_back(std::move(mesh));
   for (const auto& [option, path] : {std::pair<const char*, const std::string&>{"--csv", o.csv}, {"--plot", o.plot}, {"--scene", o.scene}, {"--html", o.html}})
     refuseOverwritingInputs(option, path, inputs);
   OperationOptions options;
@@ -191,7 +193,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   checkOutputSize(o, sc, options);
   options.keep_samples = false;  // the CSV and the plot's data are written as the samples come
   options.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
-  Streams streams(o, sc);
+  Streams streams(o, sc, std::move(visuals));
   if (!o.csv.empty() || !o.plot.empty() || !o.html.empty())
     options.observer = [&](const OperationResult& so_far, const MotionSample& x) {
       streams.add(o, sc, so_far.model->jointNames(), x);

@@ -41,6 +41,7 @@ const char* limitName(LimitMode m) { return m == LimitMode::Ignore ? "ignore" : 
 
 struct PySimulator {
   PySimulator(const Model& m, const SimulationOptions& o) : model(m), sim(std::make_unique<Simulator>(m.ptr, o)) {}
+  PySimulator(const Model& m, std::unique_ptr<Simulator> s) : model(m), sim(std::move(s)) {}
   Model model;
   std::unique_ptr<Simulator> sim;
   std::mutex mutex;
@@ -162,37 +163,28 @@ std::unique_ptr<PySimulator> makeSimulator(const Model& model, py::object integr
   return std::make_unique<PySimulator>(model, o);
 }
 
-/// The simulator as `kdl_space simulate` builds it from a scenario (makeSimulator, parsers/scenario/scenario.hpp).
+/// The simulator as `kdl_space simulate` builds it from a scenario (makeSimulator, parsers/scenario/scenario.hpp),
+/// for the scenario's robot or `model`, after checking that `model` has every joint and link the scenario's
+/// simulation names (makeSimulator finds them by name and would be handed none).
 std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model_obj) {
   const Scenario& sc = ps.scenario;
   const FloatingSystem& robot = sc.capture.robot;
   const Model model = model_obj.is_none() ? Model{robot.model, sc.robot_urdf} : py::cast<Model>(model_obj);
-  const auto in = [&](unsigned int j) {
-    const int k = model.ptr->jointIndex(robot.model->jointNames()[j]);
-    if (k < 0) throw py::value_error("model: has no joint '" + robot.model->jointNames()[j] + "' of the scenario's robot");
-    return static_cast<unsigned int>(k);
+  const auto need = [&](unsigned int j) {
+    if (model.ptr->jointIndex(robot.model->jointNames()[j]) < 0)
+      throw py::value_error("model: has no joint '" + robot.model->jointNames()[j] + "' of the scenario's robot");
   };
   const SimulationSpec& spec = sc.simulation;
-  SimulationOptions options = spec.options;
-  options.grounded = spec.grounded.value_or(robot.response == Response::Grounded);
+  // The joints and links in makeSimulator's order (braked, controlled, limited; the wrenches' links).
+  for (unsigned int j = 0; j < robot.model->nj(); ++j)
+    if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j])) need(j);
+  for (const auto& jc : spec.joints) need(jc.first);
+  for (const auto& jl : spec.limits) need(jl.first);
+  for (const ScheduledWrench& x : spec.wrenches)
+    if (model.ptr->bodyIndex(robot.model->bodies()[x.body].name) < 0)
+      throw py::value_error("model: has no link '" + robot.model->bodies()[x.body].name + "' of the scenario's robot");
   try {
-    auto w = std::make_unique<PySimulator>(model, options);
-    JointControl brake;
-    brake.mode = JointControl::Mode::Locked;
-    for (unsigned int j = 0; j < robot.model->nj(); ++j)
-      if (robot.response == Response::JointsLocked || (!robot.locked.empty() && robot.locked[j]))
-        w->sim->setJointControl(in(j), brake);
-    for (const auto& [j, control] : spec.joints) w->sim->setJointControl(in(j), control);
-    for (const auto& [j, mode] : spec.limits) w->sim->setLimitMode(in(j), mode);
-    if (spec.base_control.after_capture) w->sim->setBaseControl(spec.base_control);  // its phases: this motion is `after`
-    for (ScheduledWrench x : spec.wrenches) {
-      const int b = model.ptr->bodyIndex(robot.model->bodies()[x.body].name);
-      if (b < 0)
-        throw py::value_error("model: has no link '" + robot.model->bodies()[x.body].name + "' of the scenario's robot");
-      x.body = static_cast<unsigned int>(b);
-      w->sim->addWrench(x);
-    }
-    return w;
+    return std::make_unique<PySimulator>(model, makeSimulator(sc, model.ptr, false));  // the motion after the capture
   } catch (const Error& e) {
     e.rethrowWithContext(sc.file + ": ");
   }

@@ -225,6 +225,22 @@ def test_run_matches_the_tool(cli, source_dir):
     assert run.stats.accepted_steps == j["accepted_steps"] and run.stats.rejected_steps == j["rejected_steps"]
 
 
+
+TWO_LINKS = """<robot name="two"><link name="base"><inertial><mass value="10"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="arm"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="elbow" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+<limit lower="-3" upper="3" effort="10" velocity="1"/></joint></robot>"""
+
+
+def test_from_scenario_refuses_a_model_without_the_scenarios_joints(tmp_path):
+    # makeSimulator finds the scenario's joints in the model by name: a model without them is
+    # refused in the scenario's terms before any is looked up (the first one its section controls).
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text(TWO_LINKS)
+    scenario = kdl_space.load_scenario(str(CAPTURE_SCENARIO))
+    with pytest.raises(ValueError, match=r"^model: has no joint 'joint1' of the scenario's robot$"):
+        kdl_space.Simulator.from_scenario(scenario, kdl_space.load_urdf(str(urdf)))
+
 def pd(kp, kd, target, calls=None):
     def controller(t, q, qdot, base_pose, base_twist):
         assert q.shape == qdot.shape == target.shape and base_pose.shape == (4, 4) and base_twist.shape == (6,)

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "kdl_space/operation/capture_operation.hpp"
+#include "kdl_space/parsers/scenario/scenario_errors.hpp"
 
 namespace kdl_space::operation {
 
@@ -56,13 +58,7 @@ std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_pt
 /// of its own type (an OperationError, which names the file already, as it is).
 template <typename F>
 auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const OperationError&) {
-    throw;
-  } catch (const Error& e) {
-    e.rethrowWithContext(scenario.file + ": ");
-  }
+  return inScenarioFile<OperationError>(scenario, std::forward<F>(f));
 }
 
 }  // namespace kdl_space::operation
