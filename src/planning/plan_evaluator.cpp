@@ -89,7 +89,6 @@ void PlanEvaluator::setUpClosing() {
   dynamics_ = std::make_unique<FreeFloatingSolver>(robot.model);
   if (const int rc = dynamics_->compute(robot.state))
     throw ModelError(std::string("closing_speed: the robot's dynamics at the scenario's state: ") + strError(rc));
-  dynamics_at_ = robot.state;
   if (const int rc = dynamics_->momentum(robot.velocity.base_twist, robot.velocity.qdot, PL_g_))
     throw ModelError(std::string("closing_speed: the robot's momentum at the scenario's state: ") + strError(rc));
   if (const auto* other = std::get_if<FloatingSystem>(&scenario_.capture.target)) {
@@ -106,33 +105,12 @@ void PlanEvaluator::setUpClosing() {
   }
 }
 
-namespace {
-
-/// The same joint angles and base pose, to the bit (the dynamics computed at one serve the other).
-bool sameConfiguration(const State& a, const State& b) {
-  if (a.q.data != b.q.data) return false;
-  for (int i = 0; i < 3; ++i) {
-    if (a.world_T_base.p(i) != b.world_T_base.p(i)) return false;
-    for (int j = 0; j < 3; ++j)
-      if (a.world_T_base.M(i, j) != b.world_T_base.M(i, j)) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
 bool PlanEvaluator::closing(FloatingSystem& robot, double speed, std::string& why) {
   const FloatingModel& model = *robot.model;
   const unsigned int n = model.nj();
-  // The dynamics depend on the configuration alone: computed again only for another one than the
-  // last (a scan that varies the closing speed alone evaluates one configuration over and over).
-  if (!dynamics_at_ || !sameConfiguration(*dynamics_at_, robot.state)) {
-    dynamics_at_.reset();
-    if (const int rc = dynamics_->compute(robot.state)) {
-      why = std::string("closing_speed: the robot's dynamics cannot be computed here (") + strError(rc) + ")";
-      return false;
-    }
-    dynamics_at_ = robot.state;
+  if (const int rc = dynamics_->compute(robot.state)) {
+    why = std::string("closing_speed: the robot's dynamics cannot be computed here (") + strError(rc) + ")";
+    return false;
   }
   // The twist the hand must have: the grasp point's on the target, plus the closing speed along
   // the contact frame's z (the approach axis); no rotation relative to the target.

@@ -66,7 +66,6 @@ class PlanEvaluator {
   // The hand's velocity before the grasp (closing_speed planned): the robot's dynamics, its
   // momentum (P_g; L_g) at the scenario's state, and a free-floating target's grasp-point twist.
   std::unique_ptr<FreeFloatingSolver> dynamics_;
-  std::optional<State> dynamics_at_;  ///< the configuration dynamics_ was last computed at (none: failed)
   Vector6d PL_g_ = Vector6d::Zero();
   Vector6d floating_target_twist_ = Vector6d::Zero();
 };
