@@ -65,6 +65,12 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
         << "(law.damping_time or law.damping), or law.catch_tolerance";
     throw OperationError(why.str(), E_NOERROR, std::make_shared<const OperationResult>(r));
   }
+  if (c.end == ContactEnd::Opened && c.duration <= 1e-9)  // the located end's resolution is 1e-10 s
+    r.warnings.push_back(Diagnostic{"law.normal",
+                                    "the compliant contact opened at the touch (after " + detail::number(c.duration) +
+                                        " s): the target's contact point does not close on the robot's along the "
+                                        "normal, so nothing was captured; the robot and the target move on apart",
+                                    "contact_opened_at_touch"});
   SimulationState s;
   s.t = t0 + c.duration;
   std::optional<FloatingSystem> separated;

@@ -163,6 +163,28 @@ TEST(CompliantOperation, OpenedTheRobotAndTheTargetMoveOnApart) {
   EXPECT_GT(c.target_after.base_twist.vel.Norm() + c.target_after.base_twist.rot.Norm(), 0.0);
 }
 
+TEST(CompliantOperation, AContactThatOpensAtTheTouchIsWarnedAbout) {
+  // The normal along the relative velocity: the target moves away from the hand.
+  Scenario sc = compliantScenario();
+  const CaptureResult limit = solveCapture(sc.capture);
+  const Vector3d v_rel = limit.floating_target->contact_twist_before.head<3>() - limit.robot.contact_twist_before.head<3>();
+  CompliantGrasp g;
+  g.normal = v_rel.normalized();
+  sc.compliant = g;
+  const OperationResult r = runCaptureOperation(sc);
+  ASSERT_EQ(r.compliant->end, ContactEnd::Opened);
+  EXPECT_LE(r.compliant->duration, 1e-9);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0].kind, "contact_opened_at_touch");
+  // A contact that closes first (the test above) is not warned about.
+  g.normal = -v_rel.normalized();
+  g.damping_time = 1e-6;
+  sc.compliant = g;
+  const OperationResult bounce = runCaptureOperation(sc);
+  ASSERT_EQ(bounce.compliant->end, ContactEnd::Opened);
+  for (const Diagnostic& d : bounce.warnings) EXPECT_NE(d.kind, "contact_opened_at_touch");
+}
+
 TEST(CompliantOperation, AContactThatNeverEndsIsRefusedWithWhatWasDone) {
   CompliantGrasp g;
   g.max_duration = 1e-5;  // far shorter than the contact (~ 1e-3 s)

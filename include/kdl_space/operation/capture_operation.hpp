@@ -117,7 +117,9 @@ struct KDL_SPACE_EXPORT OperationResult {
   /// What the motion after the capture found that a user should see (kind, element: the joint):
   /// `sampled_gain_unstable` (sampledGainWarnings: options.controller's rate feedback beyond what
   /// its zero-order hold keeps stable) and `stiff` (a servo whose stiffness held an explicit
-  /// integrator's steps far below the output step: stiffnessAdvice).
+  /// integrator's steps far below the output step: stiffnessAdvice), and
+  /// `contact_opened_at_touch` (element law.normal: a compliant contact that opened at once, its
+  /// target not closing on the hand).
   std::vector<Diagnostic> warnings;
   /// The phases the scenario's base control acted in, of those that ran: "approach", "after".
   std::vector<std::string> base_control_phases;
