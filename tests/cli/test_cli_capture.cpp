@@ -221,33 +221,36 @@ TEST(CaptureTool, BadScenariosNameTheField) {
 namespace kdl_space::test {
 namespace {
 
-/// robot_to_robot_capture.yaml with `law: {type: compliant}` (URDF paths absolute), in a scratch
-/// folder of this process.
-std::string compliantScenario() {
-  std::ifstream in(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/robot_to_robot_capture.yaml");
+/// The shipped scenario `name` with its `law` (up to its simulation section, if any) replaced by
+/// `law: <law>` (URDF paths absolute), in gtest's temporary folder under a name of this process.
+std::string withLaw(const std::string& name, const std::string& law) {
+  std::ifstream in(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/" + name + ".yaml");
   std::stringstream text;
   text << in.rdbuf();
   std::string s = text.str();
-  s.replace(s.find("law:"), std::string::npos, "law: {type: compliant}\n");
+  const std::size_t from = s.find("law:");
+  const std::size_t to = s.find("simulation:", from);
+  s.replace(from, to == std::string::npos ? std::string::npos : to - from, "law: " + law + "\n");
   for (std::size_t at = s.find("../urdf/"); at != std::string::npos; at = s.find("../urdf/", at))
     s.replace(at, 8, std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/");
-  const std::string path = ::testing::TempDir() + "kdl_space_compliant_" + std::to_string(getpid()) + ".yaml";
+  const std::string path = ::testing::TempDir() + "kdl_space_" + name + "_law_" + std::to_string(getpid()) + ".yaml";
   std::ofstream(path) << s;
   return path;
 }
 
-TEST(CaptureTool, CompliantContactBesideTheImpulsiveCapture) {
-  const std::string file = compliantScenario();
+/// `capture FILE --json` of a compliant law: the contact beside the impulsive capture. The
+/// default gripper (1e6 N/m, beta 1 ms) is close to the impulsive limit: the impulse within 1e-2
+/// (docs/COMPLIANT.md: the error ~ the contact's duration); momentum kept, energy balanced; the
+/// text shows it too. Returns the JSON.
+nlohmann::json compliantBesideImpulsive(const std::string& file) {
   const ToolRun r = kdlSpace("capture " + file + " --json");
-  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.rc, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
-  ASSERT_TRUE(j.contains("compliant"));
+  EXPECT_TRUE(j.contains("compliant"));
   const nlohmann::json& c = j.at("compliant");
   EXPECT_EQ(c.at("end"), "caught");
   EXPECT_GT(c.at("duration").get<double>(), 0.0);
   EXPECT_GT(c.at("peak_force").get<double>(), 0.0);
-  // The default gripper (1e6 N/m, beta 1 ms) is close to the impulsive limit: the impulse within
-  // a few 1e-4 (docs/COMPLIANT.md: the error ~ the contact's duration).
   const Eigen::MatrixXd F = m(j.at("impulse")), Fc = m(c.at("impulse"));
   EXPECT_LE((Fc - F).norm(), 1e-2 * F.norm());
   EXPECT_TRUE(near(m(c.at("momentum_after")), m(j.at("momentum_before")), 1e-12, 0.0, "momentum"));
@@ -259,10 +262,33 @@ TEST(CaptureTool, CompliantContactBesideTheImpulsiveCapture) {
   EXPECT_EQ(c.at("history").at("wrench").size(), n);
   EXPECT_EQ(c.at("history").at("deflection").size(), n);
   EXPECT_EQ(c.at("history").at("t").back().get<double>(), c.at("duration").get<double>());
-
   const ToolRun text = kdlSpace("capture " + file);
-  ASSERT_EQ(text.rc, 0) << text.err;
+  EXPECT_EQ(text.rc, 0) << text.err;
   EXPECT_NE(text.out.find("Compliant contact"), std::string::npos) << text.out;
+  return j;
+}
+
+TEST(CaptureTool, CompliantContactBesideTheImpulsiveCapture) {
+  compliantBesideImpulsive(withLaw("robot_to_robot_capture", "{type: compliant}"));
+}
+
+/// A rigid target (the tumbling box) joined as one free body, beside the rigid capture.
+TEST(CaptureTool, CompliantContactOfARigidTarget) {
+  const std::string file = withLaw("tumbling_box_capture", "{type: compliant}");
+  const nlohmann::json j = compliantBesideImpulsive(file);
+  const nlohmann::json& c = j.at("compliant");
+  const Eigen::MatrixXd w = m(j.at("target").at("twist_after")), wc = m(c.at("target").at("base_twist_after"));
+  EXPECT_LE((wc - w).norm(), 1e-2 * w.norm());
+  EXPECT_TRUE(c.at("target").at("qdot_after").empty());  // one body, no joints
+
+  // A box without mass is refused, naming the field.
+  std::string s = slurp(file);
+  s.replace(s.find("mass: 50"), 8, "mass: 0");
+  const std::string massless = ::testing::TempDir() + "kdl_space_compliant_box0_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(massless) << s;
+  const ToolRun bad = kdlSpace("capture " + massless + " --json");
+  EXPECT_EQ(bad.rc, 3) << bad.err;
+  EXPECT_NE(bad.err.find("mass"), std::string::npos) << bad.err;
 }
 
 }  // namespace
