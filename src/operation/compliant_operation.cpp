@@ -52,8 +52,6 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
     e.rethrowWithContext(sc.file + ": ");
   }
   const CompliantCaptureResult& c = *r.compliant;
-  while (!r.contact_samples.empty() && r.contact_samples.back().t > t0 + c.duration)  // one looked past the end
-    r.contact_samples.pop_back();
   if (sample_rc)
     throw OperationError(sc.file + ": the compliant contact's samples cannot be evaluated: " + strError(sample_rc),
                          sample_rc, std::make_shared<const OperationResult>(r));

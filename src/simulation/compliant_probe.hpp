@@ -21,7 +21,7 @@ class Probe {
   Probe(const JoinedSystem& js, const FloatingSystem& robot, const FloatingSystem& target, const Vector6d& K,
         const Vector6d& D)
       : js_(js), robot_(robot), target_(target), K_(K), D_(D), kin_(*js.model), rkin_(*robot.model),
-        tkin_(*target.model), rmom_(robot.model), tmom_(target.model) {
+        tkin_(*target.model), rmom_(robot.model), tmom_(target.model), jmom_(js.model) {
     const FloatingModel& m = *js.model;
     for (int k = 0; k < 6; ++k)
       for (std::size_t b = 0; b < m.bodies().size(); ++b)
@@ -91,10 +91,9 @@ class Probe {
       rv.qdot(j) = s.velocity.qdot(js_.robot_joints[j]);
     }
     if (forwardKinematics(*js_.model, s.state, kin_)) throw InputError("contact: the joined state cannot be computed");
-    MomentumSolver jm(js_.model);
-    if (jm.compute(kin_, s.velocity)) throw InputError("contact: the joined velocity cannot be computed");
+    if (jmom_.compute(kin_, s.velocity)) throw InputError("contact: the joined velocity cannot be computed");
     Vector6d base_twist;
-    jm.contactTwist(Contact{target_base_, KDL::Vector::Zero()}, base_twist);
+    jmom_.contactTwist(Contact{target_base_, KDL::Vector::Zero()}, base_twist);
     ts.world_T_base = kin_.pose(target_base_);
     tv = FloatingVelocity(tm);
     tv.base_twist = KDL::Twist(KDL::Vector(base_twist(0), base_twist(1), base_twist(2)),
@@ -116,7 +115,7 @@ class Probe {
   const FloatingSystem& target_;
   Vector6d K_, D_;
   Kinematics kin_, rkin_, tkin_;
-  MomentumSolver rmom_, tmom_;
+  MomentumSolver rmom_, tmom_, jmom_;  ///< each side's, the joined system's (built once)
   int body_[6] = {0, 0, 0, 0, 0, 0};
   Contact robot_contact_;
   int target_base_ = -1;
