@@ -151,7 +151,6 @@ py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object
     py::gil_scoped_release nogil;
     CompliantRun run;
     run.options = sc.simulation.options;
-    if (run.options.integrator == Integrator::RK4) run.options.integrator = Integrator::DormandPrince54;
     run.cancelled = SignalPoll();
     try {
       c = solveCompliantCapture(sc.capture, g, run);

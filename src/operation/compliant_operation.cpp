@@ -7,17 +7,6 @@
 #include "operation/phases.hpp"
 
 namespace kdl_space::operation {
-namespace {
-
-/// The contact's integrator: the scenario's options, but an adaptive one (a fixed rk4 step chosen
-/// for the motion would not resolve a contact of a few milliseconds).
-SimulationOptions contactOptions(const Scenario& sc) {
-  SimulationOptions options = sc.simulation.options;
-  if (options.integrator == Integrator::RK4) options.integrator = Integrator::DormandPrince54;
-  return options;
-}
-
-}  // namespace
 
 void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const std::optional<CaptureResult>& limit,
                       const OperationOptions& o, OperationResult& r) {
@@ -28,7 +17,7 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
   r.model = problem.robot.model;
   const double t0 = r.t_capture;
   CompliantRun run;
-  run.options = contactOptions(sc);
+  run.options = sc.simulation.options;  // (rk4 runs as dopri5 in the contact)
   bool cancelled = false;
   run.cancelled = [&] { return cancelled = o.cancelled && o.cancelled(); };
   int sample_rc = E_NOERROR;

@@ -107,6 +107,7 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   SimulationOptions opt = options;
   opt.grounded = false;
   opt.gravity = Vector3d::Zero();  // the contact's time scale: gravity changes nothing in it
+  if (opt.integrator == Integrator::RK4) opt.integrator = Integrator::DormandPrince54;  // its step adapts to the contact
   Simulator sim(js.model, opt);
   sim.setCancelPoll(run.cancelled);
   for (unsigned int j = 0; j < robot.model->nj(); ++j)

@@ -120,7 +120,9 @@ using ContactObserver = std::function<void(Simulator& sim, const SimulationState
 
 /// How to run a compliant contact.
 struct CompliantRun {
-  SimulationOptions options;  ///< the integrator's (grounded and gravity are ignored)
+  /// The integrator's (grounded and gravity are ignored; rk4 runs as dopri5: a fixed step chosen
+  /// for a motion would not resolve a contact of milliseconds).
+  SimulationOptions options;
   /// Simulator::setCancelPoll of the contact's run (empty: never): a true ends it with an
   /// InputError naming E_CANCELLED; a poll that throws stops it there (propagates).
   std::function<bool()> cancelled;
