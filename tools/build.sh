@@ -17,5 +17,6 @@ while (($#)); do
   esac
 done
 "$root/tools/deps.sh"
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
+source "$root/tools/cmake_generator.sh" "$build"
+cmake -S "$root" -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
 cmake --build "$build" -j"$(nproc)" ${targets[@]+"${targets[@]}"} >/dev/null

@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config ninja-build ccache                         # ccache: a warm machine's rebuilds
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libexpat1-dev
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   libnlopt-cxx-dev                                                           # capture planning (kdl_space plan)
@@ -13,6 +13,7 @@ packages=(
   libjs-three                                                                # three.js, inlined into simulate --html's page
   chromium                                                                   # headless browser: the --html page's tests
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest   # the Python module (python/)
+  python3-pytest-xdist                                                       # its tests on every core (pytest -n)
   python3-pykdl                                                              # its PyKDL interop tests
   python3-matplotlib                                                         # examples/notebook.py
   python3-distributed python3-dask                                           # studies on Dask (kdl_space.study)

@@ -16,7 +16,7 @@ seconds="${1:-60}"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DKDL_SPACE_FUZZ=ON \
   -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF -DKDL_SPACE_BUILD_BENCHMARK=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" >/dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study fuzz_commands >/dev/null
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
@@ -24,9 +24,10 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/kdl_space_fuzz.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 artifacts="$build/artifacts"
 failed=0
-# target  max_len: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow.
-for spec in "urdf 16384" "scenario 4096" "study 4096"; do
-  read -r name max_len <<<"$spec"
+# target  max_len  dictionary: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow;
+# commands mutates scenarios (over the model families), with the scenario's dictionary.
+for spec in "urdf 16384 urdf" "scenario 4096 scenario" "study 4096 study" "commands 4096 scenario"; do
+  read -r name max_len dict <<<"$spec"
   target="fuzz_$name"
   mkdir -p "$work/$name" "$artifacts/$name"
   cp "$root/fuzz/corpus/$name/"* "$work/$name/"
@@ -35,7 +36,7 @@ for spec in "urdf 16384" "scenario 4096" "study 4096"; do
   log="$build/$target.log"
   echo "tools/fuzz.sh: $target for ${seconds} s (log: $log)"
   # -timeout: one input taking longer than 10 s is a hang (a finding); -rss_limit_mb: a blow-up.
-  if "$build/fuzz/$target" "$work/$name" -dict="$root/fuzz/$name.dict" \
+  if "$build/fuzz/$target" "$work/$name" -dict="$root/fuzz/$dict.dict" \
       -max_total_time="$seconds" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 \
       -artifact_prefix="$artifacts/$name/" -print_final_stats=1 >"$log" 2>&1; then
     grep -E "^stat::(number_of_executed_units|new_units_added|peak_rss_mb)|#[0-9]+.*DONE" "$log" | sed 's/^/  /' || true

@@ -109,6 +109,10 @@ void printPoseAndConditioning(std::ostream& report, const PoseFigures& f, const 
   printWrapped(report, s.str(), width);
   printMatrix(report, "Contact frame rotation (world_R_contact)", f.rotation, {"x", "y", "z"}, {"x", "y", "z"}, width);
   std::ostringstream k;
+  if (c.sigma_J_star.size() == 0) {
+    printWrapped(report, "J* singular values: none (no movable joint)", width);
+    return;
+  }
   k << "J* singular values: " << c.sigma_J_star.transpose() << "; condition number "
     << (std::isfinite(c.condition_number) ? std::to_string(c.condition_number) : std::string("infinite (singular)"))
     << "; manipulability of J* " << c.manipulability_J_star << ", of the fixed-base J " << c.manipulability_J;
@@ -131,6 +135,27 @@ void printJointMargins(std::ostream& out, const FloatingModel& model, const KDL:
   for (const JointMargin& m : jointMargins(model, q)) rows.row(m.joint) << m.to_lower, m.to_upper, m.margin();
   printMatrix(out, "Joint margins to the limits [rad or m] (inf: no limit; negative: outside)", rows,
               model.jointNames(), {"above lower", "below upper", "margin"}, width);
+}
+
+/// The text's head: the model, its mass and CoM, I_g, H* and the joints' margins (none of the last
+/// two for a robot without joints).
+void printModelSummary(std::ostream& out, const std::string& urdf, const FloatingModel& model,
+                       const FreeFloatingSolver& solver, const State& state, std::size_t width) {
+  const unsigned int n = model.nj();
+  std::ostringstream what;
+  what << "Free-floating model " << urdf << ": base '" << model.bodies()[0].name << "', "
+       << model.bodies().size() << " links, "
+       << (n == 0 ? std::string("no movable joint (a rigid body: J* is 6 x 0, G* its inverse inertia at the point)")
+                  : std::to_string(n) + " movable joints");
+  what << "\nTotal mass w = " << solver.w() << " kg\nSystem CoM r_g = (" << solver.r_g().x() << ", "
+       << solver.r_g().y() << ", " << solver.r_g().z() << ") m";
+  printWrapped(out, what.str(), width);
+  printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
+              {"x", "y", "z"}, width);
+  if (n > 0) {
+    printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, model.jointNames(), model.jointNames(), width);
+    printJointMargins(out, model, state.q, width);
+  }
 }
 
 Json inspectJson(const FreeFloatingSolver& solver, const State& state, const Json& json_contacts,
@@ -300,8 +325,12 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
       report << "\n";
       printWrapped(report, where.str(), width);
       // Transposed, so that each joint's row carries its name; the JSON's J_star is J* (6 x n).
-      printMatrix(report, "J*^T (J* of eq. 4, transposed: n x 6, one row per joint; columns the twist (v; w) per "
-                  "unit rate)", J_star.data.transpose(), joints, twistLabels(), width);
+      if (n == 0)
+        printWrapped(report, "J*: none, 6 x 0 (the robot has no movable joint: the contact point moves only with the base)",
+                     width);
+      else
+        printMatrix(report, "J*^T (J* of eq. 4, transposed: n x 6, one row per joint; columns the twist (v; w) per "
+                    "unit rate)", J_star.data.transpose(), joints, twistLabels(), width);
       printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", G_star, twistLabels(), twistLabels(), width);
       if (grounded)
         printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels(), width);
@@ -320,16 +349,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
         << "\n";
     return;
   }
-  std::ostringstream what;
-  what << "Free-floating model " << o.urdf << ": base '" << model->bodies()[0].name << "', "
-       << model->bodies().size() << " links, " << n << " movable joints";
-  what << "\nTotal mass w = " << solver.w() << " kg\nSystem CoM r_g = (" << solver.r_g().x() << ", "
-       << solver.r_g().y() << ", " << solver.r_g().z() << ") m";
-  printWrapped(out, what.str(), width);
-  printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
-              {"x", "y", "z"}, width);
-  printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, joints, joints, width);
-  printJointMargins(out, *model, state.q, width);
+  printModelSummary(out, o.urdf, *model, solver, state, width);
   out << report.str();
   if (contacts.size() > 1) {
     std::vector<std::string> labels;

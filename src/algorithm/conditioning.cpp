@@ -9,15 +9,22 @@ namespace {
 
 double product(const Eigen::VectorXd& sigma) { return sigma.size() ? sigma.prod() : 0.0; }
 
+/// The singular values of a 6 x n matrix, largest first; none for n = 0 (Eigen 3.4's JacobiSVD
+/// of a 6 x 0 matrix crashes: PITFALLS, a robot without movable joints).
+Eigen::VectorXd singularValues(const Eigen::MatrixXd& A) {
+  if (A.rows() == 0 || A.cols() == 0) return Eigen::VectorXd();
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues();
+}
+
 }  // namespace
 
 Conditioning conditioning(const Eigen::MatrixXd& J_star, const Eigen::MatrixXd& J) {
   Conditioning c;
-  c.sigma_J_star = Eigen::JacobiSVD<Eigen::MatrixXd>(J_star).singularValues();  // descending
+  c.sigma_J_star = singularValues(J_star);  // descending
   const Eigen::Index k = c.sigma_J_star.size();
   if (k > 0 && c.sigma_J_star(k - 1) > 0.0) c.condition_number = c.sigma_J_star(0) / c.sigma_J_star(k - 1);
   c.manipulability_J_star = product(c.sigma_J_star);
-  c.manipulability_J = product(Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues());
+  c.manipulability_J = product(singularValues(J));
   return c;
 }
 

@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 
+#include "algorithm/contact_chain.hpp"
 #include "detail/text.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -51,35 +52,6 @@ KDL::Twist poseError(const KDL::Frame& current, const KDL::Frame& goal) {
 
 double clampTo(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
 
-/// The chain from the base to the contact link, its tip moved to the contact offset, and which
-/// model joint each of its joints is.
-struct ContactChain {
-  KDL::Chain chain;
-  std::vector<int> joints;  // model index per chain joint
-  KDL::JntArray lower, upper;
-};
-
-ContactChain contactChain(const FloatingModel& model, const Contact& contact) {
-  ContactChain c;
-  const std::string& link = model.bodies()[contact.body].name;
-  if (contact.body != 0 && !model.tree().getChain(model.tree().getRootSegment()->first, link, c.chain))
-    throw ModelError("inverse kinematics: no chain from the base to link " + detail::quoted(link));
-  c.chain.addSegment(KDL::Segment(link + "#contact", KDL::Joint(KDL::Joint::Fixed), KDL::Frame(contact.offset)));
-  for (const KDL::Segment& s : c.chain.segments) {
-    if (s.getJoint().getType() == KDL::Joint::Fixed) continue;
-    const int j = model.jointIndex(s.getJoint().getName());
-    if (j < 0) throw ModelError("inverse kinematics: joint " + detail::quoted(s.getJoint().getName()) + " is no coordinate");
-    c.joints.push_back(j);
-  }
-  c.lower.resize(c.joints.size());
-  c.upper.resize(c.joints.size());
-  for (std::size_t k = 0; k < c.joints.size(); ++k) {
-    c.lower(k) = model.jointProperties()[c.joints[k]].lower;
-    c.upper(k) = model.jointProperties()[c.joints[k]].upper;
-  }
-  return c;
-}
-
 /// The solvers on one chain (each keeps a reference to it: it outlives them).
 class Search {
  public:
@@ -97,9 +69,13 @@ class Search {
       q = newton;
       return true;
     }
-    KDL::JntArray lma(q.rows());
-    lma_.CartToJnt(q, goal_, lma);  // its code is not the verdict: refine measures the residual
+    KDL::JntArray lma_chain(c_.chain.getNrOfJoints());
+    lma_.CartToJnt(c_.chainAngles(q), goal_, lma_chain);  // its code is not the verdict: refine measures the residual
     iterations += static_cast<unsigned int>(std::max(0, lma_.lastNrOfIter));
+    // KDL's LMA moves the chain's joints independently: back to the coordinates by least squares.
+    KDL::JntArray lma(q.rows());
+    lma.data = c_.coupled ? Eigen::VectorXd(c_.T.completeOrthogonalDecomposition().solve(lma_chain.data - c_.o))
+                          : Eigen::VectorXd(lma_chain.data);
     for (unsigned int k = 0; k < q.rows(); ++k) lma(k) = clampTo(lma(k), c_.lower(k), c_.upper(k));
     const bool ok = refine(lma, iterations);
     q = ok || distance(lma) < distance(newton) ? lma : newton;
@@ -114,7 +90,7 @@ class Search {
     double best_distance = std::numeric_limits<double>::infinity();
     for (unsigned int i = 0; i < o_.max_iterations; ++i) {
       KDL::Frame f;
-      fk_.JntToCart(q, f);
+      fk_.JntToCart(c_.chainAngles(q), f);
       const KDL::Twist e = poseError(f, goal_);
       if (length(e.vel) <= 0.5 * o_.position_tolerance && length(e.rot) <= 0.5 * o_.orientation_tolerance) return true;
       if (length(e.vel) + length(e.rot) < best_distance) {
@@ -122,7 +98,7 @@ class Search {
         best = q;
       }
       ++iterations;
-      if (vel_.CartToJnt(q, e, dq) < 0) break;
+      if (velocity(q, e, dq) < 0) break;
       const double largest = dq.data.cwiseAbs().maxCoeff();
       if (largest > 0.5) dq.data *= 0.5 / largest;  // far from the goal the linearisation is poor
       for (unsigned int k = 0; k < q.rows(); ++k) q(k) = clampTo(q(k) + dq(k), c_.lower(k), c_.upper(k));
@@ -134,17 +110,37 @@ class Search {
   /// Distance + angle (1 m per rad) from the contact frame at `q` to the goal.
   double distance(const KDL::JntArray& q) {
     KDL::Frame f;
-    fk_.JntToCart(q, f);
+    fk_.JntToCart(c_.chainAngles(q), f);
     const KDL::Twist e = poseError(f, goal_);
     return length(e.vel) + length(e.rot);
   }
 
   /// An orthonormal basis of the self-motion at q (the null space of the chain's Jacobian).
   Eigen::MatrixXd nullBasis(const KDL::JntArray& q) {
-    KDL::Jacobian J(q.rows());
-    jac_.JntToJac(q, J);
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J.data, Eigen::ComputeFullV);
-    return svd.matrixV().rightCols(J.data.cols() - svd.rank());
+    const Eigen::MatrixXd J = jacobian(q);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
+    return svd.matrixV().rightCols(J.cols() - svd.rank());
+  }
+
+  /// The contact frame's Jacobian in the coordinates (6 x n): KDL's chain Jacobian times T.
+  Eigen::MatrixXd jacobian(const KDL::JntArray& q) {
+    KDL::Jacobian J(c_.chain.getNrOfJoints());
+    jac_.JntToJac(c_.chainAngles(q), J);
+    return c_.coupled ? Eigen::MatrixXd(J.data * c_.T) : Eigen::MatrixXd(J.data);
+  }
+
+  /// The least-norm coordinate step for the error twist `e`: KDL's ChainIkSolverVel_pinv on an
+  /// uncoupled chain; on a coupled one the same pseudo-inverse (singular values below 1e-9
+  /// dropped, as KDL's) of J T.
+  int velocity(const KDL::JntArray& q, const KDL::Twist& e, KDL::JntArray& dq) {
+    if (!c_.coupled) return vel_.CartToJnt(q, e, dq);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian(q), Eigen::ComputeThinU | Eigen::ComputeThinV);
+    Eigen::Matrix<double, 6, 1> t;
+    t << e.vel.x(), e.vel.y(), e.vel.z(), e.rot.x(), e.rot.y(), e.rot.z();
+    Eigen::VectorXd ut = svd.matrixU().transpose() * t;
+    for (Eigen::Index i = 0; i < ut.size(); ++i) ut(i) = svd.singularValues()(i) < 1e-9 ? 0.0 : ut(i) / svd.singularValues()(i);
+    dq.data = svd.matrixV() * ut;
+    return dq.data.allFinite() ? 0 : -1;
   }
 
   /// N (preferred - q): the part of the way to the preferred posture that does not move the tip.
@@ -305,7 +301,6 @@ double reactionMeasure(const FloatingModel& model, const State& state, const Con
 
 IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, const Contact& contact,
                                 const KDL::Frame& world_T_goal, const IkOptions& options) {
-  model.refuseMimic("inverse kinematics");
   if (seed.q.rows() != model.nj())
     throw ModelError("inverse kinematics: the seed has " + std::to_string(seed.q.rows()) + " joint values, the model " +
                      std::to_string(model.nj()) + " joints");
@@ -316,6 +311,12 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
                      " joint values, the model " + std::to_string(model.nj()) + " joints");
   const ContactChain c = contactChain(model, contact);
   const unsigned int n = static_cast<unsigned int>(c.joints.size());
+  if (n == 0)
+    throw InputError("inverse kinematics: no movable joint moves the contact frame on link " +
+                     detail::quoted(model.bodies()[contact.body].name) +
+                     (model.nj() == 0 ? std::string(" (the robot has no movable joint: a rigid body)")
+                                      : " (none lies between the base and this link)") +
+                     ": it moves only with the base, which inverse kinematics holds; give a contact on an arm");
   KDL::JntArray q0(n), preferred(n);
   const KDL::JntArray& pref_model = options.preferred ? *options.preferred : seed.q;
   for (unsigned int k = 0; k < n; ++k) {
@@ -350,7 +351,7 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
   unsigned int iterations = 0;
   for (unsigned int a = 0; a <= options.restarts; ++a) {
     KDL::JntArray qc = a == 0 ? q0 : start(c, q0, a);
-    const bool ok = n > 0 && search.attempt(qc, iterations);
+    const bool ok = search.attempt(qc, iterations);
     if (ok && search.minimisesMeasure())
       search.minimiseMeasure(qc, iterations);
     else if (ok)
@@ -368,10 +369,15 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
         r.orientation_residual <= options.orientation_tolerance)
       return r;
     const double score = r.position_residual + r.orientation_residual;  // m + rad (1 m per rad)
-    if (score < best_score && search.withinLimits(qc)) {
+    if ((score < best_score || best.q.rows() == 0) && search.withinLimits(qc)) {
       best_score = score;
       best = r;
     }
+  }
+  if (best.q.rows() == 0) {  // no attempt ended inside the limits: report the seed
+    best.q = seed.q;
+    best.chain_joints = c.joints;
+    measure(model, seed, contact, world_T_goal, best);
   }
   best.iterations = iterations;
   best.attempts = options.restarts + 1;
@@ -384,7 +390,6 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
       << " rad), with";
   for (unsigned int k = 0; k < n; ++k)
     msg << (k ? ", " : " ") << model.jointNames()[c.joints[k]] << " = " << best.q(c.joints[k]);
-  if (n == 0) msg << " no joint between the base and the link";
   msg << "; move the goal closer or check its frame";
   throw IkUnreachable(msg.str(), best);
 }

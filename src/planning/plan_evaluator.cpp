@@ -48,6 +48,9 @@ PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& option
   }
   if (!scenario.impact)
     throw InputError("plan: the scenario has no target and no law: there is no capture to plan");
+  if (scenario.capture.robot.model->nj() == 0)
+    throw InputError("plan: the robot has no movable joint (a rigid body): there is no configuration to choose; "
+                     "`kdl_space capture` solves its capture as it is");
   const FloatingSystem& robot = scenario.capture.robot;
   const auto* rigid = std::get_if<RigidTarget>(&scenario.capture.target);
   // A redundant arm: its self-motion exists at the scenario's state (SelfMotion refuses otherwise).

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <kdl/treefksolverpos_recursive.hpp>
 #include <random>
 #include <string>
@@ -147,6 +148,102 @@ TEST(InverseKinematics, RefusesAWrongSizedSeed) {
   State seed(model);
   seed.q.resize(3);
   EXPECT_THROW(solveInverseKinematics(model, seed, model.contact("end_effector"), KDL::Frame::Identity()), ModelError);
+}
+
+/// The Franka-like arm's forward kinematics from its modified-DH parameters, with Eigen only (no
+/// KDL, no URDF): joint i is Rx(alpha) Tx(a) Rz(q_i) Tz(d); then the flange (0.107 m), the hand
+/// turned -pi/4 about z, and the TCP (0.1034 m) or a finger (0.0584 m up, then along -y by the
+/// right finger's opening, which mimics the left's).
+Eigen::Isometry3d frankaLikeFrame(const Eigen::Isometry3d& world_T_base, const double q[7], double finger,
+                                  bool right_finger) {
+  static const double a[7] = {0, 0, 0, 0.0825, -0.0825, 0, 0.088};
+  static const double d[7] = {0.333, 0, 0.316, 0, 0.384, 0, 0};
+  static const double alpha[7] = {0, -M_PI / 2, M_PI / 2, M_PI / 2, -M_PI / 2, M_PI / 2, M_PI / 2};
+  Eigen::Isometry3d T = world_T_base;
+  for (int i = 0; i < 7; ++i)
+    T = T * Eigen::AngleAxisd(alpha[i], Eigen::Vector3d::UnitX()) * Eigen::Translation3d(a[i], 0, 0) *
+        Eigen::AngleAxisd(q[i], Eigen::Vector3d::UnitZ()) * Eigen::Translation3d(0, 0, d[i]);
+  T = T * Eigen::Translation3d(0, 0, 0.107) * Eigen::AngleAxisd(-M_PI / 4, Eigen::Vector3d::UnitZ());
+  if (right_finger) return T * Eigen::Translation3d(0, 0, 0.0584) * Eigen::Translation3d(0, -finger, 0);
+  return T * Eigen::Translation3d(0, 0, 0.1034);
+}
+
+// Issue 34: ik with mimic joints. The Franka-like arm's second finger mimics the first. At the
+// TCP the mimic joint is off the chain (its relation to its leader kept); at the right finger it
+// is on the chain, and the search runs in the coupled coordinates (J T): the finger's opening is
+// found with the arm's angles. Checked by the DH forward kinematics above to 1e-9 m and rad.
+TEST(InverseKinematics, MimicFingerOnAndOffTheChainOfAFrankaLikeArm) {
+  const FloatingModel model = loadUrdfFile(KDL_SPACE_TEST_DATA_DIR "/models/franka_like.urdf");
+  ASSERT_EQ(model.nj(), 8u);  // seven arm joints and the left finger; the right finger follows it
+  ASSERT_EQ(model.mimic().size(), 1u);
+  std::mt19937 rng(3434);
+  std::uniform_real_distribution<double> u(0.1, 0.9);
+  for (const bool right_finger : {false, true}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      State truth(model);
+      truth.world_T_base = KDL::Frame(KDL::Rotation::RPY(0.2, -0.1, 0.3), KDL::Vector(0.5, -0.2, 0.1));
+      for (unsigned int j = 0; j < model.nj(); ++j) {
+        const JointProperties& p = model.jointProperties()[j];
+        truth.q(j) = p.lower + u(rng) * (p.upper - p.lower);
+      }
+      double q_arm[7];
+      for (int i = 0; i < 7; ++i) q_arm[i] = truth.q(model.jointIndex("panda_joint" + std::to_string(i + 1)));
+      const int finger = model.jointIndex("panda_finger_joint1");
+      Eigen::Isometry3d world_T_base;
+      world_T_base.matrix().setIdentity();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) world_T_base(r, c) = truth.world_T_base.M(r, c);
+        world_T_base(r, 3) = truth.world_T_base.p(r);
+      }
+      const Eigen::Isometry3d goal_e = frankaLikeFrame(world_T_base, q_arm, truth.q(finger), right_finger);
+      KDL::Frame goal;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) goal.M(r, c) = goal_e(r, c);
+        goal.p(r) = goal_e(r, 3);
+      }
+      State seed(model);
+      seed.world_T_base = truth.world_T_base;
+      seed.q(model.jointIndex("panda_joint4")) = -1.5;  // inside its limits
+      seed.q(model.jointIndex("panda_joint6")) = 1.5;
+      const Contact h = model.contact(right_finger ? "panda_rightfinger" : "panda_hand_tcp");
+      const IkResult r = solveInverseKinematics(model, seed, h, goal);
+      expectInLimits(model, r.q);
+      double q_got[7];
+      for (int i = 0; i < 7; ++i) q_got[i] = r.q(model.jointIndex("panda_joint" + std::to_string(i + 1)));
+      const Eigen::Isometry3d got = frankaLikeFrame(world_T_base, q_got, r.q(finger), right_finger);
+      EXPECT_LE((got.translation() - goal_e.translation()).norm(), 1e-9) << "right finger " << right_finger;
+      EXPECT_LE(Eigen::AngleAxisd(got.linear().transpose() * goal_e.linear()).angle(), 1e-9);
+      // On the chain the finger is solved; off it the finger keeps the seed's opening.
+      if (!right_finger) EXPECT_EQ(r.q(finger), seed.q(finger));
+      EXPECT_EQ(std::count(r.chain_joints.begin(), r.chain_joints.end(), finger), right_finger ? 1 : 0);
+    }
+  }
+}
+
+// A robot without movable joints has nothing to solve: refused, saying why.
+TEST(InverseKinematics, ARobotWithoutJointsIsRefusedSayingWhy) {
+  const std::string urdf = R"(<robot name="r"><link name="bus"><inertial><mass value="100"/>
+      <inertia ixx="10" iyy="11" izz="12" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="f" type="fixed"><parent link="bus"/><child link="fixture"/><origin xyz="1 0 0"/></joint>
+      <link name="fixture"/></robot>)";
+  const FloatingModel model = loadUrdfString(urdf, "rigid.urdf");
+  try {
+    solveInverseKinematics(model, State(model), model.contact("fixture"), KDL::Frame(KDL::Vector(1, 0, 0)));
+    FAIL() << "a robot without joints was solved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no movable joint"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'fixture'"), std::string::npos) << e.what();
+  }
+}
+
+// A goal so far away that squared distances overflow: refused as out of reach, not a crash.
+TEST(InverseKinematics, AGoalBeyondTheRangeOfDoublesIsOutOfReach) {
+  const FloatingModel model = loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf");
+  IkOptions o;
+  o.restarts = 1;
+  EXPECT_THROW(solveInverseKinematics(model, State(model), model.contact("end_effector"),
+                                      KDL::Frame(KDL::Vector(1e200, 0, 0)), o),
+               IkUnreachable);
 }
 
 }  // namespace

@@ -107,9 +107,14 @@ class KDL_SPACE_EXPORT IkUnreachable : public InputError {
 /// N (preferred - q) vanishes (Posture), or (Reaction) a scan along a one-dimensional
 /// self-motion, then steps down N grad reactionMeasure, each projected back onto the pose. The residuals are measured by the
 /// model's own forwardKinematics, not by the chain's.
-/// \throws ModelError for a model with mimic joints, a contact body outside the model, a seed of
-/// the wrong size or a non-finite goal; IkUnreachable (an InputError) when no attempt reaches
-/// the tolerances: its message gives the remaining distance [m] and angle [rad].
+/// Mimic joints (URDF <mimic>) are not coordinates: on the chain each turns with its leader
+/// (chain angle multiplier * leader + offset), and the search runs in the coordinates (the chain's
+/// Jacobian times the coupling, J T, as the dynamics do); off the chain they keep their relation
+/// to their leaders. The limits searched are the coordinates' own.
+/// \throws ModelError for a contact body outside the model, a seed of the wrong size or a
+/// non-finite goal; InputError when no movable joint lies between the base and the contact link
+/// (a robot without joints: it moves only with the base); IkUnreachable (an InputError) when no
+/// attempt reaches the tolerances: its message gives the remaining distance [m] and angle [rad].
 KDL_SPACE_EXPORT IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, const Contact& contact,
                                                  const KDL::Frame& world_T_goal, const IkOptions& options = {});
 

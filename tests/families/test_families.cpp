@@ -1,0 +1,322 @@
+// Every public entry of the library over every kind of robot (issue 34): the contracts written once
+// (as manif's MANIF_TEST writes a group's), instantiated for each model family of
+// tests/support/model_families.hpp. Each entry is checked against an independent route (KDL's
+// six-virtual-joint tree, with the mimic coupling written out from the URDF's <mimic> elements;
+// conservation laws; the capture's own constraint) or refused with a message that says why,
+// never a crash. A robot without joints is an ordinary case: J* is 6 x 0, G* is the body's
+// inverse inertia at the point.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "kdl_space/algorithm/conditioning.hpp"
+#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
+#include "kdl_space/impact/capture.hpp"
+#include "kdl_space/multibody/poses.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/parsers/urdf/urdf_check.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "kdl_space/planning/capture_plan.hpp"
+#include "kdl_space/study/study.hpp"
+#include "model_families.hpp"
+#include "test_util.hpp"
+#include "virtual_joint_route.hpp"
+
+namespace kdl_space::test {
+namespace {
+
+std::string slurpFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The family's URDF read as written, and without its <mimic> elements (each joint its own
+/// coordinate): the second is the independent route's robot.
+std::shared_ptr<const FloatingModel> load(const ModelFamily& f) {
+  return std::make_shared<const FloatingModel>(loadUrdfFile(familyUrdf(f.name)));
+}
+std::shared_ptr<const FloatingModel> loadUncoupled(const ModelFamily& f) {
+  const std::string text = std::regex_replace(slurpFile(familyUrdf(f.name)), std::regex("<mimic[^>]*/>"), "");
+  return std::make_shared<const FloatingModel>(loadUrdfString(text, f.name + "_uncoupled.urdf"));
+}
+
+/// The coupling from the URDF: the uncoupled robot's joint values are T q + o of the coupled
+/// robot's coordinates q, read from the model's mimic list and matched by name.
+struct Coupling {
+  Eigen::MatrixXd T;
+  Eigen::VectorXd o;
+};
+Coupling coupling(const FloatingModel& coupled, const FloatingModel& free) {
+  Coupling c{Eigen::MatrixXd::Zero(free.nj(), coupled.nj()), Eigen::VectorXd::Zero(free.nj())};
+  for (unsigned int j = 0; j < coupled.nj(); ++j) c.T(free.jointIndex(coupled.jointNames()[j]), j) = 1.0;
+  for (const Mimic& m : coupled.mimic()) {
+    c.T(free.jointIndex(m.joint), coupled.jointIndex(m.leader)) = m.multiplier;
+    c.o(free.jointIndex(m.joint)) = m.offset;
+  }
+  return c;
+}
+
+/// A random state inside the joints' limits (continuous joints over a turn).
+State randomStateInLimits(const FloatingModel& model, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0), pos(-1.0, 1.0);
+  State s(model);
+  for (unsigned int j = 0; j < model.nj(); ++j) {
+    const JointProperties& p = model.jointProperties()[j];
+    const double lo = std::isfinite(p.lower) ? p.lower : -M_PI, hi = std::isfinite(p.upper) ? p.upper : M_PI;
+    s.q(j) = lo + (0.1 + 0.8 * u(rng)) * (hi - lo);
+  }
+  s.world_T_base = basePose(KDL::Vector(pos(rng), pos(rng), pos(rng)), pos(rng), pos(rng) / 2, pos(rng));
+  return s;
+}
+
+/// The same state of the uncoupled robot.
+State uncoupledState(const State& s, const FloatingModel& free, const Coupling& c) {
+  State u(free);
+  u.world_T_base = s.world_T_base;
+  u.q.data = c.T * s.q.data + c.o;
+  return u;
+}
+
+/// G of the independent route: KDL's six-virtual-joint tree of the uncoupled robot, coupled by
+/// hand: (J_full C) (C^T M_full C)^-1 (J_full C)^T, C = diag(1_6, T).
+Eigen::MatrixXd independentG(const FloatingModel& free, const State& u, const Coupling& c, const LinkPoint& h) {
+  const VirtualJointTree vt(free, u);
+  const int n = static_cast<int>(c.T.cols()), m = static_cast<int>(c.T.rows());
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(6 + m, 6 + n);
+  C.topLeftCorner(6, 6).setIdentity();
+  C.bottomRightCorner(m, n) = c.T;
+  const Eigen::MatrixXd J = vt.J_full(h) * C;
+  const Eigen::MatrixXd M = C.transpose() * vt.M_full() * C;
+  return J * M.llt().solve(J.transpose());
+}
+
+/// A scenario of the family with a rigid box at the contact, the law given, written into a folder
+/// of this test; returns its path.
+std::string writeScenario(const ModelFamily& f, const std::string& law, const std::string& extra = "") {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("families_" + f.name);
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / ("scenario_" + std::to_string(std::hash<std::string>()(law + extra)) + ".yaml")).string();
+  std::ofstream out(path);
+  out << "robot:\n  urdf: " << familyUrdf(f.name) << "\n  contact: {link: " << f.contact << ", offset: [" << f.offset[0]
+      << ", " << f.offset[1] << ", " << f.offset[2] << "]}\n"
+      << "  base: {position: [0, 0, 0], rpy: [0.1, -0.2, 0.3], twist: [0.01, 0, 0.02, 0.001, -0.002, 0.003]}\n"
+      << "target:\n  mass: 40\n  inertia: [[2, 0, 0], [0, 3, 0], [0, 0, 4]]\n"
+      << "  pose: {position: [2.5, 0.5, 0.3], rpy: [0.2, 0.1, -0.3]}\n"
+      << "  twist: [-0.05, 0.01, 0.02, 0.03, -0.02, 0.04]\n"
+      << "law: " << law << "\n"
+      << "simulation: {duration: 0.5, output_step: 0.1, integrator: dopri5, rtol: 1.0e-10, atol: 1.0e-12}\n" << extra;
+  return path;
+}
+
+const std::vector<std::string>& laws() {
+  static const std::vector<std::string> l{
+      "{type: capture}", "{type: translational}", "{type: point, normal: [1, 0, 0], restitution: 0.5}",
+      "{type: friction, normal: [1, 0, 0], restitution: 0.2, friction: 0.3}"};
+  return l;
+}
+
+class Families : public ::testing::TestWithParam<ModelFamily> {};
+
+// The model: its coordinates, and every quantity of every link against the independent route.
+TEST_P(Families, GStarAtEveryLinkEqualsTheVirtualJointRoute) {
+  const ModelFamily& f = GetParam();
+  const auto model = load(f);
+  ASSERT_EQ(model->nj(), f.joints);
+  const auto free = loadUncoupled(f);
+  const Coupling c = coupling(*model, *free);
+  std::mt19937 rng(34);
+  FreeFloatingSolver solver(model);
+  RecursiveExIITSolver recursive(model);
+  for (int trial = 0; trial < 3; ++trial) {
+    const State s = randomStateInLimits(*model, rng);
+    const State u = uncoupledState(s, *free, c);
+    ASSERT_EQ(solver.compute(s), 0);
+    ASSERT_EQ(recursive.compute(s), 0);
+    for (std::size_t b = 0; b < model->bodies().size(); ++b) {
+      const std::string& link = model->bodies()[b].name;
+      const KDL::Vector offset(0.05, -0.02, 0.1);
+      const Contact h = model->contact(link, offset);
+      Matrix6d G_dense, G_rec;
+      KDL::Jacobian J_star(model->nj()), J(model->nj());
+      ASSERT_EQ(solver.G_star(h, G_dense), 0) << link;
+      ASSERT_EQ(recursive.G_star(h, G_rec), 0) << link;
+      ASSERT_EQ(solver.J_star(h, J_star), 0) << link;
+      ASSERT_EQ(solver.J(h, J), 0) << link;
+      const Eigen::MatrixXd G_ref = independentG(*free, u, c, LinkPoint{link, offset});
+      const double scale = G_ref.norm();
+      EXPECT_TRUE(near(G_dense, G_ref, 0, 1e-10 * scale, f.name + " G* (dense) at " + link));
+      EXPECT_TRUE(near(G_rec, G_ref, 0, 1e-10 * scale, f.name + " G* (recursive) at " + link));
+      EXPECT_EQ(J_star.data.cols(), static_cast<Eigen::Index>(f.joints));
+      // conditioning() on a 6 x n J*: n = 0 has no singular values and no manipulability.
+      const Conditioning k = conditioning(J_star.data, J.data);
+      EXPECT_EQ(k.sigma_J_star.size(), static_cast<Eigen::Index>(std::min(6u, f.joints)));
+      if (f.joints == 0) {
+        EXPECT_EQ(k.manipulability_J_star, 0.0);
+        EXPECT_TRUE(std::isinf(k.condition_number));
+      }
+      Conditioning k2;
+      std::vector<Diagnostic> warnings;
+      EXPECT_EQ(checkConfiguration(model, s, h, k2, warnings), 0);
+    }
+  }
+}
+
+// No joints: G* is the single rigid body's inverse inertia at the point, by hand.
+TEST(FamiliesRigid, GStarOfARobotWithoutJointsIsTheBodysInverseInertia) {
+  for (const std::string name : {"rigid_body", "rigid_bus"}) {
+    const auto model = std::make_shared<const FloatingModel>(loadUrdfFile(familyUrdf(name)));
+    ASSERT_EQ(model->nj(), 0u);
+    FreeFloatingSolver solver(model);
+    State s(*model);
+    s.world_T_base = basePose(KDL::Vector(0.3, -0.1, 0.2), 0.4, -0.3, 0.2);
+    ASSERT_EQ(solver.compute(s), 0);
+    const Contact h = model->contact(model->bodies().back().name, KDL::Vector(0.1, 0.2, -0.1));
+    Vector3d p;
+    Matrix6d G;
+    ASSERT_EQ(solver.contactPoint(h, p), 0);
+    ASSERT_EQ(solver.G_star(h, G), 0);
+    // An impulse (f; n) at p: dv_g = f / w, dw = I_g^-1 (n + r x f), dv_p = dv_g + dw x r, r = p - r_g.
+    const Vector3d r = p - solver.r_g();
+    Eigen::Matrix3d rx;
+    rx << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+    const Eigen::Matrix3d Ii = solver.I_g().inverse();
+    Matrix6d G_hand;
+    G_hand << Eigen::Matrix3d::Identity() / solver.w() - rx * Ii * rx, -rx * Ii, Ii * rx, Ii;
+    EXPECT_TRUE(near(G, G_hand, 1e-12, 1e-15, name + " G*"));
+  }
+}
+
+// Each impact law: momentum conserved; a capture leaves the hand moving with the target's point.
+TEST_P(Families, CaptureWithEachLawConservesMomentum) {
+  const ModelFamily& f = GetParam();
+  for (const std::string& law : laws()) {
+    const Scenario sc = loadScenario(writeScenario(f, law));
+    const CaptureResult r = solveCapture(sc.capture);
+    const double scale = r.momentum_before.norm() + 1.0;
+    EXPECT_TRUE(near(r.momentum_after, r.momentum_before, 0, 1e-12 * scale, f.name + " " + law + ": momentum"));
+    EXPECT_LE(r.energy_after, r.energy_before * (1 + 1e-12)) << f.name << " " << law;
+    if (law != "{type: capture}") continue;
+    // The rigid grasp: the hand moves with the target's point after it (the box's CoM at its pose).
+    const Vector3d w = r.target_twist_after.tail<3>();
+    const Vector3d v_point = r.target_twist_after.head<3>() + w.cross(r.contact_point - Vector3d(2.5, 0.5, 0.3));
+    Vector6d target_point;
+    target_point << v_point, w;
+    EXPECT_TRUE(near(r.robot.contact_twist_after, target_point, 0, 1e-12 * (target_point.norm() + 1),
+                     f.name + " capture: the hand moves with the target's point"));
+  }
+}
+
+// simulate: the operation (capture, then 0.5 s of motion) keeps the momentum of both sides.
+TEST_P(Families, TheOperationRunsAndConservesMomentum) {
+  const ModelFamily& f = GetParam();
+  const Scenario sc = loadScenario(writeScenario(f, "{type: capture}"));
+  const OperationResult r = runCaptureOperation(sc);
+  ASSERT_TRUE(r.capture);
+  ASSERT_FALSE(r.samples.empty());
+  const Vector6d h0 = r.samples.front().h;
+  for (const MotionSample& x : r.samples)
+    EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
+  EXPECT_NEAR(r.samples.back().t, 0.5, 1e-12);
+}
+
+// ik: a pose the contact frame had at another configuration is reached, as measured by KDL's
+// virtual-joint tree of the uncoupled robot (its mimic joints where their leaders put them); a
+// robot without joints on the chain is refused, saying so.
+TEST_P(Families, InverseKinematicsReachesAPoseOfTheChainOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const auto model = load(f);
+  const auto free = loadUncoupled(f);
+  const Coupling c = coupling(*model, *free);
+  std::mt19937 rng(3434);
+  for (const std::string& link : {f.contact, f.other_contact}) {
+    if (link.empty()) continue;
+    const Contact h = model->contact(link, KDL::Vector(0.01, 0.02, 0.03));
+    const State seed = randomStateInLimits(*model, rng);
+    if (f.joints == 0) {
+      try {
+        solveInverseKinematics(*model, seed, h, KDL::Frame(KDL::Vector(1, 2, 3)));
+        ADD_FAILURE() << f.name << ": ik of a robot without joints returned";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no movable joint"), std::string::npos) << e.what();
+      }
+      continue;
+    }
+    State truth = randomStateInLimits(*model, rng);
+    truth.world_T_base = seed.world_T_base;
+    const KDL::Frame goal =
+        VirtualJointTree(*free, uncoupledState(truth, *free, c)).pose(link) * KDL::Frame(KDL::Vector(0.01, 0.02, 0.03));
+    const IkResult r = solveInverseKinematics(*model, seed, h, goal);
+    State reached = seed;
+    reached.q = r.q;
+    const KDL::Frame got =
+        VirtualJointTree(*free, uncoupledState(reached, *free, c)).pose(link) * KDL::Frame(KDL::Vector(0.01, 0.02, 0.03));
+    EXPECT_LE((got.p - goal.p).Norm(), 1e-9) << f.name << " at " << link;
+    const KDL::Rotation dR = got.M.Inverse() * goal.M;
+    EXPECT_LE(dR.GetRot().Norm(), 1e-9) << f.name << " at " << link;
+    for (unsigned int j = 0; j < model->nj(); ++j) {
+      EXPECT_GE(r.q(j), model->jointProperties()[j].lower) << model->jointNames()[j];
+      EXPECT_LE(r.q(j), model->jointProperties()[j].upper) << model->jointNames()[j];
+    }
+  }
+}
+
+// plan: an optimum inside the limits, or a refusal that names what is missing.
+TEST_P(Families, PlanFindsAnOptimumOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const Scenario sc = loadScenario(writeScenario(f, "{type: capture}"));
+  PlanOptions o;
+  o.scan = 5;
+  try {
+    const CapturePlan p = planCapture(sc, o);
+    EXPECT_GT(f.joints, 0u) << f.name << ": a robot without joints has nothing to plan";
+    EXPECT_TRUE(std::isfinite(p.optimum.objective));
+    EXPECT_LE(p.optimum.objective, p.nominal.objective + 1e-12);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_FALSE(what.empty());
+    if (f.joints == 0) EXPECT_NE(what.find("no movable joint"), std::string::npos) << what;
+  }
+}
+
+// study: every sample of a small study computes.
+TEST_P(Families, AStudyComputesEverySample) {
+  const ModelFamily& f = GetParam();
+  const std::string scenario = writeScenario(f, "{type: capture}");
+  const std::string study_path = scenario + ".study.yaml";
+  std::ofstream(study_path) << "scenario: " << scenario << "\nsamples: 6\nseed: 34\ninputs:\n"
+                            << "  target.mass: {uniform: [20, 60]}\n  target.twist.wx: {normal: {mean: 0.03, std: 0.01}}\n";
+  const auto study = std::make_shared<const Study>(loadStudy(study_path));
+  StudyEvaluator eval(study);
+  std::vector<double> row(eval.columns());
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    eval.evaluate(i, row.data());
+    EXPECT_EQ(row[1], 0.0) << f.name << " sample " << i << ": " << eval.failure();
+  }
+}
+
+// check: the loader's and the checker's verdicts agree, and every family loads.
+TEST_P(Families, CheckFindsNoError) {
+  const ModelFamily& f = GetParam();
+  const UrdfReport report = checkUrdfFile(familyUrdf(f.name));
+  EXPECT_TRUE(report.errors.empty()) << f.name << ": " << (report.errors.empty() ? "" : report.errors.front().message);
+}
+
+std::string familyName(const ::testing::TestParamInfo<ModelFamily>& info) { return info.param.name; }
+INSTANTIATE_TEST_SUITE_P(EveryKindOfRobot, Families, ::testing::ValuesIn(modelFamilies()), familyName);
+
+}  // namespace
+}  // namespace kdl_space::test
