@@ -18,5 +18,9 @@ while (($#)); do
 done
 "$root/tools/deps.sh"
 source "$root/tools/cmake_generator.sh" "$build"
-cmake -S "$root" -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
+# RelWithDebInfo with line tables only (-g1: a backtrace names file and line; full -g took 65 % more
+# compile time, measured on the test files): the same -O2 code. For a debugger's view of the
+# locals, pass -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g -DNDEBUG" (the arguments come after these).
+cmake -S "$root" -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" "$@" >/dev/null
 cmake --build "$build" -j"$(nproc)" ${targets[@]+"${targets[@]}"} >/dev/null

@@ -13,9 +13,10 @@ seconds="${1:-60}"
 
 # clang, and libFuzzer with the sanitizer runtimes (Debian 12: libclang-rt-14-dev).
 "$root/tools/deps.sh" clang libclang-rt-14-dev
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DKDL_SPACE_FUZZ=ON \
+source "$root/tools/cmake_generator.sh" "$build"
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" "${generator_args[@]}" -DKDL_SPACE_FUZZ=ON \
   -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF -DKDL_SPACE_BUILD_BENCHMARK=OFF \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" >/dev/null
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" >/dev/null
 cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study fuzz_commands >/dev/null
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
@@ -24,29 +25,47 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/kdl_space_fuzz.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 artifacts="$build/artifacts"
 failed=0
-# target  max_len  dictionary: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow;
-# commands mutates scenarios (over the model families), with the scenario's dictionary.
-for spec in "urdf 16384 urdf" "scenario 4096 scenario" "study 4096 study" "commands 4096 scenario"; do
-  read -r name max_len dict <<<"$spec"
-  target="fuzz_$name"
+# One target for SECONDS, then its verdict: `fuzz_one NAME MAX_LEN DICT` (exit 1 on a finding).
+fuzz_one() {
+  local name="$1" max_len="$2" dict="$3" rc=0
+  local target="fuzz_$name" log="$build/fuzz_$name.log"
   mkdir -p "$work/$name" "$artifacts/$name"
   cp "$root/fuzz/corpus/$name/"* "$work/$name/"
   # The inputs that once found a bug are seeds too (tests/data/fuzz_regressions/, if any).
   cp "$root/tests/data/fuzz_regressions/$name/"* "$work/$name/" 2>/dev/null || true
-  log="$build/$target.log"
-  echo "tools/fuzz.sh: $target for ${seconds} s (log: $log)"
   # -timeout: one input taking longer than 10 s is a hang (a finding); -rss_limit_mb: a blow-up.
-  if "$build/fuzz/$target" "$work/$name" -dict="$root/fuzz/$dict.dict" \
-      -max_total_time="$seconds" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 \
-      -artifact_prefix="$artifacts/$name/" -print_final_stats=1 >"$log" 2>&1; then
-    grep -E "^stat::(number_of_executed_units|new_units_added|peak_rss_mb)|#[0-9]+.*DONE" "$log" | sed 's/^/  /' || true
-  else
-    rc=$?
-    failed=1
-    echo "tools/fuzz.sh: $target FOUND A BUG (exit $rc); end of its log:" >&2
-    tail -n 60 "$log" >&2
-    echo "tools/fuzz.sh: the input that caused it (reproduce: $build/fuzz/$target FILE):" >&2
-    grep -hoE "Test unit written to [^ ]+" "$log" | sed 's/.* to /  /' >&2 || echo "  (none written)" >&2
-  fi
+  "$build/fuzz/$target" "$work/$name" -dict="$root/fuzz/$dict.dict" \
+    -max_total_time="$seconds" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$artifacts/$name/" -print_final_stats=1 >"$log" 2>&1 || rc=$?
+  {
+    if ((rc == 0)); then
+      echo "tools/fuzz.sh: $target ran ${seconds} s (log: $log)"
+      grep -E "^stat::(number_of_executed_units|new_units_added|peak_rss_mb)|#[0-9]+.*DONE" "$log" | sed 's/^/  /' || true
+    else
+      echo "tools/fuzz.sh: $target FOUND A BUG (exit $rc); end of its log ($log):"
+      tail -n 60 "$log"
+      echo "tools/fuzz.sh: the input that caused it (reproduce: $build/fuzz/$target FILE):"
+      grep -hoE "Test unit written to [^ ]+" "$log" | sed 's/.* to /  /' || echo "  (none written)"
+    fi
+  } >"$log.verdict"
+  echo "$rc" >"$log.rc"
+}
+# target  max_len  dictionary: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow;
+# commands mutates scenarios (over the model families), with the scenario's dictionary. As many
+# targets at once as there are cores, each for SECONDS: the same fuzzing in a fraction of the time.
+specs=("urdf 16384 urdf" "scenario 4096 scenario" "study 4096 study" "commands 4096 scenario")
+jobs=$(nproc)
+names=()
+for spec in "${specs[@]}"; do
+  read -r name max_len dict <<<"$spec"
+  while (($(jobs -rp | wc -l) >= jobs)); do wait -n || true; done
+  echo "tools/fuzz.sh: fuzz_$name for ${seconds} s"
+  fuzz_one "$name" "$max_len" "$dict" &
+  names+=("$name")
+done
+wait
+for name in "${names[@]}"; do
+  cat "$build/fuzz_$name.log.verdict" >&2
+  [[ "$(cat "$build/fuzz_$name.log.rc")" == 0 ]] || failed=1
 done
 exit "$failed"
