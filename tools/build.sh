@@ -23,4 +23,6 @@ source "$root/tools/cmake_generator.sh" "$build"
 # locals, pass -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g -DNDEBUG" (the arguments come after these).
 cmake -S "$root" -B "$build" "${generator_args[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" "$@" >/dev/null
-cmake --build "$build" -j"$(nproc)" ${targets[@]+"${targets[@]}"} >/dev/null
+# Quiet when it builds; on a failure, what failed and why (the build's own log, build.log).
+cmake --build "$build" -j"$(nproc)" ${targets[@]+"${targets[@]}"} >"$build/build.log" 2>&1 ||
+  { grep -E -A12 "^FAILED|error" "$build/build.log" | head -n 80 >&2; echo "tools/build.sh: the build failed (log: $build/build.log)" >&2; exit 1; }

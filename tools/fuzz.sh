@@ -17,7 +17,8 @@ source "$root/tools/cmake_generator.sh" "$build"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" "${generator_args[@]}" -DKDL_SPACE_FUZZ=ON \
   -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF -DKDL_SPACE_BUILD_BENCHMARK=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" >/dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study fuzz_commands >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study fuzz_commands >"$build/build.log" 2>&1 ||
+  { grep -E -A12 "^FAILED|error" "$build/build.log" | head -n 80 >&2; echo "tools/fuzz.sh: the build failed (log: $build/build.log)" >&2; exit 1; }
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"

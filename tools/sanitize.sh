@@ -17,7 +17,8 @@ build="${KDL_SPACE_ASAN_BUILD_DIR:-$root/build-asan}"
 source "$root/tools/cmake_generator.sh" "$build"
 cmake -S "$root" -B "$build" "${generator_args[@]}" -DKDL_SPACE_SANITIZE=ON -DKDL_SPACE_BUILD_BENCHMARK=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" "$@" >/dev/null
-cmake --build "$build" -j"$(nproc)" >/dev/null
+cmake --build "$build" -j"$(nproc)" >"$build/build.log" 2>&1 ||
+  { grep -E -A12 "^FAILED|error" "$build/build.log" | head -n 80 >&2; echo "tools/sanitize.sh: the build failed (log: $build/build.log)" >&2; exit 1; }
 # Every report is fatal (UBSan too: -fno-sanitize-recover at compile time, halt_on_error here);
 # leaks are reported at exit. Suppressions, each with its reason: tools/sanitizers/.
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:abort_on_error=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
