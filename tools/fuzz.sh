@@ -1,24 +1,19 @@
 #!/usr/bin/env bash
-# tools/fuzz.sh [SECONDS]: installs clang and libFuzzer, builds the fuzz targets (KDL_SPACE_FUZZ=ON,
-# ASan + UBSan, assertions on) into build-fuzz/ (or $KDL_SPACE_FUZZ_BUILD_DIR) and runs each for
+# tools/fuzz.sh [SECONDS]: installs clang and libFuzzer, builds the fuzz targets (ASan + UBSan,
+# assertions on) in the instrumented build, build-asan/ (or $KDL_SPACE_ASAN_BUILD_DIR), and runs each for
 # SECONDS (default 60) on a scratch copy of its seed corpus fuzz/corpus/<target>/ (the repository
 # is never written). Fails on any finding (crash, sanitizer report, leak, uncaught exception,
 # timeout of one input, memory blow-up) and prints the path of the input that caused it; see
 # README "Sanitizers and fuzzing" for turning it into a regression test.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${KDL_SPACE_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 seconds="${1:-60}"
 [[ "$seconds" =~ ^[0-9]+$ ]] && ((seconds > 0)) || { echo "usage: tools/fuzz.sh [SECONDS]" >&2; exit 2; }
 
-# clang, and libFuzzer with the sanitizer runtimes (Debian 12: libclang-rt-14-dev).
-"$root/tools/deps.sh" clang libclang-rt-14-dev
-source "$root/tools/cmake_generator.sh" "$build"
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" "${generator_args[@]}" -DKDL_SPACE_FUZZ=ON \
-  -DKDL_SPACE_BUILD_TESTS=OFF -DKDL_SPACE_BUILD_TOOLS=OFF -DKDL_SPACE_BUILD_BENCHMARK=OFF \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" >/dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_urdf fuzz_scenario fuzz_study fuzz_commands >"$build/build.log" 2>&1 ||
-  { grep -E -A12 "^FAILED|error" "$build/build.log" | head -n 80 >&2; echo "tools/fuzz.sh: the build failed (log: $build/build.log)" >&2; exit 1; }
+# The fuzz targets of the one instrumented build (tools/sanitized_build.sh: after tools/sanitize.sh,
+# already built).
+source "$root/tools/sanitized_build.sh"
+sanitized_build fuzz_urdf fuzz_scenario fuzz_study fuzz_commands
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"

@@ -50,7 +50,7 @@ std::uint64_t bounded(long long value, std::uint64_t most, const char* name, con
   return static_cast<std::uint64_t>(value);
 }
 
-py::array_t<double> rows(const PyStudy& s, long long begin_arg, long long end_arg, long long threads_arg) {
+py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long end_arg, long long threads_arg) {
   const Study& st = *s.study;
   const std::uint64_t end = bounded(end_arg, st.samples, "end", "the study's samples");
   const std::uint64_t begin = bounded(begin_arg, end, "begin", "end");
@@ -260,7 +260,7 @@ void bindStudy(py::module_& m) {
       }, py::arg("chunk_size") = 0, py::arg("begin") = 0, py::arg("end") = py::none(),
            "The chunks [(begin, end), ...] of rows [begin, end) on the study's grid of chunks of chunk_size "
            "samples (0: default_chunk_size), as the command-line tool cuts them.")
-      .def("rows", &rows, py::arg("begin"), py::arg("end"), py::arg("threads") = 1,
+      .def("rows", &studyRows, py::arg("begin"), py::arg("end"), py::arg("threads") = 1,
            "Rows [begin, end) of the table, (end - begin, len(columns)) float64, computed on `threads` threads "
            "(0: all cores) in chunks, GIL released; Ctrl-C stops the run within a sample and raises KeyboardInterrupt. A sample that cannot "
            "be computed has its status (an error code) and NaN outcomes. ValueError unless 0 <= begin <= end <= "

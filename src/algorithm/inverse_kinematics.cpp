@@ -53,9 +53,9 @@ KDL::Twist poseError(const KDL::Frame& current, const KDL::Frame& goal) {
 double clampTo(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
 
 /// The solvers on one chain (each keeps a reference to it: it outlives them).
-class Search {
+class IkSearch {
  public:
-  Search(const ContactChain& c, const KDL::JntArray& preferred, const KDL::Frame& goal, const IkOptions& o)
+  IkSearch(const ContactChain& c, const KDL::JntArray& preferred, const KDL::Frame& goal, const IkOptions& o)
       : c_(c), preferred_(preferred), goal_(goal), o_(o), fk_(c.chain), jac_(c.chain),
         vel_(c.chain, 1e-9, 150),
         lma_(c.chain, 1e-12, static_cast<int>(o.max_iterations), 1e-15) {}
@@ -324,7 +324,7 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
     preferred(k) = clampTo(pref_model(c.joints[k]), c.lower(k), c.upper(k));
   }
   const KDL::Frame base_T_goal = seed.world_T_base.Inverse() * world_T_goal;  // the chain's frame
-  Search search(c, preferred, base_T_goal, options);
+  IkSearch search(c, preferred, base_T_goal, options);
 
   const auto toModel = [&](const KDL::JntArray& qc) {
     KDL::JntArray q = seed.q;

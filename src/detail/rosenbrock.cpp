@@ -19,8 +19,8 @@ constexpr int kStages = 4;
 constexpr double kGamma = 0.5;
 constexpr double kAlpha[kStages] = {0.0, 0.0, 1.0, 1.0};
 constexpr double kGammaSum[kStages] = {0.5, 1.5, 0.0, 0.0};
-constexpr double kA[kStages][kStages] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {2, 0, 0, 0}, {2, 0, 1, 0}};
-constexpr double kC[kStages][kStages] = {
+constexpr double kRodasA[kStages][kStages] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {2, 0, 0, 0}, {2, 0, 1, 0}};
+constexpr double kRodasC[kStages][kStages] = {
     {0, 0, 0, 0}, {4, 0, 0, 0}, {1, -1, 0, 0}, {1, -1, -8.0 / 3.0, 0}};
 constexpr double kM[kStages] = {2, 0, 1, 1};
 constexpr double kE[kStages] = {0, 0, 0, 1};
@@ -93,11 +93,11 @@ int RosenbrockStepper::step(const Rhs& f, double t, double h, const Eigen::Vecto
     } else {
       y_ = x;
       for (int j = 0; j < i; ++j)
-        if (kA[i][j] != 0.0) y_ += kA[i][j] * K_.col(j);
+        if (kRodasA[i][j] != 0.0) y_ += kRodasA[i][j] * K_.col(j);
       if (const int rc = evaluate(f, t + kAlpha[i] * h, y_, rhs_)) return rc;
     }
     for (int j = 0; j < i; ++j)
-      if (kC[i][j] != 0.0) rhs_ += (kC[i][j] / h) * K_.col(j);
+      if (kRodasC[i][j] != 0.0) rhs_ += (kRodasC[i][j] / h) * K_.col(j);
     if (kGammaSum[i] != 0.0) rhs_ += (kGammaSum[i] * h) * dfdt_;
     K_.col(i).noalias() = lu_.solve(rhs_);
   }

@@ -40,7 +40,7 @@ Eigen::MatrixXd massMatrix(const FloatingModel& model, const Kinematics& kin) {
   return M;
 }
 
-std::string quotedList(const std::vector<std::string>& names) {
+std::string quotedNames(const std::vector<std::string>& names) {
   std::vector<std::string> quoted_names;
   for (const std::string& name : names) quoted_names.push_back(quoted(name));
   return listNames(quoted_names);
@@ -83,7 +83,7 @@ void checkMassMatrix(const FloatingModel& model, std::vector<Diagnostic>& diagno
     null = eig.eigenvectors().col(0);
   }
   const std::string what = base_links.size() == 1 ? "the free-floating base" : "the free-floating base (the links " +
-                           quotedList(base_links) + ": the root and the links fixed to it)";
+                           quotedNames(base_links) + ": the root and the links fixed to it)";
   if (!singular) {
     if (massless_base)
       diagnostics.push_back({bodies[0].name, what + " has no mass" + (rotational[0] ? " (only a rotational inertia)" : "") +
@@ -99,7 +99,7 @@ void checkMassMatrix(const FloatingModel& model, std::vector<Diagnostic>& diagno
   std::vector<std::string> joints;
   for (unsigned int j = 0; j < model.nj(); ++j)
     if (std::abs(null(6 + j)) > 1e-6 * largest) joints.push_back(model.jointNames()[j]);
-  const std::string with = joints.empty() ? "" : " with joint" + std::string(joints.size() == 1 ? " " : "s ") + quotedList(joints);
+  const std::string with = joints.empty() ? "" : " with joint" + std::string(joints.size() == 1 ? " " : "s ") + quotedNames(joints);
   if (massless_base && base_moves) {
     const std::string fix = "(kdl_space reads the root link's <inertial>, which kdl_parser drops)";
     throw rules::RuleError(rules::error(
@@ -122,13 +122,13 @@ void checkMassMatrix(const FloatingModel& model, std::vector<Diagnostic>& diagno
   if (rotor_links.empty()) return;
   const bool one = joints.size() == 1;
   const std::string movers = joints.empty() ? std::string("the base moves")
-                                            : std::string(one ? "joint " : "joints ") + quotedList(joints) +
+                                            : std::string(one ? "joint " : "joints ") + quotedNames(joints) +
                                                   (base_moves ? " and the base move" : one ? " moves" : " move");
   throw rules::RuleError(rules::error(
       "singular_inertia", joints.empty() ? ElementType::File : ElementType::Joint, joints.empty() ? "" : joints.front(),
       "the system's mass matrix is singular at q = 0: " + movers + " no inertia (" +
-          (rotor_links.size() == 1 ? "the link " + quotedList(rotor_links) + " has"
-                                   : "the links " + quotedList(rotor_links) + " have") +
+          (rotor_links.size() == 1 ? "the link " + quotedNames(rotor_links) + " has"
+                                   : "the links " + quotedNames(rotor_links) + " have") +
           " a rotational inertia but no mass); give " + (rotor_links.size() == 1 ? "it its" : "them their") +
           " mass, the joint an armature, or no <inertial> to a link that only carries a frame (its joint is then "
           "treated as fixed)"));

@@ -28,7 +28,7 @@ double& coordinate(PlanPoint& p, int which) {
 }
 
 /// The search: the chart's evaluator, the box, and the best feasible configuration seen.
-struct Search {
+struct PlanSearch {
   PlanEvaluator& evaluator;
   Box box;
   PlanPoint fixed;  ///< the values of the parameters not searched
@@ -66,12 +66,12 @@ struct Search {
 };
 
 double nloptScore(const std::vector<double>& x, std::vector<double>& /*grad*/, void* data) {
-  return static_cast<Search*>(data)->score(x);
+  return static_cast<PlanSearch*>(data)->score(x);
 }
 
 /// The scan: N points per searched parameter, the box's first varying fastest (the inverse
 /// kinematics of a (wrist_roll, timing) pair is computed once for its rows). Returns the scores.
-std::vector<double> scan(Search& s, unsigned int N, std::vector<std::vector<double>>& points) {
+std::vector<double> scan(PlanSearch& s, unsigned int N, std::vector<std::vector<double>>& points) {
   const std::size_t d = s.box.which.size();
   std::size_t total = 1;
   for (std::size_t k = 0; k < d; ++k) total *= N;
@@ -107,7 +107,7 @@ std::vector<std::size_t> localMinima(const std::vector<double>& scores, unsigned
   return minima;
 }
 
-void polish(Search& s, const std::vector<double>& start, unsigned int N, unsigned int evaluations) {
+void polish(PlanSearch& s, const std::vector<double>& start, unsigned int N, unsigned int evaluations) {
   const std::size_t d = start.size();
   nlopt::opt opt(d == 1 ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, static_cast<unsigned>(d));
   std::vector<double> lower(d), upper(d), step(d), tol(d);
@@ -141,7 +141,7 @@ void polish(Search& s, const std::vector<double>& start, unsigned int N, unsigne
 CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
   PlanEvaluator evaluator(scenario, options);  // or InputError: the options, nothing to plan
   const PlanOptions& o = evaluator.options();
-  Search s{evaluator, {}, {}, 0, false, {}, {}, false, {}};
+  PlanSearch s{evaluator, {}, {}, 0, false, {}, {}, false, {}};
   const bool closing = o.closing_speed.has_value();
   const PlanRange ranges[4] = {*o.self_motion, o.wrist_roll, o.timing, closing ? *o.closing_speed : PlanRange{}};
   for (const int k : {0, 3, 1, 2}) {

@@ -18,7 +18,7 @@ namespace {
 
 using detail::kAxisOf;
 using detail::Probe;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kInfinite = std::numeric_limits<double>::infinity();
 
 void checkPositive(const Vector6d& v, const std::string& field, bool zero_ok) {
   for (int k = 0; k < 6; ++k)
@@ -62,9 +62,9 @@ struct EndScales {
 /// where it ends; +inf where inactive. All are functions of the state alone (no accelerations),
 /// as the stop event needs, and normalised (dimensionless, ~1 at the touch).
 struct EndCriteria {
-  double speed = kInf;    ///< the relative speed over its start, minus catch_tolerance
-  double closing = kInf;  ///< without a normal: dV/dt of the springs, scaled (the hand closes while > 0)
-  double opening = kInf;  ///< with a normal: -n^T f, f the force on the robot (it pushes while > 0)
+  double speed = kInfinite;    ///< the relative speed over its start, minus catch_tolerance
+  double closing = kInfinite;  ///< without a normal: dV/dt of the springs, scaled (the hand closes while > 0)
+  double opening = kInfinite;  ///< with a normal: -n^T f, f the force on the robot (it pushes while > 0)
   double least() const { return std::min(speed, std::min(closing, opening)); }
 };
 

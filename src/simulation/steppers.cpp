@@ -39,8 +39,8 @@ class Rk4 final : public Stepper {
 
 // Dormand & Prince (1980) RK5(4)7M tableau: c, A, the fifth-order weights b5 (the solution: local
 // extrapolation) and the fourth-order b4 (the estimate is their difference).
-constexpr double kC[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
-constexpr double kA[7][6] = {
+constexpr double kDopriC[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+constexpr double kDopriA[7][6] = {
     {},
     {1.0 / 5},
     {3.0 / 40, 9.0 / 40},
@@ -61,8 +61,8 @@ class Dopri5 final : public Stepper {
     trial_failed = false;
     for (int i = 0; i < 7; ++i) {
       x_stage_ = x;
-      for (int j = 0; j < i; ++j) x_stage_ += h * kA[i][j] * k_[j];
-      if (int rc = f_.f(t + kC[i] * h, x_stage_, k_[i])) {
+      for (int j = 0; j < i; ++j) x_stage_ += h * kDopriA[i][j] * k_[j];
+      if (int rc = f_.f(t + kDopriC[i] * h, x_stage_, k_[i])) {
         trial_failed = i > 0;  // a stage away from x: a smaller step may not reach that state
         return rc;
       }

@@ -337,8 +337,9 @@ TEST_P(RealPatternLoads, WarningsAreTheExpectedOnesFromLoaderAndChecker) {
     EXPECT_TRUE(d.severity == Severity::Warning || d.severity == Severity::Note) << d.kind;
 
   // Each expected warning names its links or joints.
-  for (const auto& [kind, names] : c.warnings)
+  for (const auto& [expected_kind, names] : c.warnings)
     for (const std::string& name : names) {
+      const std::string& kind = expected_kind;  // a lambda captures no structured binding before C++20 (clang)
       const bool named = std::any_of(report.warnings.begin(), report.warnings.end(), [&](const Finding& f) {
         return f.kind == kind && (f.element == name || f.message.find(name) != std::string::npos);
       });
