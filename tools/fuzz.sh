@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # tools/fuzz.sh [SECONDS]: installs clang and libFuzzer, builds the fuzz targets (ASan + UBSan,
-# assertions on) in the instrumented build, build-asan/ (or $KDL_SPACE_ASAN_BUILD_DIR), and runs each for
-# SECONDS (default 60) on a scratch copy of its seed corpus fuzz/corpus/<target>/ (the repository
+# assertions on) in the instrumented build, build-asan/ (or $KDL_SPACE_ASAN_BUILD_DIR), and runs
+# each for SECONDS (default 60) on a scratch copy of its seed corpus fuzz/corpus/<target>/ (the repository
 # is never written). Fails on any finding (crash, sanitizer report, leak, uncaught exception,
 # timeout of one input, memory blow-up) and prints the path of the input that caused it; see
 # README "Sanitizers and fuzzing" for turning it into a regression test.

@@ -2,9 +2,8 @@
 # Installs what is missing, builds the library, the tool, the tests (not the benchmark) and the fuzz
 # targets with AddressSanitizer and UndefinedBehaviorSanitizer (clang, assertions on) into
 # build-asan/ (or $KDL_SPACE_ASAN_BUILD_DIR; tools/sanitized_build.sh), and runs the library's
-# suites and a representative set of the tool's there. Any sanitizer
-# report fails the test that triggered it. Third-party libraries (KDL, urdfdom, yaml-cpp) are not
-# instrumented.
+# suites and a representative set of the tool's there. Any sanitizer report fails the test that
+# triggered it. Third-party libraries (KDL, urdfdom, yaml-cpp) are not instrumented.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 source "$root/tools/sanitized_build.sh"  # build-asan/: clang, ASan + UBSan, the fuzz targets too

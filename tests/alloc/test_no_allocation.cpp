@@ -24,10 +24,9 @@
 #include "generated_chain.hpp"
 #include "test_util.hpp"
 
-
 namespace {
-// volatile: under ASan, malloc and free are opaque builtins that GCC knows read no global, so
-// it would drop the stores to a plain flag around an inlined malloc/free pair.
+// volatile: malloc and free are builtins that the compiler knows read no global, so it could drop
+// the stores to a plain flag around an inlined malloc/free pair.
 volatile long g_allocations = 0;
 volatile bool g_counting = false;
 inline void count() {

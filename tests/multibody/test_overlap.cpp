@@ -45,8 +45,6 @@ double minkowski(const OrientedBox& a, const OrientedBox& b, const Vector3d& n) 
   return support(a, u) + support(b, -u);
 }
 
-/// The minimum of `minkowski` over directions: 100,000 on a Fibonacci sphere, then random steps
-/// from the best that shrink to 1e-10 rad (a descent that never goes below the minimum).
 /// Three draws of `d`, x then y then z.
 template <typename Distribution>
 Vector3d draw(Distribution& d, std::mt19937& rng) {
@@ -54,9 +52,10 @@ Vector3d draw(Distribution& d, std::mt19937& rng) {
   return {x, y, z};
 }
 
+/// The minimum of `minkowski` over directions: 100,000 on a Fibonacci sphere, then random steps
+/// that shrink to 1e-10 rad from each of the 20 best (a descent that never goes below the minimum;
+/// one start can sit in the basin of another face of A - B: it did for some boxes).
 double bruteForceDepth(const OrientedBox& a, const OrientedBox& b, std::mt19937& rng) {
-  // The 100,000 directions of a Fibonacci sphere, then a shrinking random search from each of the
-  // 20 best (one start can sit in the basin of another face of A - B: it did for some boxes).
   const int n = 100000, starts = 20;
   const double golden = M_PI * (3.0 - std::sqrt(5.0));
   std::vector<std::pair<double, Vector3d>> sampled;
