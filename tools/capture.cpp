@@ -317,12 +317,15 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     throw InputError(sc.file + ": approach: the contact instant comes from the approach's motion; run kdl_space "
                      "simulate (it solves the capture then), or remove the approach section to solve the impact "
                      "at the scenario's states");
+  stopIfInterrupted("capture " + sc.file + ": after loading it");
   const CaptureResult result = inScenario(sc, [&] { return solveCapture(sc.capture); });
+  stopIfInterrupted("capture " + sc.file + ": after solving the capture");
   std::optional<CompliantCaptureResult> compliant;
   if (sc.compliant)
     compliant = inScenario(sc, [&] {
       return solveCompliantCapture(sc.capture, *sc.compliant);
     });
+  stopIfInterrupted("capture " + sc.file + ": after solving it");
   if (!o.scene.empty()) {
     AtomicFile scene(o.scene, "--scene");
     writeScene(scene, {impactSnapshot(sc)},
@@ -346,7 +349,7 @@ void runCapture(const CaptureOptions& o, std::ostream& out) {
     all.insert(all.end(), mesh_warnings.begin(), mesh_warnings.end());
     j["warnings"] = warningsJson(all);
     if (compliant) j["compliant"] = compliantJson(*compliant);  // beside the impulsive capture
-    out << j.dump(2) << "\n";
+    out << jsonText(j, 2) << "\n";
   } else {
     printCaptureSummary(out, sc, result);
     if (compliant) printCompliantSummary(out, *compliant, result);

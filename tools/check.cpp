@@ -85,7 +85,8 @@ std::string modelNote(const ModelSummary& m, bool tips_requested) {
   std::ostringstream s;
   s << "base '" << m.base << "', " << plural(m.links, "link") << ", " << plural(m.joint_names.size(), "movable joint")
     << ", total mass " << m.total_mass << " kg";
-  if (!m.joint_names.empty()) s << "; at q = 0: cond(H*) = " << m.condition_H_star;
+  if (!m.joint_names.empty() && std::isnan(m.condition_H_star)) s << "; at q = 0: cond(H*) not computed (see the note)";
+  else if (!m.joint_names.empty()) s << "; at q = 0: cond(H*) = " << m.condition_H_star;
   std::vector<std::pair<std::string, double>> shown = m.condition_G_star;
   std::size_t more = 0;
   if (!tips_requested) {
@@ -137,6 +138,7 @@ CLI::App* addCheck(CLI::App& app, CheckOptions& o) {
 
 int runCheck(const CheckOptions& o, std::ostream& out) {
   const UrdfReport report = checkUrdfFile(o.urdf, o.tips);
+  stopIfInterrupted("check " + o.urdf + ": after the checks");
   const bool failed = !report.errors.empty() || (o.strict && !report.warnings.empty());
   if (o.json) {
     Json j;
@@ -145,7 +147,7 @@ int runCheck(const CheckOptions& o, std::ostream& out) {
     j["notes"] = findingsJson(report.notes);
     j["model"] = summaryJson(report.model);
     // Names and values come from the file as written: replace what is not UTF-8.
-    out << std::setprecision(17) << j.dump(2, ' ', false, Json::error_handler_t::replace) << "\n";
+    out << std::setprecision(17) << jsonText(j, 2) << "\n";
   } else {
     for (const Finding& f : report.errors) out << report.source << ": error: " << describe(f) << "\n";
     for (const Finding& f : report.warnings) out << report.source << ": warning: " << describe(f) << "\n";

@@ -207,12 +207,18 @@ void checkOutputFile(const std::string& path, const std::string& option) {
   if (!fs::is_directory(status)) throw InputError(where + quoted(folder.string()) + " is not a folder");
   // Whether a file can be created there is known only by creating one (access() says yes to
   // root on a read-only /sys).
-  const fs::path probe = folder / ("." + fs::path(path).filename().string() + ".probe" + std::to_string(getpid()));
-  const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
-  if (fd < 0)
-    throw InputError(where + "cannot create a file in the folder " + quoted(folder.string()) + ": " + std::strerror(errno));
-  close(fd);
-  unlink(probe.c_str());
+  unlink(createFreshFile(folder.string(), "." + fs::path(path).filename().string() + ".probe", where).c_str());
+}
+
+std::string createFreshFile(const std::string& folder, const std::string& stem, const std::string& where, int* fd) {
+  std::string name = (fs::path(folder.empty() ? "." : folder) / (stem + std::to_string(getpid()) + "-XXXXXX")).string();
+  const int created = mkostemp(name.data(), O_CLOEXEC);  // O_CREAT | O_EXCL, mode 0600
+  if (created < 0)
+    throw InputError(where + "cannot create a file in the folder " + quoted(folder.empty() ? "." : folder) + ": " +
+                     std::strerror(errno));
+  if (fd) *fd = created;
+  else close(created);
+  return name;
 }
 
 void refuseOverwritingInputs(const std::string& option, const std::string& path, const std::vector<InputFile>& inputs) {
@@ -246,11 +252,18 @@ void installInterruptHandler() {
 
 const std::atomic<bool>& interruptFlag() { return interrupt_flag; }
 
+std::string writeFailure() { return errno ? std::string(std::strerror(errno)) : std::string("disk full?"); }
+
+void stopIfInterrupted(const std::string& where) {
+  if (interrupt_flag.load()) throw Interrupted(where + "; no output written");
+}
+
 AtomicFile::AtomicFile(std::string path, std::string option)
     : path_(std::move(path)), option_(std::move(option)) {
-  // Same folder (the rename is atomic there), a name that says what it is.
+  // Same folder (the rename is atomic there), a name that says what it is and that no one can
+  // plant a link at beforehand.
   const fs::path p(path_);
-  tmp_ = (p.parent_path() / ("." + p.filename().string() + ".tmp" + std::to_string(getpid()))).string();
+  tmp_ = createFreshFile(p.parent_path().string(), "." + p.filename().string() + ".tmp", option_ + " " + path_ + ": ");
 }
 
 AtomicFile::~AtomicFile() {

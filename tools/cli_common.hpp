@@ -34,6 +34,14 @@ const std::atomic<bool>& interruptFlag();
 struct Interrupted : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+/// \brief Why the last write failed, for a message: the system's reason (strerror(errno): "No
+/// space left on device"), or "disk full?" when the stream kept none.
+std::string writeFailure();
+
+/// \brief Throws Interrupted(`where` + "; no output written") once interruptFlag() is set: the
+/// commands without a long loop of their own (check, inspect, capture) poll it between their steps
+/// and before they write anything.
+void stopIfInterrupted(const std::string& where);
 
 /// A command-line mistake (exit 2).
 struct UsageError : std::runtime_error {
@@ -44,6 +52,13 @@ struct UsageError : std::runtime_error {
 using InputError = kdl_space::InputError;
 
 using Json = nlohmann::ordered_json;
+
+/// \brief A JSON document as text (`indent` -1: one line). Whatever bytes a string holds are
+/// written: control characters escaped (`\u001b`), bytes that are not UTF-8 replaced by U+FFFD,
+/// never an exception at the end of a run (nlohmann's default throws type_error 316).
+inline std::string jsonText(const Json& j, int indent = -1) {
+  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
+}
 
 /// A matrix as a JSON array of rows; a column vector as a flat array.
 Json toJson(const Eigen::MatrixXd& m);
@@ -115,12 +130,23 @@ struct InputFile {
 /// robots/a.urdf; it would be overwritten").
 void refuseOverwritingInputs(const std::string& option, const std::string& path, const std::vector<InputFile>& inputs);
 
-/// \brief A file written under a temporary name in the same folder and renamed into place by
+/// \brief Creates a new empty file `folder`/`stem`PID-XXXXXX (six random characters), exclusively
+/// (O_CREAT | O_EXCL: an existing name, a planted symbolic link included, is never opened or
+/// followed; mkostemp draws another), mode 0600, and returns its path; `fd`, if given, receives
+/// the open descriptor (else it is closed). The PID in the name lets a later run remove the
+/// temporaries of runs that are gone (removeStaleTemporaries). Throws InputError `where` +
+/// "cannot create a file in the folder ...: REASON".
+std::string createFreshFile(const std::string& folder, const std::string& stem, const std::string& where,
+                            int* fd = nullptr);
+
+/// \brief A file written under a fresh temporary name in the same folder (createFreshFile: created
+/// at construction, unpredictable, never through a link someone planted) and renamed into place by
 /// commit(), so that a failed run never leaves a partial file that looks complete; the temporary
 /// is removed if the object is destroyed without a commit.
 class AtomicFile {
  public:
-  /// `option` names the file in messages (e.g. "--csv").
+  /// `option` names the file in messages (e.g. "--csv"). Creates the temporary `.NAME.tmpPID-XXXXXX`
+  /// beside `path`; throws InputError if it cannot.
   AtomicFile(std::string path, std::string option);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;

@@ -13,7 +13,7 @@ seconds="${1:-60}"
 # The fuzz targets of the one instrumented build (tools/sanitized_build.sh: after tools/sanitize.sh,
 # already built).
 source "$root/tools/sanitized_build.sh"
-sanitized_build fuzz_urdf fuzz_scenario fuzz_study fuzz_commands
+sanitized_build fuzz_urdf fuzz_scenario fuzz_study fuzz_commands fuzz_page
 
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
@@ -47,9 +47,10 @@ fuzz_one() {
   echo "$rc" >"$log.rc"
 }
 # target  max_len  dictionary: the largest seed (dual_arm.urdf, 8.4 kB) fits with room to grow;
-# commands mutates scenarios (over the model families), with the scenario's dictionary. As many
-# targets at once as there are cores, each for SECONDS: the same fuzzing in a fraction of the time.
-specs=("urdf 16384 urdf" "scenario 4096 scenario" "study 4096 study" "commands 4096 scenario")
+# commands mutates scenarios (over the model families), with the scenario's dictionary; page
+# mutates a robot folder's URDF (names, mesh filenames) into the page writer, with the URDF's. As
+# many targets at once as there are cores, each for SECONDS: the same fuzzing in a fraction of the time.
+specs=("urdf 16384 urdf" "scenario 4096 scenario" "study 4096 study" "commands 4096 scenario" "page 8192 urdf")
 jobs=$(nproc)
 names=()
 for spec in "${specs[@]}"; do

@@ -2,8 +2,13 @@
 // remove themselves, texts quoted for gnuplot's scripts, and gnuplot run on a script.
 #pragma once
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -13,11 +18,23 @@
 
 namespace kdl_space::cli {
 
-/// A scratch file removed when it goes out of scope (gnuplot's data, script and log).
+/// A scratch file removed when it goes out of scope (gnuplot's data, script and log), beside an
+/// AtomicFile's fresh temporary (its name + ".dat", ".gp"): created empty at once, exclusively
+/// (O_EXCL | O_NOFOLLOW: a link planted at the name is refused, never followed).
 class ScratchFile {
  public:
-  explicit ScratchFile(std::string path) : path_(std::move(path)) {}
-  ~ScratchFile() { std::remove(path_.c_str()); }
+  explicit ScratchFile(std::string path) : path_(std::move(path)) {
+    const int fd = open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    if (fd < 0) {
+      const std::string why = "cannot create the scratch file " + path_ + ": " + std::strerror(errno);
+      path_.clear();  // not ours: never removed
+      throw InputError(why);
+    }
+    close(fd);
+  }
+  ~ScratchFile() {
+    if (!path_.empty()) std::remove(path_.c_str());
+  }
   ScratchFile(const ScratchFile&) = delete;
   ScratchFile& operator=(const ScratchFile&) = delete;
   const std::string& path() const { return path_; }

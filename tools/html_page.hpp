@@ -245,7 +245,11 @@ function kdlSpaceMain() {
        g.computeVertexNormals();
        return new THREE.Mesh(g, meshMaterial(null));
      }
-     var dae = new THREE.ColladaLoader().parse(new TextDecoder().decode(bytes), '');
+     // Whatever the file still names (a texture, another file) is never fetched: every URL the
+     // loader asks for becomes an empty data: URL (the writer removed the DAE's images already).
+     var offline = new THREE.LoadingManager();
+     offline.setURLModifier(function () { return 'data:,'; });
+     var dae = new THREE.ColladaLoader(offline).parse(new TextDecoder().decode(bytes), '');
      dae.scene.traverse(function (o) {  // a DAE without normals: from its triangles
        if (o.isMesh && o.geometry.isBufferGeometry && !o.geometry.attributes.normal) o.geometry.computeVertexNormals();
      });

@@ -1,5 +1,6 @@
 #include "html_writer.hpp"
 
+#include <cerrno>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -96,13 +97,17 @@ Json meshVisualJson(const LinkVisual& v, int index) {
   return j;
 }
 
-/// The page's text with `</` escaped, so that nothing inside a <script> ends it.
-std::string scriptSafe(const std::string& s) {
+/// The page's JSON with every `<`, `>` and `&` written as a JSON escape (`\u003c`...): JSON has
+/// them only inside strings, where the escape reads back the same; no `</script>`, `<!--` or
+/// `<script>` in a name then ends or swallows the <script> that holds the data.
+std::string scriptSafe(const std::string& json) {
   std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += "<\\";
-    else out += s[i];
+  out.reserve(json.size());
+  for (const char c : json) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
   }
   return out;
 }
@@ -159,13 +164,12 @@ void HtmlWriter::readMesh(const std::string& link, LinkVisual& v) {
   } else if (std::ifstream(format == "stl" ? kStlLoaderJs : kColladaLoaderJs).fail()) {
     why = "is not drawn: three.js's loader is not installed (Debian package libjs-three; tools/deps.sh installs it)";
   } else if (meshIndex(v.mesh_path) < 0) {
-    std::ifstream in(v.mesh_path, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    if (!in || bytes.str().empty())
-      why = "(" + v.mesh_path + ") cannot be read or is empty: check the file";
-    else
-      meshes_.push_back({v.mesh_path, format, bytes.str()});
+    MeshBytes read = readMeshFile(v.mesh_path, format == "dae");
+    if (!read.problem.empty()) why = "(" + v.mesh_path + ") " + read.problem + ": check the file";
+    else meshes_.push_back({v.mesh_path, format, std::move(read.bytes)});
+    if (!read.dropped.empty())
+      warnings_.push_back({link, "--html: the mesh " + v.mesh_file + " is drawn without its " + read.dropped,
+                           "mesh_reference_dropped", Severity::Warning});
   }
   if (why.empty()) return;
   warnings_.push_back({link, "--html: the mesh " + v.mesh_file + " " + why + "; the page draws the link's box of inertia",
@@ -396,17 +400,18 @@ void HtmlWriter::write(const AtomicFile& file, const OperationResult& r, const s
     data["impulse"] = {F(0), F(1), F(2)};
   }
   writeTargetAndGrasp(data, r);
+  errno = 0;
   std::ofstream out(file.tmp(), std::ios::binary);
-  if (!out) throw InputError(where + "cannot write in its folder");
+  if (!out) throw InputError(where + "cannot write in its folder: " + writeFailure());
   out << kHtmlHead << "<script>\n" << readText(kThreeJs, where) << "\n</script>\n<script>\n"
       << readText(kOrbitControlsJs, where) << "\n</script>\n";
   // The mesh loaders only in a page that has such a mesh (the page stays small without).
   if (stl) out << "<script>\n" << readText(kStlLoaderJs, where) << "\n</script>\n";
   if (dae) out << "<script>\n" << readText(kColladaLoaderJs, where) << "\n</script>\n";
   out << "<script>\nwindow.KDL_DATA = "
-      << scriptSafe(data.dump()) << ";\n</script>\n" << kHtmlBody;
+      << scriptSafe(jsonText(data, -1)) << ";\n</script>\n" << kHtmlBody;
   out.close();
-  if (!out) throw InputError(where + "cannot write the page (disk full?)");
+  if (!out) throw InputError(where + "cannot write the page: " + writeFailure());
 }
 
 // --- the linked plots (issue 27, item 3) ---------------------------------------------------------

@@ -77,6 +77,7 @@ void runIk(const IkCliOptions& o, std::ostream& out) {
   options.position_tolerance = o.position_tolerance;
   options.orientation_tolerance = o.orientation_tolerance;
   options.restarts = o.restarts;
+  options.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };  // Ctrl-C: Cancelled
   const bool reaction = std::find(o.prefer.begin(), o.prefer.end(), "reaction") != o.prefer.end();
   if (reaction && o.prefer.size() > 1)
     throw UsageError("--prefer reaction: takes no posture (NAME=VALUE) and no second preference; give one of them");
@@ -95,7 +96,7 @@ void runIk(const IkCliOptions& o, std::ostream& out) {
   const KDL::Frame goal(KDL::Rotation::RPY(o.rpy[0], o.rpy[1], o.rpy[2]), KDL::Vector(o.position[0], o.position[1], o.position[2]));
   const IkResult r = inScenario(sc, [&] { return solveInverseKinematics(*robot.model, robot.state, robot.contact, goal, options); });
   if (o.json) {
-    out << ikJson(sc, goal, r).dump(2) << "\n";
+    out << jsonText(ikJson(sc, goal, r), 2) << "\n";
     return;
   }
   const FloatingModel& model = *robot.model;

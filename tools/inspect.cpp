@@ -257,6 +257,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   const std::vector<Contact>& contacts = in.contacts;
   const std::map<std::string, double>& q_by_name = in.q_by_name;
 
+  stopIfInterrupted("inspect " + o.urdf + ": after loading it");
   FreeFloatingSolver solver(model);
   if (const int rc = solver.compute(state))
     throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
@@ -276,6 +277,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   Json json_contacts = Json::array();
   std::ostringstream report;
   for (std::size_t i = 0; i < contacts.size(); ++i) {
+    stopIfInterrupted("inspect " + o.urdf + ": at contact " + std::to_string(i + 1) + " of " + std::to_string(contacts.size()));
     const Contact& h = contacts[i];
     const std::string& link = requests[i].link;
     Vector3d p_h;
@@ -345,7 +347,7 @@ void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& 
   for (const Diagnostic& d : warnings) diagnostics.push_back("warning: " + describe(d));
   if (!o.json) warnOnStderr(warnings);
   if (o.json) {
-    out << std::setprecision(17) << inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings).dump(2)
+    out << std::setprecision(17) << jsonText(inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings), 2)
         << "\n";
     return;
   }

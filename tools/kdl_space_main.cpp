@@ -11,9 +11,11 @@
 #include "plan.hpp"
 #include "simulate.hpp"
 #include "study.hpp"
+#include "terminal_text.hpp"
 
 int main(int argc, char** argv) {
   using namespace kdl_space::cli;
+  const TerminalSafeOutput terminal;  // no name, path or message sends ESC or BEL to the terminal
   CLI::App app{"kdl_space: free-floating space manipulator dynamics (Yoshida et al., Ex-IIT) on Orocos KDL"};
   app.require_subcommand(1);
   InspectOptions inspect_options;
@@ -64,6 +66,9 @@ int main(int argc, char** argv) {
     return rc;
   } catch (const Interrupted& e) {
     std::cerr << "kdl_space: interrupted: " << e.what() << "\n";
+    return kInterrupted;
+  } catch (const kdl_space::Cancelled& e) {  // a library call polled the Ctrl-C flag
+    std::cerr << "kdl_space: interrupted: " << e.what() << "; no output written\n";
     return kInterrupted;
   } catch (const UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";

@@ -159,7 +159,7 @@ void runPlan(const PlanCliOptions& o, std::ostream& out) {
   }
   if (plan.cancelled) throw Interrupted("plan: stopped during the search; nothing written");
   if (o.json) {
-    out << planJson(sc, options, plan).dump(2) << "\n";
+    out << jsonText(planJson(sc, options, plan), 2) << "\n";
     return;
   }
   out << "kdl_space plan " << sc.file << ": minimising";

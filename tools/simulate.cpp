@@ -220,7 +220,7 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   if (streams.html) r.warnings.insert(r.warnings.end(), streams.html->warnings().begin(), streams.html->warnings().end());
   const OperationFiles files{o.csv, o.plot, o.html};
   if (o.json)
-    out << operationJson(sc, r, files).dump(2) << "\n";
+    out << jsonText(operationJson(sc, r, files), 2) << "\n";
   else
     printOperation(out, sc, r, files);
 }

@@ -1,5 +1,6 @@
 #include "study.hpp"
 
+#include <cerrno>
 #include <algorithm>
 #include <atomic>
 #include <charconv>
@@ -458,18 +459,20 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   json["html"] = o.html.empty() ? Json(nullptr) : Json(o.html);  // the nominal sample's page, or null
   if (!o.summary.empty()) {
     AtomicFile f(o.summary, "--summary");
+    errno = 0;
     std::ofstream s(f.tmp());
-    s << json.dump(2) << "\n";
+    s << jsonText(json, 2) << "\n";
     s.close();
-    if (!s) throw InputError("--summary " + o.summary + ": cannot write the file");
+    if (!s) throw InputError("--summary " + o.summary + ": cannot write the file: " + writeFailure());
     f.commit();
   }
   if (!o.groups.empty()) {
     AtomicFile f(o.groups, "--groups");
+    errno = 0;
     std::ofstream g(f.tmp());
     writeStudyGroups(g, summary);
     g.close();
-    if (!g) throw InputError("--groups " + o.groups + ": cannot write the file");
+    if (!g) throw InputError("--groups " + o.groups + ": cannot write the file: " + writeFailure());
     f.commit();
   }
   if (!o.plot.empty()) {
@@ -484,7 +487,7 @@ void runStudyCommand(const StudyOptions& o, std::ostream& out) {
   }
   if (page) page->commit();
   if (o.json) {
-    out << json.dump(2) << "\n";
+    out << jsonText(json, 2) << "\n";
   } else {
     printSummary(out, st, summary, table);
     if (page) out << "Page of the nominal sample: " << o.html << " (open it in a browser)\n";

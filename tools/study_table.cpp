@@ -237,17 +237,10 @@ void StudyPartReader::checkEnd() {
 }
 
 namespace {
-// The lock is written whole to a temporary, then linked to its name: link() fails when the name
-// exists, so the lock appears at once with its holder in it (a run killed while taking it leaves at
-// most a temporary of a dead PID, never an empty lock that would name no holder).
-std::string lockTemporary(const std::string& lock) {
-  const fs::path l(lock);
-  return (l.parent_path() / ("." + l.filename().string() + ".tmp" + std::to_string(getpid()))).string();
-}
-
-bool writeWhole(const std::string& path, const std::string& text) {
-  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) return false;
+// The lock is written whole to a fresh temporary (createFreshFile), then linked to its name: link()
+// fails when the name exists, so the lock appears at once with its holder in it (a run killed while
+// taking it leaves at most a temporary of a dead PID, never an empty lock that would name no holder).
+bool writeWhole(int fd, const std::string& text) {
   const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && fsync(fd) == 0;
   return close(fd) == 0 && ok;
 }
@@ -259,8 +252,11 @@ TableLock::TableLock(const std::string& table, std::ostream& notes) : path_(tabl
   const std::time_t now = std::time(nullptr);
   std::strftime(since_now, sizeof since_now, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   const std::string text = "pid " + std::to_string(getpid()) + "\nhost " + host + "\nsince " + since_now + "\n";
-  const std::string tmp = lockTemporary(path_);
-  if (!writeWhole(tmp, text)) {
+  const fs::path l(path_);
+  int fd = -1;
+  const std::string tmp = createFreshFile(l.parent_path().string(), "." + l.filename().string() + ".tmp",
+                                          table + ": its lock " + path_ + ": ", &fd);
+  if (!writeWhole(fd, text)) {
     unlink(tmp.c_str());
     throw InputError(table + ": cannot write its lock " + path_ + " (disk full, or the folder is not writable?)");
   }
@@ -294,13 +290,16 @@ TableLock::TableLock(const std::string& table, std::ostream& notes) : path_(tabl
 TableLock::~TableLock() { unlink(path_.c_str()); }
 
 void removeStaleTemporaries(const std::string& table, const std::string& parts) {
-  // AtomicFile's temporaries: ".NAME.tmpPID"; only those of processes that are gone.
+  // AtomicFile's temporaries: ".NAME.tmpPID-XXXXXX" (createFreshFile; ".NAME.tmpPID" of earlier
+  // versions); only those of processes that are gone.
   const auto stale = [](const std::string& name, const std::string& prefix) {
     if (name.rfind(prefix, 0) != 0) return false;
-    const std::string digits = name.substr(prefix.size());
+    const std::string rest = name.substr(prefix.size());
     long pid = 0;
-    const auto [at, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
-    return !digits.empty() && ec == std::errc() && at == digits.data() + digits.size() && processGone(pid);
+    const auto [at, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), pid);
+    const std::size_t digits = static_cast<std::size_t>(at - rest.data());
+    const bool suffix = digits == rest.size() || (rest[digits] == '-' && rest.size() - digits == 7);
+    return digits > 0 && ec == std::errc() && suffix && processGone(pid);
   };
   std::error_code ec;
   const fs::path t(table);

@@ -33,6 +33,25 @@ class ComputeError : public std::runtime_error {
   int code_;
 };
 
+/// \brief `value` as a T (py::cast), or TypeError "NAME: expected TAKES, got TYPE" naming the argument
+/// (pybind11's own cast error is a RuntimeError "Unable to cast ..." that names neither).
+template <typename T>
+T argumentAs(py::handle value, const std::string& name, const char* takes) {
+  const auto wrong = [&] {
+    return py::type_error(name + ": expected " + takes + ", got " +
+                          std::string(py::str(py::type::handle_of(value).attr("__name__"))) + " " +
+                          std::string(py::repr(value)).substr(0, 60));
+  };
+  try {
+    return py::cast<T>(value);
+  } catch (const py::cast_error&) {
+    throw wrong();
+  } catch (py::error_already_set& e) {  // a conversion Python refused (dict(2.0): "not iterable")
+    if (!e.matches(PyExc_TypeError) && !e.matches(PyExc_ValueError)) throw;
+    throw wrong();
+  }
+}
+
 /// Throws ComputeError "<what>: <strError(code)>" unless code is 0.
 inline void check(int code, const std::string& what) {
   if (code != 0) throw ComputeError(code, what + ": " + strError(code));

@@ -32,8 +32,8 @@ Eigen::MatrixXd fromNumpy(py::handle given, const char* name, long rows, long co
   if (!obj.is_none()) a = Array::ensure(obj);
   if (obj.is_none() || !a) {  // a default array_t is an empty array, not a null one
     PyErr_Clear();
-    throw py::value_error(std::string(name) + ": expected an array of numbers of shape " + shapeText(expected) +
-                          ", got " + std::string(py::str(py::type::handle_of(obj).attr("__name__"))));
+    throw py::type_error(std::string(name) + ": expected an array of numbers of shape " + shapeText(expected) +
+                         ", got " + std::string(py::str(py::type::handle_of(obj).attr("__name__"))));
   }
   std::vector<long> shape(a.shape(), a.shape() + a.ndim());
   if (shape != expected)
@@ -126,8 +126,12 @@ void bindErrors(py::module_& m) {
       model_error(e.what());
     } catch (const InputError& e) {
       input_error(e.what());
+    } catch (const Cancelled& e) {  // a cancel poll said stop: what Ctrl-C raises
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     } catch (const Error& e) {
       error(e.what());
+    } catch (const py::cast_error& e) {  // a cast no argumentAs named: a TypeError all the same
+      PyErr_SetString(PyExc_TypeError, (std::string("an argument has the wrong type: ") + e.what()).c_str());
     }
   });
   py::module_ codes = m.def_submodule("codes", "The return codes of compute calls (ComputeError.code).");

@@ -19,7 +19,7 @@ std::vector<bool> lockedJoints(const FloatingModel& model, py::handle obj) {
   for (py::handle x : s) all_bool = all_bool && (py::isinstance<py::bool_>(x) || py::isinstance<py::int_>(x) ||
                                                  py::hasattr(x, "dtype"));
   if (all_bool && s.size() == model.nj() && s.size() > 0) {
-    for (std::size_t j = 0; j < s.size(); ++j) locked[j] = py::cast<bool>(s[j]);
+    for (std::size_t j = 0; j < s.size(); ++j) locked[j] = argumentAs<bool>(s[j], "locked[" + std::to_string(j) + "]", "a boolean");
     return locked;
   }
   for (py::handle x : s) locked[jointArgument(model, x, "locked")] = true;
@@ -28,12 +28,12 @@ std::vector<bool> lockedJoints(const FloatingModel& model, py::handle obj) {
 
 unsigned int jointArgument(const FloatingModel& model, py::handle obj, const char* name) {
   if (py::isinstance<py::str>(obj)) {
-    const std::string joint = py::cast<std::string>(obj);
+    const std::string joint = argumentAs<std::string>(obj, name, "a joint name or index");
     const int j = model.jointIndex(joint);
     if (j < 0) throw ModelError(std::string(name) + ": no joint named '" + joint + "' (Model.joint_names)");
     return static_cast<unsigned int>(j);
   }
-  const long j = py::cast<long>(obj);
+  const long j = argumentAs<long>(obj, name, "a joint name or index");
   if (j < 0 || j >= static_cast<long>(model.nj()))
     throw py::index_error(std::string(name) + ": joint index " + std::to_string(j) + " out of range (" +
                           std::to_string(model.nj()) + " joints)");
@@ -42,12 +42,12 @@ unsigned int jointArgument(const FloatingModel& model, py::handle obj, const cha
 
 unsigned int bodyArgument(const FloatingModel& model, py::handle obj, const char* name) {
   if (py::isinstance<py::str>(obj)) {
-    const std::string link = py::cast<std::string>(obj);
+    const std::string link = argumentAs<std::string>(obj, name, "a link name or index");
     const int b = model.bodyIndex(link);
     if (b < 0) throw ModelError(std::string(name) + ": no link named '" + link + "' (Model.link_names)");
     return static_cast<unsigned int>(b);
   }
-  const long b = py::cast<long>(obj);
+  const long b = argumentAs<long>(obj, name, "a link name or index");
   if (b < 0 || b >= static_cast<long>(model.bodies().size()))
     throw py::index_error(std::string(name) + ": body index " + std::to_string(b) + " out of range (" +
                           std::to_string(model.bodies().size()) + " bodies)");

@@ -5,13 +5,14 @@
 #include "conversions.hpp"
 #include "ik.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "simulation_types.hpp"
 
 namespace kdl_space::python {
 namespace {
 
 /// The CLI's JSON keys (ikSolutionJson), q as a NumPy array.
 py::dict solutionDict(const FloatingModel& model, const IkResult& r) {
-  py::dict d = py::module_::import("json").attr("loads")(cli::ikSolutionJson(model, r).dump());
+  py::dict d = py::module_::import("json").attr("loads")(cli::jsonText(cli::ikSolutionJson(model, r), -1));
   d["q"] = toNumpyVec(r.q.data);
   return d;
 }
@@ -27,6 +28,7 @@ py::dict solve(const std::shared_ptr<const FloatingModel>& model, const State& s
   o.orientation_tolerance = orientation_tolerance;
   o.restarts = restarts;
   o.max_iterations = max_iterations;
+  o.cancelled = SignalPoll();  // Ctrl-C: a KeyboardInterrupt within about 0.1 s
   if (prefer != "posture" && prefer != "reaction")
     throw py::value_error("prefer: '" + prefer + "' is neither 'posture' nor 'reaction'");
   o.prefer = prefer == "reaction" ? IkPreference::Reaction : IkPreference::Posture;
@@ -36,11 +38,11 @@ py::dict solve(const std::shared_ptr<const FloatingModel>& model, const State& s
     // A dict names only some joints: the others keep the seed's angle (not 0).
     KDL::JntArray p = seed.q;
     if (py::isinstance<py::dict>(preferred)) {
-      for (const auto& [key, value] : preferred.cast<py::dict>()) {
+      for (const auto& [key, value] : argumentAs<py::dict>(preferred, "preferred", "a dict of joint angles or an array")) {
         const std::string name = py::str(key);
         const int j = model->jointIndex(name);
         if (j < 0) throw py::value_error("preferred: the model has no movable joint '" + name + "'");
-        p(j) = value.cast<double>();
+        p(j) = argumentAs<double>(value, "preferred['" + name + "']", "a number");
       }
     } else {
       p = jointValues(*model, preferred, "preferred");

@@ -12,7 +12,8 @@ KDL::JntArray jointValues(const FloatingModel& model, py::handle obj, const char
   if (py::isinstance<py::dict>(obj)) {
     std::map<std::string, double> values;
     for (auto item : py::reinterpret_borrow<py::dict>(obj))
-      values[py::cast<std::string>(item.first)] = py::cast<double>(item.second);
+      values[argumentAs<std::string>(item.first, name, "joint names as keys")] =
+          argumentAs<double>(item.second, std::string(name) + "[" + std::string(py::repr(item.first)) + "]", "a number");
     return jointsByName(model, values);  // ModelError naming an unknown joint
   }
   KDL::JntArray a(model.nj());

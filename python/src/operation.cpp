@@ -61,12 +61,12 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
   const Scenario& sc = ps.scenario;
   OperationOptions o;
   if (!duration.is_none()) {
-    o.duration = py::cast<double>(duration);
+    o.duration = argumentAs<double>(duration, "duration", "a number of seconds");
     if (!(*o.duration > 0.0) || !std::isfinite(*o.duration))
       throw py::value_error("duration: expected a finite duration > 0 s, got " + std::to_string(*o.duration));
   }
   if (!output_step.is_none()) {
-    o.output_step = py::cast<double>(output_step);
+    o.output_step = argumentAs<double>(output_step, "output_step", "a number of seconds");
     if (!(*o.output_step > 0.0) || !std::isfinite(*o.output_step))
       throw py::value_error("output_step: expected a finite step > 0 s, got " + std::to_string(*o.output_step));
   }
@@ -81,7 +81,7 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
     throw py::type_error("observer: expected a callable observer(t, phase, q, qdot)");
   if (controller.is_none() && !control_rate.is_none()) throw py::value_error("control_rate: given without a controller");
   if (!control_rate.is_none()) {
-    o.control_rate = py::cast<double>(control_rate);
+    o.control_rate = argumentAs<double>(control_rate, "control_rate", "a rate in Hz");
     if (!(o.control_rate > 0.0) || !std::isfinite(o.control_rate))
       throw py::value_error("control_rate: expected a finite rate > 0 [Hz], got " + std::to_string(o.control_rate));
   }
@@ -116,7 +116,7 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
     if (partial) reportWarnings(partial->warnings);
     std::rethrow_exception(failed);
   }
-  const py::dict d = py::module_::import("json").attr("loads")(cli::operationJson(sc, r).dump());
+  const py::dict d = py::module_::import("json").attr("loads")(cli::jsonText(cli::operationJson(sc, r), -1));
   reportWarnings(r.warnings);  // the motion's warnings (also in d["warnings"]) as RuntimeWarnings
   d["samples"] = samplesDict(r);
   return operationResultOf(d, std::make_shared<const Scenario>(sc), std::move(r));  // a dict with to_html
@@ -130,9 +130,9 @@ CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damp
   if (!damping.is_none() && !damping_time.is_none())
     throw py::value_error("damping, damping_time: give one (D per axis, or D = damping_time * stiffness)");
   if (!damping.is_none()) g.damping = vec6(damping, "damping");
-  if (!damping_time.is_none()) g.damping_time = py::cast<double>(damping_time), g.damping.reset();
-  if (!catch_tolerance.is_none()) g.catch_tolerance = py::cast<double>(catch_tolerance);
-  if (!max_duration.is_none()) g.max_duration = py::cast<double>(max_duration);
+  if (!damping_time.is_none()) g.damping_time = argumentAs<double>(damping_time, "damping_time", "a number of seconds"), g.damping.reset();
+  if (!catch_tolerance.is_none()) g.catch_tolerance = argumentAs<double>(catch_tolerance, "catch_tolerance", "a number");
+  if (!max_duration.is_none()) g.max_duration = argumentAs<double>(max_duration, "max_duration", "a number of seconds");
   if (!normal.is_none()) {
     const Vector3d n = vec3(normal, "normal");
     if (!(n.norm() > 1e-12)) throw py::value_error("normal: has zero length");
@@ -158,7 +158,7 @@ py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object
       e.rethrowWithContext(sc.file + ": ");
     }
   }
-  return py::module_::import("json").attr("loads")(cli::compliantJson(c).dump());
+  return py::module_::import("json").attr("loads")(cli::jsonText(cli::compliantJson(c), -1));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "conversions.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 #include "plan.hpp"
+#include "simulation_types.hpp"
 
 namespace kdl_space::python {
 namespace {
@@ -16,11 +17,11 @@ struct PyPlan {
 };
 
 /// The tool's JSON of the terms (cli::termsJson) as a dict.
-py::dict termsDict(const PlanTerms& t) { return py::module_::import("json").attr("loads")(cli::termsJson(t).dump()); }
+py::dict termsDict(const PlanTerms& t) { return py::module_::import("json").attr("loads")(cli::jsonText(cli::termsJson(t), -1)); }
 
 std::optional<PlanRange> rangeOf(py::handle r, const char* name) {
   if (r.is_none()) return std::nullopt;
-  const auto ab = r.cast<std::pair<double, double>>();
+  const auto ab = argumentAs<std::pair<double, double>>(r, name, "a pair (lower, upper)");
   if (ab.first > ab.second) throw py::value_error(std::string(name) + ": the range's lower end must not exceed its upper end");
   return PlanRange{ab.first, ab.second};
 }
@@ -37,7 +38,8 @@ PyPlan plan(const Scenario& sc, const PlanArgs& a) {
   PlanOptions o;
   if (!weights.is_none()) {
     o.weights.clear();
-    for (const auto& [key, value] : weights.cast<py::dict>()) o.weights.emplace_back(py::str(key), value.cast<double>());
+    for (const auto& [key, value] : argumentAs<py::dict>(weights, "weights", "a dict {term: weight}"))
+      o.weights.emplace_back(py::str(key), argumentAs<double>(value, "weights[" + std::string(py::repr(key)) + "]", "a number"));
   } else {
     o.weights = {{a.objective, 1.0}};
   }
@@ -48,10 +50,13 @@ PyPlan plan(const Scenario& sc, const PlanArgs& a) {
   o.scan = a.scan;
   o.polish_starts = a.polish_starts;
   PyPlan result{{}, sc.file};
+  const SignalFlag interrupted;  // Ctrl-C: the search stops, then KeyboardInterrupt
+  o.cancelled = interrupted;
   {
     py::gil_scoped_release nogil;
     result.plan = planCapture(sc, o);  // InputError: the options, nothing to plan
   }
+  if (interrupted.raised()) throw py::error_already_set();
   return result;
 }
 

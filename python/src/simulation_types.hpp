@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <memory>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -32,6 +33,30 @@ class SignalPoll {
   }
 
  private:
+  unsigned calls_ = 0;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/// \brief SignalPoll for a search that stops on `true` and keeps its best so far (planCapture's
+/// PlanOptions::cancelled, whose optimiser would swallow an exception): a pending signal's error
+/// (KeyboardInterrupt) stays set, and the caller raises it once the call returns, holding the GIL
+/// (`if (poll.raised()) throw py::error_already_set();`). Copies share the flag.
+class SignalFlag {
+ public:
+  bool operator()() {
+    if (*raised_) return true;
+    if (++calls_ % 8 != 0) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(50)) return false;
+    last_ = now;
+    py::gil_scoped_acquire gil;
+    *raised_ = PyErr_CheckSignals() != 0;
+    return *raised_;
+  }
+  bool raised() const { return *raised_; }
+
+ private:
+  std::shared_ptr<bool> raised_ = std::make_shared<bool>(false);
   unsigned calls_ = 0;
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };

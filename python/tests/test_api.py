@@ -113,7 +113,7 @@ def test_wrong_shapes_name_the_argument(arm, computed):
     c, s_ = math.cos(0.3), math.sin(0.3)
     R = np.array([[c, -s_, 0, 1], [s_, c, 0, 2], [0, 0, 1, 3], [0, 0, 0, 1]])
     assert np.allclose(kdl_space.State(arm, base_pose=R).base_pose, R, atol=1e-15)
-    with pytest.raises(ValueError, match=r"qdot: expected an array of numbers of shape \(7,\)"):
+    with pytest.raises(TypeError, match=r"qdot: expected an array of numbers of shape \(7,\)"):
         kdl_space.State(arm, qdot="fast")
     with pytest.raises(ValueError, match=r"offset: expected shape \(3,\)"):
         arm.contact("end_effector", (0, 0))

@@ -70,6 +70,14 @@ def test_out_of_reach_raises_with_the_remaining_distance():
     assert set(e.value.q_by_name) >= {"joint1", "joint7"}
 
 
+@pytest.mark.parametrize("x", [1e200, 1e308])
+def test_a_goal_beyond_the_range_of_doubles_raises_input_error(x):
+    """Far enough that squared distances overflow: an InputError, not an abort of the interpreter."""
+    scenario = kdl_space.load_scenario(str(SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"))
+    with pytest.raises(kdl_space.InputError, match="out of reach"):
+        kdl_space.ik(scenario, ([x, 0.0, 0.0], [0.0, 0.0, 0.0]), restarts=1)
+
+
 def test_prefer_reaction_turns_the_base_no_more_than_the_posture():
     """prefer='reaction': the goal (by NumPy's forward kinematics) reached to 1e-9, with a reaction
     measure no larger than the posture solution's; a wrong preference, or a posture with it, is a
@@ -90,3 +98,24 @@ def test_prefer_reaction_turns_the_base_no_more_than_the_posture():
         kdl_space.ik(scenario, goal, prefer="least_effort")
     with pytest.raises(ValueError, match="preferred"):
         kdl_space.ik(scenario, goal, prefer="reaction", preferred=truth)
+
+
+def test_ctrl_c_ends_ik_within_a_second():
+    """Out of reach with 100,000 restarts (minutes): SIGINT raises KeyboardInterrupt between two
+    iterations, not when the search ends (issue 35, item 6)."""
+    import os
+    import signal
+    import threading
+    import time
+
+    scenario = kdl_space.load_scenario(str(SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"))
+    sent = []
+    timer = threading.Timer(1.0, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT)))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            kdl_space.ik(scenario, ([50.0, 0.0, 0.0], [0.0, 0.0, 0.0]), restarts=100000)
+    finally:
+        timer.cancel()
+        timer.join()
+    assert sent and time.monotonic() - sent[0] < 1.0

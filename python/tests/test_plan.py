@@ -66,3 +66,23 @@ def test_a_planned_closing_speed_is_the_commands_and_within_the_rate_limits(cli)
         assert abs(plan.qdot_before[plan.joint_names.index(name)]) <= velocity, name
     with pytest.raises(kdl_space.InputError, match="closing_speed: must be >= 0"):
         kdl_space.plan_capture(str(ARM6), closing_speed=(-1.0, 0.0))
+
+
+def test_ctrl_c_ends_plan_capture_within_a_second():
+    """A scan of 10^6 points (long): SIGINT stops the search and raises KeyboardInterrupt (issue 35,
+    item 6), not when the search ends."""
+    import os
+    import signal
+    import threading
+    import time
+
+    sent = []
+    timer = threading.Timer(1.0, lambda: (sent.append(time.monotonic()), os.kill(os.getpid(), signal.SIGINT)))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            kdl_space.plan_capture(str(CAPTURE_SCENARIO), scan=1000000)
+    finally:
+        timer.cancel()
+        timer.join()
+    assert sent and time.monotonic() - sent[0] < 1.0

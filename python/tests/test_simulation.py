@@ -317,7 +317,7 @@ def test_controller_errors_propagate(arm):
             sim.run(moving(arm), 0.2, 0.01, controller=bad, control_rate=rate)
         with pytest.raises(ValueError, match=r"controller: tau: expected shape \(7,\), got \(3,\)"):
             sim.run(moving(arm), 0.2, 0.01, controller=lambda *a: np.zeros(3), control_rate=rate)
-        with pytest.raises(ValueError, match="controller: tau: expected an array"):
+        with pytest.raises(TypeError, match="controller: tau: expected an array"):  # a wrong type
             sim.run(moving(arm), 0.2, 0.01, controller=lambda *a: None, control_rate=rate)
         with pytest.raises(ValueError, match="not finite"):
             sim.run(moving(arm), 0.2, 0.01, controller=lambda *a: np.full(arm.nj, np.nan), control_rate=rate)

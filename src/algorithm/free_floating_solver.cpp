@@ -5,8 +5,13 @@
 #include "algorithm/set_up.hpp"
 
 namespace kdl_space {
+// The factorisations are sized here, constructed in place (assigning Eigen::LLT(n) would copy
+// its uninitialised info member: undefined behaviour, reported by UBSan; factorising the identity
+// to size them cost n^3 / 3 flops, seconds at thousands of joints).
 FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
-    : model_(std::move(model)) {
+    : model_(std::move(model)),
+      H_star_llt_(model_ ? static_cast<Eigen::Index>(model_->nj()) : 0),
+      H_llt_(model_ ? static_cast<Eigen::Index>(model_->nj()) : 0) {
   if (!model_) throw ModelError("FreeFloatingSolver: null model");
   const std::size_t nb = model_->bodies().size();
   const unsigned int n = model_->nj();
@@ -23,10 +28,6 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   dqdot_work_.setZero(n);
   H_.resize(n);
   H_star_.resize(n);
-  // Sized by factorising the identity: assigning Eigen::LLT(n) would copy its uninitialised
-  // info member (undefined behaviour, reported by UBSan in tools/sanitize.sh).
-  H_llt_.compute(Eigen::MatrixXd::Identity(n, n));
-  H_star_llt_.compute(Eigen::MatrixXd::Identity(n, n));
   reserveContacts(2);  // dual-arm without allocation
   locked_.assign(n, false);
   H_locked_work_.setZero(n, n);

@@ -89,6 +89,7 @@ class IkSearch {
     KDL::JntArray dq(q.rows()), best = q;
     double best_distance = std::numeric_limits<double>::infinity();
     for (unsigned int i = 0; i < o_.max_iterations; ++i) {
+      stopIfCancelled(iterations);
       KDL::Frame f;
       fk_.JntToCart(c_.chainAngles(q), f);
       const KDL::Twist e = poseError(f, goal_);
@@ -105,6 +106,12 @@ class IkSearch {
     }
     q = best;
     return false;
+  }
+
+  /// Throws Cancelled when the caller's poll says so (IkOptions::cancelled).
+  void stopIfCancelled(unsigned int iterations) const {
+    if (o_.cancelled && o_.cancelled())
+      throw Cancelled("inverse kinematics: cancelled after " + std::to_string(iterations) + " iterations");
   }
 
   /// Distance + angle (1 m per rad) from the contact frame at `q` to the goal.
@@ -350,6 +357,7 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
   double best_score = std::numeric_limits<double>::infinity();
   unsigned int iterations = 0;
   for (unsigned int a = 0; a <= options.restarts; ++a) {
+    search.stopIfCancelled(iterations);
     KDL::JntArray qc = a == 0 ? q0 : start(c, q0, a);
     const bool ok = search.attempt(qc, iterations);
     if (ok && search.minimisesMeasure())

@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "kdl_space/simulation/integrator.hpp"
 #include "operation/phases.hpp"
 
 namespace kdl_space {
@@ -21,6 +22,24 @@ void checkStepBudget(const Scenario& sc, double duration, double output_step) {
         << spec.options.max_steps;
     throw InputError(why.str());
   }
+}
+
+/// An approach whose servo is too stiff for an explicit integrator is refused before it starts
+/// (it would spend the step budget first: 51 s for servo_bandwidth 1e9): the closed-loop rate of a
+/// joint's velocity servo is the bandwidth, and an explicit Runge-Kutta step must stay below about
+/// 3 / rate (its stability interval on the negative real axis: 2.8 for RK4, 3.3 for DOPRI5).
+void checkApproachStiffness(const Scenario& sc) {
+  const SimulationSpec& spec = sc.simulation;
+  if (!sc.approach || spec.options.integrator == Integrator::Rosenbrock) return;
+  const double steps = sc.approach->max_duration * sc.approach->servo_bandwidth / 3.0;
+  if (!(steps > static_cast<double>(spec.options.max_steps))) return;
+  std::ostringstream why;
+  why << std::setprecision(6) << sc.file << ": approach.servo_bandwidth: " << sc.approach->servo_bandwidth
+      << " 1/s needs explicit steps below about " << 3.0 / sc.approach->servo_bandwidth << " s, so "
+      << steps << " steps for approach.max_duration = " << sc.approach->max_duration
+      << " s, more than simulation.max_steps = " << spec.options.max_steps
+      << ": lower the bandwidth (a joint servo's is 10 to 100 1/s), or use simulation.integrator: rosenbrock";
+  throw InputError(why.str());
 }
 
 /// Why a simulation stopped, in the scenario's terms: what grew, when, and what to try. `s` is
@@ -254,6 +273,7 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
   r.duration = o.duration.value_or(sc.simulation.duration);
   r.output_step = o.output_step.value_or(sc.simulation.output_step);
   if (o.motion) checkStepBudget(sc, r.duration, r.output_step);
+  if (o.approach) checkApproachStiffness(sc);
   r.at_contact = sc.capture;
   SimulationState s;
   if (sc.approach && o.approach) {

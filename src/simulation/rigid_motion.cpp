@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace kdl_space {
@@ -26,7 +27,30 @@ FreeRigidMotion::FreeRigidMotion(const RigidTarget& at_zero, double grid_step)
   L_ = R * at_zero.inertia * R.transpose() * at_zero.twist.tail<3>();
   Eigen::Vector4d q;
   at_zero.pose.M.GetQuaternion(q(0), q(1), q(2), q(3));
-  grid_.push_back(q);
+  checkpoints_.push_back(q);
+  last_q_ = q;
+}
+
+Eigen::Vector4d FreeRigidMotion::gridPoint(std::size_t k) {
+  // From the last point reached when it is on the way, else from the checkpoint below k.
+  const std::size_t below = std::min(k / stride_, checkpoints_.size() - 1);
+  if (last_k_ > k || below * stride_ > last_k_) {
+    last_k_ = below * stride_;
+    last_q_ = checkpoints_[below];
+  }
+  while (last_k_ < k) {
+    last_q_ = step(last_q_, grid_step_);
+    ++last_k_;
+    if (last_k_ % stride_ == 0 && last_k_ / stride_ == checkpoints_.size()) {
+      checkpoints_.push_back(last_q_);
+      if (checkpoints_.size() > kMaxCheckpoints) {  // every other one kept: the stride doubles
+        for (std::size_t j = 0; 2 * j < checkpoints_.size(); ++j) checkpoints_[j] = checkpoints_[2 * j];
+        checkpoints_.resize((checkpoints_.size() + 1) / 2);
+        stride_ *= 2;
+      }
+    }
+  }
+  return last_q_;
 }
 
 Eigen::Vector4d FreeRigidMotion::step(const Eigen::Vector4d& q, double h) const {
@@ -44,9 +68,10 @@ Eigen::Vector4d FreeRigidMotion::step(const Eigen::Vector4d& q, double h) const 
 int FreeRigidMotion::at(double t, RigidTarget& target) {
   if (!std::isfinite(t)) return E_NOT_FINITE;
   if (t < 0.0) return E_BAD_ARGUMENT;
-  const auto k = static_cast<std::size_t>(std::floor(t / grid_step_));
-  while (grid_.size() <= k) grid_.push_back(step(grid_.back(), grid_step_));
-  const Eigen::Vector4d q = step(grid_[k], t - static_cast<double>(k) * grid_step_);
+  const double grid_index = std::floor(t / grid_step_);
+  if (!(grid_index < 9.0e15)) return E_BAD_ARGUMENT;  // beyond the grid's exact integers
+  const auto k = static_cast<std::size_t>(grid_index);
+  const Eigen::Vector4d q = step(gridPoint(k), t - static_cast<double>(k) * grid_step_);
   const Matrix3d R = rotationOf(q);
   const Vector3d w = R * (I_inv_ * (R.transpose() * L_));
   const Vector3d c = toEigen(start_.pose * toKDL(start_.com)) + t * start_.twist.head<3>();  // CoM, world

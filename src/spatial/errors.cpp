@@ -23,11 +23,13 @@ const char* strError(int code) {
 Error::~Error() = default;
 ModelError::~ModelError() = default;
 InputError::~InputError() = default;
+Cancelled::~Cancelled() = default;
 
 void Error::rethrowWithContext(const std::string& context) const { std::rethrow_exception(renamed(context + what())); }
 
 std::exception_ptr Error::renamed(const std::string& what) const { return std::make_exception_ptr(Error(what)); }
 std::exception_ptr ModelError::renamed(const std::string& what) const { return std::make_exception_ptr(ModelError(what)); }
 std::exception_ptr InputError::renamed(const std::string& what) const { return std::make_exception_ptr(InputError(what)); }
+std::exception_ptr Cancelled::renamed(const std::string& what) const { return std::make_exception_ptr(Cancelled(what)); }
 
 }  // namespace kdl_space

@@ -87,6 +87,16 @@ TEST(IkTool, OutOfReachExits3WithTheRemainingDistance) {
   EXPECT_NE(run.err.find(" m and "), std::string::npos) << run.err;
 }
 
+TEST(IkTool, AGoalBeyondTheRangeOfDoublesExits3NotAnAbort) {
+  // From ~1e150 m the squared distance overflows: no attempt was recorded, and the message read an
+  // empty vector (SIGABRT in Eigen's bounds check). Refused as out of reach, the tool and the place.
+  for (const char* position : {"1e200,0,0", "-1e308,1e308,0", "0,0,1e160"}) {
+    const ToolRun run = kdlSpace("ik " + kScenario + " --position " + position + " --restarts 1");
+    EXPECT_EQ(run.rc, 3) << position << ": " << run.err;
+    EXPECT_NE(run.err.find("out of reach"), std::string::npos) << run.err;
+  }
+}
+
 TEST(IkTool, UsageMistakesExit2) {
   EXPECT_EQ(kdlSpace("ik " + kScenario).rc, 2);                            // no --position
   EXPECT_EQ(kdlSpace("ik " + kScenario + " --position 1,2").rc, 2);       // two numbers
@@ -129,10 +139,12 @@ TEST(GraspPlacement, TheContactFrameHoldsTheTargetsGraspFrame) {
 }
 
 TEST(GraspPlacement, AGraspOutOfReachNamesTheFieldAndTheDistance) {
-  const ToolRun run = kdlSpace("capture " + graspScenario("grasp_far.yaml", "[40, 0, 0]"));
-  EXPECT_EQ(run.rc, 3);
-  EXPECT_NE(run.err.find("grasp_far.yaml:7: robot.place: the grasp frame: inverse kinematics: the pose is out of reach"),
-            std::string::npos) << run.err;
+  for (const char* where : {"[40, 0, 0]", "[1.0e200, 0, 0]"}) {
+    const ToolRun run = kdlSpace("capture " + graspScenario("grasp_far.yaml", where));
+    EXPECT_EQ(run.rc, 3) << where << ": " << run.err;
+    EXPECT_NE(run.err.find("grasp_far.yaml:7: robot.place: the grasp frame: inverse kinematics: the pose is out of reach"),
+              std::string::npos) << run.err;
+  }
 }
 
 }  // namespace

@@ -90,24 +90,48 @@ TEST_F(SimulateBounded, RunWithMoreRowsThanTheLimitIsRefusedBeforeItStarts) {
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - start).count(), 5.0);
 }
 
-TEST_F(SimulateBounded, FullDiskStopsTheRunAtOnceAndLeavesNothing) {
-  // 1000 s at 1 ms would take minutes; the temporary file is /dev/full (a link made under the
-  // name the tool gives it: .NAME.tmpPID, the shell's PID being the tool's after exec).
+TEST_F(SimulateBounded, AFailedWriteStopsTheRunAtOnceAndLeavesNothing) {
+  // 1000 s at 1 ms would take minutes; the files may grow to 32 KiB only (`ulimit -f 64`, 512-byte
+  // blocks, SIGXFSZ ignored: a write past it fails with EFBIG, as a full disk's with ENOSPC).
   const std::string s = scenario("  duration: 1000\n  output_step: 1.0e-3\n  integrator: rk4\n  step: 1.0e-3\n");
-  for (const auto& [option, temporary] : {std::pair<std::string, std::string>{"--csv", ".run.csv.tmp"},
-                                         {"--plot", ".run.svg.tmp"}}) {
+  for (const std::string option : {"--csv", "--plot"}) {
     const std::string out = path(option == "--csv" ? "run.csv" : "run.svg");
-    const std::string suffix = option == "--csv" ? "" : ".dat";  // the plot's data file
     const auto start = Clock::now();
-    const ToolRun r = shell("/bin/sh -c 'ln -s /dev/full " + path(temporary) + "$$" + suffix + " && exec " + KDL_SPACE_CLI +
-                            " simulate " + s + " " + option + " " + out + "'");
+    const ToolRun r = shell("/bin/sh -c 'trap \"\" XFSZ; ulimit -f 64 && exec " + std::string(KDL_SPACE_CLI) + " simulate " +
+                            s + " " + option + " " + out + "'");
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     EXPECT_EQ(r.rc, 3) << r.err;
     EXPECT_NE(r.err.find(option + " " + out + ": cannot write"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(" rows (disk full?): No space left on device"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" rows (disk full?): File too large"), std::string::npos) << r.err;
     EXPECT_LT(elapsed, 3.0) << "the run stops at the first failed write";
-    EXPECT_EQ(leftovers(), Strings{}) << option << ": the temporary (the link) is removed, no output named";
+    EXPECT_EQ(leftovers(), Strings{}) << option << ": the temporary is removed, no output named";
   }
+}
+
+TEST_F(SimulateBounded, ALinkPlantedAtTheTemporarysNameIsNeverFollowed) {
+  // Earlier versions wrote `.NAME.tmpPID` with create+truncate: a link planted there (the shell's
+  // PID is the tool's after exec) had its target overwritten. Links at that name and at every
+  // name a run could have used before this one are left alone, their target untouched.
+  const std::string victim = path("precious.txt");
+  std::ofstream(victim) << "the user's own file\n";
+  const std::string s = scenario("  duration: 1\n  output_step: 0.1\n");
+  for (const std::string option : {"--csv", "--plot", "--html"}) {
+    const std::string name = option == "--csv" ? "run.csv" : option == "--plot" ? "run.svg" : "run.html";
+    const std::string out = path(name), link = path("." + name + ".tmp");
+    const ToolRun r = shell("/bin/sh -c 'ln -s " + victim + " " + link + "$$ && ln -s " + victim + " " + link + "$$.dat && exec " +
+                            KDL_SPACE_CLI + " simulate " + s + " " + option + " " + out + "'");
+    EXPECT_EQ(r.rc, 0) << r.err;
+    std::ifstream v(victim);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(v)), std::istreambuf_iterator<char>()), "the user's own file\n")
+        << option;
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out))) << option << ": written, as a file of its own";
+    EXPECT_GT(fs::file_size(out), 100u) << option;
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (fs::is_symlink(entry.symlink_status())) fs::remove(entry.path());
+    fs::remove(out);
+  }
+  fs::remove(victim);
+  EXPECT_EQ(leftovers(), Strings{});
 }
 
 /// Starts `command` (through sh, which `exec`s the tool: the PID is the tool's), stderr to `err`.
@@ -130,9 +154,15 @@ TEST_F(SimulateBounded, CtrlCStopsTheRunWithinHalfASecondAndLeavesNothing) {
   ASSERT_GT(pid, 0);
   // Signalled once the run is under way (its CSV's temporary exists: the first sample is written),
   // not after a fixed time: a loaded machine or a sanitizer build may still be loading at 1 s.
-  const std::string temporary = path(".run.csv.tmp" + std::to_string(pid));
-  for (int k = 0; k < 600 && !fs::exists(temporary); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  ASSERT_TRUE(fs::exists(temporary)) << "the run did not start within 60 s";
+  // (createFreshFile's .run.csv.tmpPID-XXXXXX: it exists once the writer is made, after the set-up).
+  const std::string temporary = ".run.csv.tmp" + std::to_string(pid) + "-";
+  const auto started = [&] {
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.path().filename().string().rfind(temporary, 0) == 0 && entry.file_size() > 0) return true;
+    return false;
+  };
+  for (int k = 0; k < 600 && !started(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(started()) << "the run did not start within 60 s";
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, WNOHANG), 0) << "the run is still going";

@@ -2,11 +2,15 @@
 // file without errors loads, a file the loader refuses has errors, with the loader's words).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <random>
 #include <regex>
+#include <sstream>
 
+#include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
@@ -305,3 +309,54 @@ TEST(UrdfCheckMassRatio, SaysWhenTheLightLinkHangsOnAFixedJoint) {
 
 }  // namespace
 }  // namespace kdl_space
+
+namespace kdl_space::test {
+namespace {
+
+/// A tree of `links` links: 10 arms of revolute joints (alternating axes) from a heavy base.
+std::string treeOf(int links) {
+  std::ostringstream x;
+  x << "<robot name=\"tree\">\n";
+  const auto link = [&](const std::string& name, double mass) {
+    x << "<link name=\"" << name << "\"><inertial><mass value=\"" << mass
+      << "\"/><inertia ixx=\"0.01\" iyy=\"0.02\" izz=\"0.015\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n";
+  };
+  link("base", 100.0);
+  const int arm = (links - 1) / 10;
+  for (int i = 1; i < links; ++i) {
+    link("l" + std::to_string(i), 1.0 + 0.001 * i);
+    const bool first = (i - 1) % arm == 0;
+    x << "<joint name=\"j" << i << "\" type=\"revolute\"><parent link=\"" << (first ? "base" : "l" + std::to_string(i - 1))
+      << "\"/><child link=\"l" << i << "\"/><origin xyz=\"0.1 0.02 0\" rpy=\"0 0 " << (first ? 0.6 * (i / arm) : 0.1)
+      << "\"/><axis xyz=\"" << (i % 3 == 0) << " " << (i % 3 == 1) << " " << (i % 3 == 2)
+      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>\n";
+  }
+  x << "</robot>\n";
+  return x.str();
+}
+
+TEST(UrdfCheck, ALargeModelIsMeasuredByTheLinearRouteWithTheSameGStar) {
+  // 501 links (500 joints), above kDenseCheckJoints: cond(H*) not computed (a note says why),
+  // cond(G*) at the leaves by the O(n) recursion, equal to the dense route's (computed here).
+  const std::string xml = treeOf(501);
+  const UrdfReport r = checkUrdfString(xml, "tree.urdf");
+  ASSERT_TRUE(r.errors.empty()) << ::testing::PrintToString(summary(r.errors));
+  EXPECT_TRUE(std::isnan(r.model.condition_H_star));
+  bool noted = false;
+  for (const Finding& f : r.notes) noted |= f.kind == "large_model" && f.message.find("500 joints") == 0;
+  EXPECT_TRUE(noted) << ::testing::PrintToString(summary(r.notes));
+  const auto model = std::make_shared<const FloatingModel>(loadUrdfString(xml, "tree.urdf"));
+  FreeFloatingSolver dense(model);
+  ASSERT_EQ(dense.compute(State(*model)), E_NOERROR);
+  ASSERT_EQ(r.model.condition_G_star.size(), 10u);  // the arms' tips
+  for (const auto& [link, condition] : r.model.condition_G_star) {
+    Matrix6d G;
+    ASSERT_EQ(dense.G_star(model->contact(link), G), E_NOERROR);
+    EXPECT_NEAR(condition, spectralFigures(G).condition, 1e-7 * spectralFigures(G).condition) << link;
+  }
+  // Below the bound the dense route still measures cond(H*).
+  EXPECT_TRUE(std::isfinite(checkUrdfString(treeOf(101), "small.urdf").model.condition_H_star));
+}
+
+}  // namespace
+}  // namespace kdl_space::test

@@ -109,8 +109,9 @@ TEST(UrdfVisuals, RelativeAbsoluteAndFileMeshesAreFoundFromTheUrdfFolder) {
   const std::string urdf_dir = (d / "robot").string(), file = (d / "robot/meshes/a.stl").string();
   EXPECT_EQ(resolveMeshFile("meshes/a.stl", urdf_dir, {}).path, file);
   EXPECT_EQ(resolveMeshFile("./meshes/../meshes/a.stl", urdf_dir, {}).path, file);
-  EXPECT_EQ(resolveMeshFile(file, "/nowhere", {}).path, file);
-  EXPECT_EQ(resolveMeshFile("file://" + file, "/nowhere", {}).path, file);
+  EXPECT_EQ(resolveMeshFile(file, urdf_dir, {}).path, file);
+  EXPECT_EQ(resolveMeshFile("file://" + file, urdf_dir, {}).path, file);
+  EXPECT_EQ(resolveMeshFile(file, "/nowhere", {(d / "robot").string()}).path, file);  // in the search path
   const MeshLocation missing = resolveMeshFile("meshes/b.stl", urdf_dir, {});
   EXPECT_EQ(missing.path, "");
   EXPECT_NE(missing.problem.find((d / "robot/meshes/b.stl").string()), std::string::npos) << missing.problem;
@@ -140,6 +141,84 @@ TEST(UrdfVisuals, ReadingAUrdfResolvesItsMeshesAndKeepsTheirScale) {
   EXPECT_EQ(alone.at("arm")[1].mesh_path, "");
   EXPECT_NE(alone.at("arm")[1].mesh_problem.find("'r'"), std::string::npos) << alone.at("arm")[1].mesh_problem;
   EXPECT_EQ(alone.at("arm")[2].mesh_path, (d / "robot/meshes/arm.stl").string());
+}
+
+// --- A page is shared: nothing outside the folders the user named (issue 35, item 2) ---------------
+
+TEST(MeshFiles, LinksAndPathsOutOfTheNamedFoldersAreRefused) {
+  const fs::path d = treeWith("escape", {"robot/meshes/a.stl", "share/pkg/meshes/b.stl", "elsewhere/secret.stl"});
+  const std::string urdf_dir = (d / "robot").string(), share = (d / "share").string();
+  fs::create_symlink("/etc/passwd", d / "robot/meshes/passwd.stl");
+  fs::create_symlink("/proc/self/environ", d / "share/pkg/meshes/environ.stl");
+  fs::create_symlink(d / "elsewhere/secret.stl", d / "share/pkg/meshes/secret.stl");
+  fs::create_symlink(d / "elsewhere", d / "share/pkg/linked");  // a folder link on the way
+  fs::create_symlink(d / "share/pkg/meshes/b.stl", d / "robot/meshes/inside.stl");  // stays inside: read
+  const std::vector<std::string> path{share};
+  struct Case {
+    std::string filename, needle;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"meshes/passwd.stl", "resolves to /etc/passwd"},
+           {"package://pkg/meshes/environ.stl", "resolves to /proc/"},
+           {"package://pkg/meshes/secret.stl", "elsewhere/secret.stl, which is outside"},
+           {"package://pkg/linked/secret.stl", "is outside"},
+           {"package://pkg/../../elsewhere/secret.stl", "leaves its package"},
+           {"package://../elsewhere/secret.stl", "leaves its package"},
+           {"package://pkg//" + (d / "elsewhere/secret.stl").string(), "leaves its package"},
+           {"package://./elsewhere/secret.stl", "leaves its package"},
+           {"../elsewhere/secret.stl", "is outside the robot file's folder"},
+           {(d / "elsewhere/secret.stl").string(), "is outside"},
+           {"file://" + (d / "elsewhere/secret.stl").string(), "is outside"},
+           {"file:///etc/passwd", "is outside"},
+       }) {
+    const MeshLocation m = resolveMeshFile(c.filename, urdf_dir, path);
+    EXPECT_EQ(m.path, "") << c.filename;
+    EXPECT_NE(m.problem.find(c.needle), std::string::npos) << c.filename << ": " << m.problem;
+  }
+  // What is outside says what to do; a link that stays inside the named folders is read.
+  EXPECT_NE(resolveMeshFile("meshes/passwd.stl", urdf_dir, path).problem.find("give --mesh-path"), std::string::npos);
+  EXPECT_EQ(resolveMeshFile("meshes/inside.stl", urdf_dir, path).path, fs::canonical(d / "share/pkg/meshes/b.stl").string());
+  // Naming the folder a link points into allows it (a colcon --symlink-install's src folder).
+  EXPECT_EQ(resolveMeshFile("package://pkg/meshes/secret.stl", urdf_dir, {share, (d / "elsewhere").string()}).path,
+            fs::canonical(d / "elsewhere/secret.stl").string());
+}
+
+TEST(MeshFiles, AFileOverTheCapIsRefusedBeforeItIsRead) {
+  const fs::path d = treeWith("cap", {"robot/meshes/small.stl"});
+  const fs::path big = d / "robot/meshes/big.stl";
+  std::ofstream(big).close();
+  fs::resize_file(big, max_mesh_file_bytes + 1);  // sparse: no disk used
+  const MeshLocation m = resolveMeshFile("meshes/big.stl", (d / "robot").string(), {});
+  EXPECT_EQ(m.path, "");
+  EXPECT_NE(m.problem.find("67108865 bytes"), std::string::npos) << m.problem;
+  EXPECT_NE(m.problem.find("more than the 64 MiB a mesh file may have"), std::string::npos) << m.problem;
+  // readMeshFile checks it again on the open file (the file may grow after it was resolved).
+  const MeshBytes read = readMeshFile(big.string(), false);
+  EXPECT_EQ(read.bytes, "");
+  EXPECT_NE(read.problem.find("more than the 64 MiB"), std::string::npos) << read.problem;
+  fs::resize_file(big, max_mesh_file_bytes);
+  EXPECT_EQ(resolveMeshFile("meshes/big.stl", (d / "robot").string(), {}).path, fs::canonical(big).string());
+  fs::remove(big);
+}
+
+TEST(MeshFiles, ReadingRefusesLinksAndDevicesAndDropsACollada_sImages) {
+  const fs::path d = treeWith("read_bytes", {"m/a.stl"});
+  fs::create_symlink(d / "m/a.stl", d / "m/link.stl");
+  EXPECT_NE(readMeshFile((d / "m/link.stl").string(), false).problem.find("cannot be opened"), std::string::npos)
+      << "a link at the name is not followed (the path given is resolved already)";
+  EXPECT_NE(readMeshFile("/dev/zero", false).problem.find("not a regular file"), std::string::npos);
+  std::ofstream(d / "m/empty.stl").close();
+  EXPECT_NE(readMeshFile((d / "m/empty.stl").string(), false).problem.find("empty"), std::string::npos);
+  EXPECT_EQ(readMeshFile((d / "m/a.stl").string(), false).bytes, "solid x\nendsolid x\n");
+  const std::string geometry = "<library_geometries><geometry id=\"g\"/></library_geometries>";
+  std::ofstream(d / "m/t.dae") << "<COLLADA><library_images><image id=\"i\"><init_from>http://127.0.0.1:9/beacon.png"
+                               << "</init_from></image></library_images>" << geometry
+                               << "<library_images_kept/><library_images/><library_images id=\"x\">file:///etc/passwd</library_images></COLLADA>";
+  const MeshBytes dae = readMeshFile((d / "m/t.dae").string(), true);
+  EXPECT_EQ(dae.problem, "");
+  EXPECT_EQ(dae.bytes, "<COLLADA>" + geometry + "<library_images_kept/></COLLADA>");
+  EXPECT_NE(dae.dropped.find("3 <library_images>"), std::string::npos) << dae.dropped;
+  EXPECT_EQ(readMeshFile((d / "m/t.dae").string(), false).dropped, "") << "an STL is not XML: kept as it is";
 }
 
 }  // namespace

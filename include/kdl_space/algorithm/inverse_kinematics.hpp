@@ -5,6 +5,7 @@
 #pragma once
 
 #include <limits>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,10 @@ struct IkOptions {
   std::optional<KDL::JntArray> preferred;
   /// Which self-motion solution a redundant arm returns (`preferred` is unused for Reaction).
   IkPreference prefer = IkPreference::Posture;
+  /// \brief The caller's way to stop the search (Ctrl-C): called before every Newton-Raphson
+  /// iteration and every attempt; true throws Cancelled. It may also throw its own exception
+  /// (Python's KeyboardInterrupt), which propagates. Empty: never cancelled.
+  std::function<bool()> cancelled;
 };
 
 /// A solution.

@@ -32,12 +32,12 @@ struct Finding {
   /// `duplicate_name`, `unknown_joint_type`, `no_root`, `several_roots`, `loop`,
   /// `missing_link`, `free_joint_inside`, `non_positive_mass`, `inertia_not_positive_definite`,
   /// `not_finite`, `bad_number`, `zero_axis`, `unknown_tip`, `base_without_mass`, `too_deep`,
-  /// `singular_inertia`, `unreadable`, `refused_by_loader`, `xacro` (errors);
+  /// `singular_inertia`, `unreadable`, `refused_by_loader`, `xacro`, `encoding` (errors);
   /// `inertia_without_mass`, `link_inertia_not_positive_definite`,
   /// `point_mass`, `inertia_round_off`, `triangle_inequality`, `joint_moves_no_mass`,
   /// `revolute_without_limit`, `singular_composite`, `mimic_ignored`, `axis_not_unit`,
   /// `limits_exclude_zero`, `mass_ratio` (warnings); `root_inertia_dropped_by_kdl_parser`,
-  /// `massless_link`, `massless_base` (notes).
+  /// `massless_link`, `massless_base`, `encoding` (an ISO-8859-1 file read), `large_model` (notes).
   std::string kind;
   ElementType element_type = ElementType::File;
   std::string element;  ///< link, joint or tip name; the robot's name; "" for the file

@@ -13,12 +13,16 @@ namespace kdl_space {
 /// angular momentum is constant in the world and its angular velocity follows Euler's equations,
 /// w(t) = R(t) I^-1 R(t)^T L (I: the inertia about the CoM in the body's frame), dR/dt = [w] R.
 ///
-/// The attitude is integrated once on a fixed grid (classical Runge-Kutta on the quaternion, steps
-/// of `grid_step`, renormalised), extended as later times are asked for; a time between two grid
-/// points is one Runge-Kutta step from the point before it. So at(t) is a function of t alone
-/// (the same answer whatever was asked before), smooth between grid points and continuous across
-/// them to round-off. Error per unit time ~ (|w| grid_step)^4 |w| (1e-16 rad/s for |w| = 1 rad/s
-/// and 1 ms).
+/// The attitude is integrated on a fixed grid (classical Runge-Kutta on the quaternion, steps of
+/// `grid_step`, renormalised) from t = 0; a time between two grid points is one Runge-Kutta step
+/// from the point before it. So at(t) is a function of t alone (the same answer, to the bit,
+/// whatever was asked before), smooth between grid points and continuous across them to
+/// round-off. Error per unit time ~ (|w| grid_step)^4 |w| (1e-16 rad/s for |w| = 1 rad/s and 1 ms).
+///
+/// Memory is bounded whatever the time asked for (issue 35, item 4): the grid is not kept, only
+/// at most kMaxCheckpoints of its points (every `stride` steps, the stride doubled when they would
+/// be more) and the last point reached. Times asked in increasing order cost one step per grid
+/// step passed; a time before the last one reached starts again from the checkpoint below it.
 class KDL_SPACE_EXPORT FreeRigidMotion {
  public:
   /// The target at t = 0. \throws ModelError unless its mass > 0, its inertia symmetric positive
@@ -33,11 +37,21 @@ class KDL_SPACE_EXPORT FreeRigidMotion {
   /// The quaternion (x, y, z, w) of the target's frame after one step of length h from q.
   Eigen::Vector4d step(const Eigen::Vector4d& q, double h) const;
 
+  /// The attitude at grid point k (k grid_step), from the nearest checkpoint or the last point.
+  Eigen::Vector4d gridPoint(std::size_t k);
+
+ public:
+  static constexpr std::size_t kMaxCheckpoints = 4096;  ///< 128 KiB of attitudes at most
+
+ private:
   RigidTarget start_;
   Matrix3d I_inv_;  ///< inverse inertia about the CoM, target-frame axes
   Vector3d L_;      ///< angular momentum about the CoM, world (constant)
   double grid_step_;
-  std::vector<Eigen::Vector4d> grid_;  ///< attitude at k grid_step
+  std::size_t stride_ = 1024;               ///< grid steps between checkpoints (a power of two)
+  std::vector<Eigen::Vector4d> checkpoints_;  ///< attitude at grid point j stride_
+  std::size_t last_k_ = 0;                   ///< the last grid point reached
+  Eigen::Vector4d last_q_;                   ///< its attitude
 };
 
 }  // namespace kdl_space

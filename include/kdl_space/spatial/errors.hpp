@@ -94,4 +94,15 @@ class KDL_SPACE_EXPORT InputError : public Error {
   std::exception_ptr renamed(const std::string& what) const override;
 };
 
+/// Thrown by a set-up call whose caller's cancel poll asked it to stop (IkOptions::cancelled: a
+/// Ctrl-C): nothing it would have returned was computed. The message says where it stopped.
+class KDL_SPACE_EXPORT Cancelled : public Error {
+ public:
+  using Error::Error;
+  ~Cancelled() override;
+
+ protected:
+  std::exception_ptr renamed(const std::string& what) const override;
+};
+
 }  // namespace kdl_space

@@ -1,6 +1,10 @@
 #include "parsers/scenario/scenario_fields.hpp"
 
+#include <yaml-cpp/depthguard.h>
+
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <cmath>
 #include <unordered_set>
 
@@ -18,6 +22,28 @@ bool yamlNotFinite(const std::string& text) {
   return t == ".nan" || t == ".NaN" || t == ".NAN";
 }
 
+/// "a key of N characters at line L: YAML reads keys of at most 1024 (...)" when the file has
+/// a quoted key (JSON's are) longer than YAML's limit on an implicit key, else "".
+std::string longKey(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') ++line;
+    if (text[i] != '"') continue;
+    std::size_t end = i + 1;
+    while (end < text.size() && text[end] != '"' && text[end] != '\n') end += text[end] == '\\' ? 2 : 1;
+    if (end >= text.size() || text[end] != '"') continue;
+    std::size_t colon = end + 1;
+    while (colon < text.size() && (text[colon] == ' ' || text[colon] == '\t')) ++colon;
+    if (colon < text.size() && text[colon] == ':' && end - i - 1 > 1024)
+      return "a key of " + std::to_string(end - i - 1) + " characters at line " + std::to_string(line) +
+             ": YAML reads keys of at most 1024 (the scenario's keys are short names: is it the right file?)";
+    i = end;
+  }
+  return "";
+}
+
 }  // namespace
 
 YAML::Node parseFile(const std::string& file, const std::string& kind) {
@@ -26,9 +52,14 @@ YAML::Node parseFile(const std::string& file, const std::string& kind) {
     return YAML::LoadFile(file);
   } catch (const YAML::BadFile&) {
     throw InputError(file + ": cannot open the file");
+  } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says "bad file"
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": nested " + std::to_string(e.depth()) +
+                     " levels deep, deeper than the reader follows (a scenario nests 4 or 5): is it the right file?");
   } catch (const YAML::Exception& e) {
     std::string msg;  // yaml-cpp quotes the offending byte: keep it printable
     for (const char c : e.msg) msg += static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f ? c : '?';
+    if (const std::string key = longKey(file); !key.empty())  // yaml-cpp: "end of map flow not found"
+      throw InputError(file + ": not valid YAML or JSON: " + key);
     throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML or JSON: " + detail::cut(msg));
   } catch (const std::exception& e) {
     throw InputError(file + ": cannot read the file: " + e.what());

@@ -13,6 +13,7 @@
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
 #include "parsers/urdf/urdf_summary.hpp"
+#include "parsers/urdf/urdf_text.hpp"
 #include "parsers/urdf/urdf_xml.hpp"
 
 namespace kdl_space {
@@ -266,8 +267,17 @@ UrdfReport Checker::run(const std::string& xml) {
 
 }  // namespace
 
-UrdfReport checkUrdfString(const std::string& xml, const std::string& source, const std::vector<std::string>& tips) {
-  return Checker(source, tips).run(xml);
+UrdfReport checkUrdfString(const std::string& bytes, const std::string& source, const std::vector<std::string>& tips) {
+  const detail::UrdfText utf8 = detail::urdfText(bytes);
+  if (!utf8.problem.empty()) {
+    UrdfReport report;
+    report.source = source;
+    report.errors.push_back(rules::error("encoding", ElementType::File, "", utf8.problem));
+    return report;
+  }
+  UrdfReport report = Checker(source, tips).run(utf8.text);
+  if (!utf8.note.empty()) report.notes.insert(report.notes.begin(), rules::note("encoding", ElementType::File, "", utf8.note));
+  return report;
 }
 
 UrdfReport checkUrdfFile(const std::string& path, const std::vector<std::string>& tips) {

@@ -16,6 +16,7 @@
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
 #include "parsers/urdf/urdf_parse.hpp"
+#include "parsers/urdf/urdf_text.hpp"
 #include "parsers/urdf/urdf_xml.hpp"
 
 namespace kdl_space {
@@ -108,7 +109,11 @@ std::map<std::string, JointProperties> properties(const urdf::ModelInterface& mo
 
 }  // namespace
 
-FloatingModel loadUrdfString(const std::string& written, const std::string& source) {
+FloatingModel loadUrdfString(const std::string& bytes, const std::string& source) {
+  // Its names in UTF-8, without control characters, whatever writer they reach.
+  const detail::UrdfText utf8 = detail::urdfText(bytes);
+  if (!utf8.problem.empty()) throw ModelError(source + ": " + utf8.problem);
+  const std::string& written = utf8.text;
   // Before TinyXML's recursive descent sees the text (parse, twice below).
   if (const std::string problem = rules::xmlDepthProblem(written); !problem.empty())
     throw ModelError(source + ": not XML that can be read safely: " + problem);
@@ -121,6 +126,7 @@ FloatingModel loadUrdfString(const std::string& written, const std::string& sour
   for (const std::string& joint : unlimited) rules::checkRevoluteWithoutLimit(joint, findings);
   const urdf::ModelInterfaceSharedPtr model = parseUrdfXml(xml, source);
   std::vector<Diagnostic> diagnostics;
+  if (!utf8.note.empty()) diagnostics.push_back({"", utf8.note, "encoding", Severity::Note});
   auto fail = [&](const std::string& what) -> void { throw ModelError(source + ": " + what); };
 
   // The links and joints as a graph, walked as the checker walks them (urdf_graph.hpp). urdfdom

@@ -82,6 +82,13 @@ void checkMimic(const std::string& joint, const std::string& leader, bool leader
                         "its <mimic> multiplier must be finite and non-zero, its offset finite"));
     return;
   }
+  if (std::abs(multiplier) > kMaxMimicMultiplier) {  // T^T H T would overflow; no coupling is such
+    out.push_back(error("bad_mimic", ElementType::Joint, joint,
+                        "its <mimic> multiplier " + number(multiplier) + " is beyond +-" + number(kMaxMimicMultiplier) +
+                            " (a coupling's ratio is a few units; the coupled inertia, multiplier^2 times the "
+                            "follower's, would overflow): check the number"));
+    return;
+  }
   out.push_back(note("mimic_joint", ElementType::Joint, joint,
                      "follows joint " + detail::quoted(leader) + " (q = " + number(multiplier) + " q_" + leader +
                          (offset == 0.0 ? std::string() : " + " + number(offset)) +

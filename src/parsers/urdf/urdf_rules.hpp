@@ -40,9 +40,14 @@ void checkLimits(const std::string& joint, double lower, double upper, Findings&
 /// it) is read as continuous.
 void checkRevoluteWithoutLimit(const std::string& joint, Findings& out);
 
+/// The largest |multiplier| of a <mimic>: a gear or a gripper's coupling is a few units; past it
+/// the coupled inertia (multiplier^2 times the follower's) overflows in the dynamics.
+constexpr double kMaxMimicMultiplier = 1e6;
+
 /// \brief Note `mimic_joint`: a movable joint with <mimic> follows its leader (q = multiplier *
 /// q_leader + offset): not a coordinate. Error `bad_mimic` when the leader is no movable joint
-/// (`leader_movable`) or the multiplier is zero or not finite, or the offset not finite.
+/// (`leader_movable`) or the multiplier is zero, not finite or beyond kMaxMimicMultiplier, or the
+/// offset not finite.
 void checkMimic(const std::string& joint, const std::string& leader, bool leader_movable, double multiplier,
                 double offset, Findings& out);
 

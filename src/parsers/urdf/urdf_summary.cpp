@@ -3,9 +3,11 @@
 #include <Eigen/Eigenvalues>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/recursive_ex_iit.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "detail/text.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
@@ -30,18 +32,30 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     summary.joint_properties = model->jointProperties();
     summary.joints_treated_as_fixed = model->fixedJoints();
     summary.total_mass = model->totalMass();
-    FreeFloatingSolver solver(model);
     const double inf = std::numeric_limits<double>::infinity();
-    if (solver.compute(State(*model)) != E_NOERROR) {
+    // Up to kDenseCheckJoints the dense route (H*, its eigenvalues: O(n^3)); above, the O(n)
+    // recursion alone (G* at the tips; H* singular when an articulated inertia is not positive),
+    // so that a robot of thousands of links is checked in linear time (issue 35, item 7).
+    const bool dense = model->nj() <= kDenseCheckJoints;
+    std::optional<FreeFloatingSolver> solver;  // its n x n workspaces only when used
+    if (dense) solver.emplace(model);
+    RecursiveExIITSolver recursive(model);
+    const int rc = dense ? solver->compute(State(*model)) : recursive.compute(State(*model));
+    if (rc != E_NOERROR) {
       report.errors.push_back(rules::error(
           "singular_inertia", ElementType::File, "",
           "H* (generalized inertia) is singular at q = 0: some joints move the bodies in the "
           "same way (e.g. coincident axes with only massless links between them)"));
       summary.condition_H_star = inf;
-    } else if (model->nj() == 0) {
+    } else if (model->nj() == 0 || !dense) {
       summary.condition_H_star = std::numeric_limits<double>::quiet_NaN();
+      if (!dense)
+        report.notes.push_back(rules::note(
+            "large_model", ElementType::File, "",
+            std::to_string(model->nj()) + " joints: cond(H*) is not computed above " + std::to_string(kDenseCheckJoints) +
+                " joints (a dense eigen-decomposition, O(n^3)); cond(G*) at the tips is, by the O(n) recursion"));
     } else {
-      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(solver.H_star().data, Eigen::EigenvaluesOnly);
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(solver->H_star().data, Eigen::EigenvaluesOnly);
       const Eigen::VectorXd& l = eig.eigenvalues();
       summary.condition_H_star = l(0) > 0.0 ? l(l.size() - 1) / l(0) : inf;
     }
@@ -57,10 +71,10 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     }
     for (const std::string& link : contacts) {
       Matrix6d G;
-      const int rc = solver.G_star(model->contact(link), G);
-      summary.condition_G_star.emplace_back(link, rc == E_NOERROR ? spectralFigures(G).condition : inf);
+      const int rc_G = dense ? solver->G_star(model->contact(link), G) : recursive.G_star(model->contact(link), G);
+      summary.condition_G_star.emplace_back(link, rc_G == E_NOERROR ? spectralFigures(G).condition : inf);
     }
-    conditions = "at q = 0, cond(H*) = " + rules::number(summary.condition_H_star);
+    conditions = dense ? "at q = 0, cond(H*) = " + rules::number(summary.condition_H_star) : "at q = 0";
     for (std::size_t i = 0; i < summary.condition_G_star.size(); ++i)
       conditions += (i == 0 ? ", cond(G*) = " : ", ") + rules::number(summary.condition_G_star[i].second) + " at " +
                     detail::quoted(summary.condition_G_star[i].first);

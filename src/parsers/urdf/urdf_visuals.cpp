@@ -6,6 +6,7 @@
 
 #include "kdl_space/spatial/errors.hpp"
 #include "parsers/urdf/urdf_parse.hpp"
+#include "parsers/urdf/urdf_text.hpp"
 
 namespace kdl_space {
 namespace {
@@ -45,50 +46,14 @@ bool shapeOf(const urdf::Geometry& g, LinkVisual& v) {
   return false;
 }
 
-bool isFile(const std::filesystem::path& p) {
-  std::error_code ec;
-  return std::filesystem::is_regular_file(p, ec);
-}
-
-bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
-
 }  // namespace
-
-MeshLocation resolveMeshFile(const std::string& filename, const std::string& urdf_dir,
-                             const std::vector<std::string>& package_path) {
-  namespace fs = std::filesystem;
-  if (startsWith(filename, "package://")) {
-    const std::string rest = filename.substr(10);
-    const std::size_t slash = rest.find('/');
-    if (slash == 0 || slash == std::string::npos || slash + 1 == rest.size())
-      return {"", "is not package://PACKAGE/PATH"};
-    const std::string package = rest.substr(0, slash), inside = rest.substr(slash + 1);
-    for (const std::string& dir : package_path) {
-      if (dir.empty()) continue;
-      const fs::path d(dir);
-      if (isFile(d / package / inside)) return {(d / package / inside).lexically_normal().string(), ""};
-      // A folder that is the package itself ("a/b/PKG/"'s name is PKG too).
-      if ((d.filename().empty() ? d.parent_path() : d).filename() == package && isFile(d / inside))
-        return {(d / inside).lexically_normal().string(), ""};
-    }
-    std::string searched;
-    for (const std::string& dir : package_path)
-      if (!dir.empty()) searched += (searched.empty() ? "" : ", ") + dir;
-    return {"", searched.empty() ? "package '" + package + "': no package folder to search"
-                                 : "package '" + package + "' has no " + inside + " in " + searched};
-  }
-  fs::path file;
-  if (startsWith(filename, "file://")) file = filename.substr(7);
-  else if (filename.find("://") != std::string::npos) return {"", "only package:// and file:// are read"};
-  else file = fs::path(filename).is_absolute() ? fs::path(filename) : fs::path(urdf_dir) / filename;
-  if (file.empty() || !isFile(file)) return {"", "no such file " + file.string()};
-  return {file.lexically_normal().string(), ""};
-}
 
 std::map<std::string, std::vector<LinkVisual>> readUrdfVisualsString(const std::string& xml, const std::string& source,
                                                                       const std::vector<std::string>& package_path) {
   const std::string urdf_dir = std::filesystem::path(source).parent_path().string();
-  const urdf::ModelInterfaceSharedPtr model = parseUrdfXml(xml, source);
+  const detail::UrdfText utf8 = detail::urdfText(xml);
+  if (!utf8.problem.empty()) throw ModelError(source + ": " + utf8.problem);
+  const urdf::ModelInterfaceSharedPtr model = parseUrdfXml(utf8.text, source);
   std::map<std::string, std::vector<LinkVisual>> out;
   for (const auto& [name, link] : model->links_) {
     if (!link) continue;

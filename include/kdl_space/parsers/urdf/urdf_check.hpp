@@ -24,7 +24,8 @@ struct ModelSummary {
   std::vector<FixedJoint> joints_treated_as_fixed;  ///< movable joints of the file that are not coordinates
   double total_mass = 0.0;               ///< [kg]
   /// Condition number (largest / smallest eigenvalue) of H* at q = 0, base at the origin;
-  /// NaN without movable joints, +inf when singular.
+  /// NaN without movable joints, or above 400 of them (not computed: an O(n^3) eigen-decomposition;
+  /// the note `large_model` says so), +inf when singular.
   double condition_H_star = 0.0;
   /// Condition number of G* at each contact link (the requested tips, else every link that
   /// carries no other link), at q = 0.

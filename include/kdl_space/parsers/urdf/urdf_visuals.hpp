@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kdl_space/export.hpp"
+#include "kdl_space/parsers/urdf/mesh_file.hpp"
 
 namespace kdl_space {
 
@@ -26,24 +27,6 @@ struct LinkVisual {
   KDL::Frame origin = KDL::Frame::Identity();               ///< link_T_visual
   std::optional<Eigen::Vector4d> rgba;                      ///< the material's colour, when given
 };
-
-/// Where a mesh's filename points: `path` the regular file found, or "" and `problem` saying why.
-struct MeshLocation {
-  std::string path;
-  std::string problem;
-};
-
-/// \brief The file a URDF mesh's `filename` names (what ROS tools read), without reading it:
-/// - `package://PKG/REST`: the first folder D of `package_path`, in order, where D/PKG/REST is a
-///   file, or, for a D named PKG itself (a package's own folder, as ROS_PACKAGE_PATH may list),
-///   D/REST. Packages are not searched for below D (no crawl for package.xml: a workspace's
-///   `src` folder holding its packages one level down works; deeper ones are listed themselves).
-/// - `file:///ABS`: /ABS; an absolute path: itself; a relative path: from `urdf_dir`.
-/// - any other scheme (http://, ...): not found.
-/// The library reads no environment variable: the caller builds `package_path` (the tool: its
-/// --mesh-path folders, then ROS_PACKAGE_PATH).
-KDL_SPACE_EXPORT MeshLocation resolveMeshFile(const std::string& filename, const std::string& urdf_dir,
-                                              const std::vector<std::string>& package_path);
 
 /// \brief Every link's visuals, by link name (links without one are absent). A material named
 /// on a visual without a colour of its own takes the colour of the robot-level material of that
