@@ -1,6 +1,6 @@
 // libFuzzer target: the page a user shares (`kdl_space capture --html`, writeCaptureHtml) from a
-// robot folder whose URDF text is the input: its link and joint names, its visuals, its meshes'
-// filenames (issue 35, items 2, 5, 7 and 9). The folder holds a mesh of its own (robot/meshes/
+// robot folder whose URDF text is the input (its root link named `base`, the contact): its link
+// and joint names, its visuals, its meshes' filenames (issue 35, items 2, 5, 7 and 9). The folder holds a mesh of its own (robot/meshes/
 // box.stl) and a package's (share/pkg/meshes/box.dae); outside it lies a secret file, which
 // robot/meshes/secret.stl and share/pkg/meshes/secret.stl link to and paths can climb to.
 // Invariants, for every input that loads: the page holds none of the secret's bytes (raw or in
@@ -75,7 +75,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   fs::create_symlink(root / "outside" / "secret.stl", root / "robot" / "meshes" / "secret.stl");
   fs::create_symlink(root / "outside" / "secret.stl", root / "share" / "pkg" / "meshes" / "secret.stl");
   std::ofstream(root / "robot" / "scenario.yaml")
-      << "robot:\n  urdf: robot.urdf\n  mode: free\ntarget:\n  mass: 5\n  inertia: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n"
+      << "robot:\n  urdf: robot.urdf\n  contact: {link: base}\n  mode: free\ntarget:\n  mass: 5\n  inertia: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n"
          "  pose: {position: [3, 0, 0], rpy: [0, 0, 0]}\n  twist: [-0.1, 0, 0, 0, 0, 0]\nlaw:\n  type: capture\n";
   return 0;
 }

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -210,12 +211,24 @@ void checkOutputFile(const std::string& path, const std::string& option) {
   unlink(createFreshFile(folder.string(), "." + fs::path(path).filename().string() + ".probe", where).c_str());
 }
 
+namespace {
+/// The process's file mode creation mask, read without changing it (/proc/self/status; umask()
+/// would set it, racing other threads); 022 when it cannot be read.
+mode_t processUmask() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::strtoul(line.c_str() + 6, nullptr, 8));
+  return 022;
+}
+}  // namespace
+
 std::string createFreshFile(const std::string& folder, const std::string& stem, const std::string& where, int* fd) {
   std::string name = (fs::path(folder.empty() ? "." : folder) / (stem + std::to_string(getpid()) + "-XXXXXX")).string();
   const int created = mkostemp(name.data(), O_CLOEXEC);  // O_CREAT | O_EXCL, mode 0600
   if (created < 0)
     throw InputError(where + "cannot create a file in the folder " + quoted(folder.empty() ? "." : folder) + ": " +
                      std::strerror(errno));
+  fchmod(created, 0666 & ~processUmask());  // the mode any new file of the user's gets (0644 by default)
   if (fd) *fd = created;
   else close(created);
   return name;

@@ -211,3 +211,20 @@ def test_capture_result(arm):
     assert np.allclose(r.momentum_before, r.momentum_after, rtol=1e-9, atol=1e-12)
     assert np.allclose(r.robot.contact_twist_after[3:], r.target_twist_after[3:])
     assert "CaptureResult" in repr(r)
+
+
+def test_names_in_an_iso_8859_1_urdf_are_str(tmp_path):
+    """A URDF that declares ISO-8859-1 (a joint 'Handgelenk_ä' in one byte): read, its names in
+    UTF-8, so joint_names is a list of str (it raised UnicodeDecodeError); the same bytes
+    undeclared are refused at load with the line (issue 35, item 5)."""
+    text = ARM.read_bytes().replace(b'"joint3"', '"Handgelenk_ä"'.encode("latin-1"))
+    if text.startswith(b"<?xml"):
+        text = text[text.index(b"?>") + 2:]
+    declared = tmp_path / "latin1.urdf"
+    declared.write_bytes(b'<?xml version="1.0" encoding="ISO-8859-1"?>' + text)
+    model = kdl_space.load_urdf(str(declared))
+    assert "Handgelenk_ä" in model.joint_names
+    undeclared = tmp_path / "undeclared.urdf"
+    undeclared.write_bytes(text)
+    with pytest.raises(kdl_space.ModelError, match=r"undeclared.urdf: line \d+ \(near .*Handgelenk_\\xE4.*not UTF-8"):
+        kdl_space.load_urdf(str(undeclared))

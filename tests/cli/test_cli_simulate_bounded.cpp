@@ -4,6 +4,7 @@
 // leaves a partial file.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -126,6 +127,10 @@ TEST_F(SimulateBounded, ALinkPlantedAtTheTemporarysNameIsNeverFollowed) {
         << option;
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out))) << option << ": written, as a file of its own";
     EXPECT_GT(fs::file_size(out), 100u) << option;
+    // With the mode any new file of the user's gets (not the temporary's private 0600).
+    const mode_t mask = umask(0);
+    umask(mask);
+    EXPECT_EQ(static_cast<unsigned>(fs::status(out).permissions()), 0666u & ~static_cast<unsigned>(mask)) << option;
     for (const auto& entry : fs::directory_iterator(dir))
       if (fs::is_symlink(entry.symlink_status())) fs::remove(entry.path());
     fs::remove(out);
