@@ -15,7 +15,7 @@ import pytest
 
 from conftest import ARM, CAPTURE_SCENARIO
 from test_html import CHROMIUM, needs_browser, page_data
-from test_html_meshes import DAE_HI, DAE_LO, binary_stl, box_triangles, LO, HI
+from test_html_meshes import DAE_HI, DAE_LO, HI, LO, binary_stl, box_triangles, collada_box
 
 SECRET = b"kdl_space-secret-" + os.urandom(12).hex().encode() + b"\n"
 
@@ -43,39 +43,18 @@ def beacon():
 
 def textured_collada(url):
     """test_html_meshes' box, its triangles bound to a material whose diffuse is a texture at `url`."""
-    c = [((DAE_HI if i & 1 else DAE_LO)[0], (DAE_HI if i & 2 else DAE_LO)[1], (DAE_HI if i & 4 else DAE_LO)[2]) for i in range(8)]
-    faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
-    index = " ".join(f"{a} {b} {d} {a} {d} {e}" for a, b, d, e in faces)
-    positions = " ".join(repr(float(x)) for corner in c for x in corner)
-    return f"""<?xml version="1.0" encoding="utf-8"?>
-<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><unit name="decimetre" meter="0.1"/><up_axis>Z_UP</up_axis></asset>
+    texture = f"""</asset>
   <library_images><image id="tex"><init_from>{url}/beacon.png</init_from></image></library_images>
   <library_effects><effect id="eff"><profile_COMMON>
     <newparam sid="surf"><surface type="2D"><init_from>tex</init_from></surface></newparam>
     <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
     <technique sid="common"><lambert><diffuse><texture texture="samp" texcoord="UV"/></diffuse></lambert></technique>
   </profile_COMMON></effect></library_effects>
-  <library_materials><material id="mat"><instance_effect url="#eff"/></material></library_materials>
-  <library_geometries>
-    <geometry id="box-mesh" name="box"><mesh>
-      <source id="box-positions">
-        <float_array id="box-positions-array" count="24">{positions}</float_array>
-        <technique_common><accessor source="#box-positions-array" count="8" stride="3">
-          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
-        </accessor></technique_common>
-      </source>
-      <vertices id="box-vertices"><input semantic="POSITION" source="#box-positions"/></vertices>
-      <triangles count="12" material="skin"><input semantic="VERTEX" source="#box-vertices" offset="0"/><p>{index}</p></triangles>
-    </mesh></geometry>
-  </library_geometries>
-  <library_visual_scenes>
-    <visual_scene id="Scene"><node id="box" type="NODE"><instance_geometry url="#box-mesh"><bind_material><technique_common>
-      <instance_material symbol="skin" target="#mat"/></technique_common></bind_material></instance_geometry></node></visual_scene>
-  </library_visual_scenes>
-  <scene><instance_visual_scene url="#Scene"/></scene>
-</COLLADA>
-"""
+  <library_materials><material id="mat"><instance_effect url="#eff"/></material></library_materials>"""
+    bound = ('<instance_geometry url="#box-mesh"><bind_material><technique_common>'
+             '<instance_material symbol="skin" target="#mat"/></technique_common></bind_material></instance_geometry>')
+    text = collada_box(DAE_LO, DAE_HI).replace("</asset>", texture).replace('<triangles count="12">', '<triangles count="12" material="skin">')
+    return text.replace('<instance_geometry url="#box-mesh"/>', bound)
 
 
 # link: the mesh's filename; each but link6 points outside the robot's folder and the search path.
