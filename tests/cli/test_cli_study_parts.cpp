@@ -269,15 +269,23 @@ TEST(StudyParts, TemporariesOfRunsThatAreGoneAreRemoved) {
   fs::remove(table);
   fs::create_directories(parts);
   const std::string dead = std::to_string(deadPid()), live = std::to_string(getpid());
+  // Today's names (createFreshFile: .NAME.tmpPID-XXXXXX) and earlier versions' (.NAME.tmpPID).
   const std::string beside_dead = scratch(".temps.csv.tmp" + dead), beside_live = scratch(".temps.csv.tmp" + live),
                     other = scratch(".other.csv.tmp" + dead), in_parts = parts + "/.rows-0-16.csv.tmp" + dead,
-                    lock_dead = scratch(".temps.csv.lock.tmp" + dead);
-  for (const std::string& p : {beside_dead, beside_live, other, in_parts, lock_dead}) spit(p, "half a table");
+                    lock_dead = scratch(".temps.csv.lock.tmp" + dead), fresh_dead = scratch(".temps.csv.tmp" + dead + "-a1B2c3"),
+                    fresh_live = scratch(".temps.csv.tmp" + live + "-a1B2c3"),
+                    fresh_in_parts = parts + "/.rows-16-32.csv.tmp" + dead + "-Zz9Yy8";
+  for (const std::string& p : {beside_dead, beside_live, other, in_parts, lock_dead, fresh_dead, fresh_live, fresh_in_parts})
+    spit(p, "half a table");
   const ToolRun r = kdlSpace("study " + kSmall + " -o " + table);
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_FALSE(fs::exists(beside_dead));
   EXPECT_FALSE(fs::exists(in_parts));
   EXPECT_FALSE(fs::exists(lock_dead)) << "the lock's temporary of a run killed as it took the lock";
+  EXPECT_FALSE(fs::exists(fresh_dead));
+  EXPECT_FALSE(fs::exists(fresh_in_parts));
+  EXPECT_TRUE(fs::exists(fresh_live)) << "a live run's temporary is left alone";
+  fs::remove(fresh_live);
   EXPECT_TRUE(fs::exists(beside_live)) << "a live run's temporary is left alone";
   EXPECT_TRUE(fs::exists(other)) << "another table's temporary is left alone";
   // In the parts folder while it is still needed: a run stopped by Ctrl-C keeps its chunks, and
