@@ -13,8 +13,9 @@ Matrix3d rotationOf(const Eigen::Vector4d& q) {
 }
 }  // namespace
 
-FreeRigidMotion::FreeRigidMotion(const RigidTarget& at_zero, double grid_step)
-    : start_(at_zero), grid_step_(grid_step) {
+FreeRigidMotion::FreeRigidMotion(const RigidTarget& at_zero, double grid_step, std::size_t max_checkpoints)
+    : start_(at_zero), grid_step_(grid_step), max_checkpoints_(max_checkpoints) {
+  if (max_checkpoints < 2) throw ModelError("FreeRigidMotion: max_checkpoints must be at least 2");
   if (!(at_zero.mass > 0.0) || !std::isfinite(at_zero.mass)) throw ModelError("FreeRigidMotion: the mass must be finite and > 0");
   if (!at_zero.inertia.allFinite() || !at_zero.com.allFinite() || !at_zero.twist.allFinite() || !allFinite(at_zero.pose))
     throw ModelError("FreeRigidMotion: the inertia, CoM, pose and twist must be finite");
@@ -43,7 +44,7 @@ Eigen::Vector4d FreeRigidMotion::gridPoint(std::size_t k) {
     ++last_k_;
     if (last_k_ % stride_ == 0 && last_k_ / stride_ == checkpoints_.size()) {
       checkpoints_.push_back(last_q_);
-      if (checkpoints_.size() > kMaxCheckpoints) {  // every other one kept: the stride doubles
+      if (checkpoints_.size() > max_checkpoints_) {  // every other one kept: the stride doubles
         for (std::size_t j = 0; 2 * j < checkpoints_.size(); ++j) checkpoints_[j] = checkpoints_[2 * j];
         checkpoints_.resize((checkpoints_.size() + 1) / 2);
         stride_ *= 2;

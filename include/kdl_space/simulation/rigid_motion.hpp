@@ -20,14 +20,14 @@ namespace kdl_space {
 /// round-off. Error per unit time ~ (|w| grid_step)^4 |w| (1e-16 rad/s for |w| = 1 rad/s and 1 ms).
 ///
 /// Memory is bounded whatever the time asked for (issue 35, item 4): the grid is not kept, only
-/// at most kMaxCheckpoints of its points (every `stride` steps, the stride doubled when they would
-/// be more) and the last point reached. Times asked in increasing order cost one step per grid
+/// at most `max_checkpoints` of its points (every 1024 steps at first, the spacing doubled when
+/// they would be more) and the last point reached. Times asked in increasing order cost one step per grid
 /// step passed; a time before the last one reached starts again from the checkpoint below it.
 class KDL_SPACE_EXPORT FreeRigidMotion {
  public:
   /// The target at t = 0. \throws ModelError unless its mass > 0, its inertia symmetric positive
-  /// definite, its numbers finite and grid_step finite and > 0.
-  explicit FreeRigidMotion(const RigidTarget& at_zero, double grid_step = 1e-3);
+  /// definite, its numbers finite, grid_step finite and > 0 and max_checkpoints >= 2 (4,096: 128 KiB).
+  explicit FreeRigidMotion(const RigidTarget& at_zero, double grid_step = 1e-3, std::size_t max_checkpoints = 4096);
 
   /// \brief The target at time t >= 0: pose of its frame, twist (v of the CoM; w) in the world,
   /// and the rest as at t = 0. \return 0, E_BAD_ARGUMENT (t < 0), E_NOT_FINITE (t not finite).
@@ -40,14 +40,11 @@ class KDL_SPACE_EXPORT FreeRigidMotion {
   /// The attitude at grid point k (k grid_step), from the nearest checkpoint or the last point.
   Eigen::Vector4d gridPoint(std::size_t k);
 
- public:
-  static constexpr std::size_t kMaxCheckpoints = 4096;  ///< 128 KiB of attitudes at most
-
- private:
   RigidTarget start_;
   Matrix3d I_inv_;  ///< inverse inertia about the CoM, target-frame axes
   Vector3d L_;      ///< angular momentum about the CoM, world (constant)
   double grid_step_;
+  std::size_t max_checkpoints_;
   std::size_t stride_ = 1024;               ///< grid steps between checkpoints (a power of two)
   std::vector<Eigen::Vector4d> checkpoints_;  ///< attitude at grid point j stride_
   std::size_t last_k_ = 0;                   ///< the last grid point reached
