@@ -37,10 +37,11 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     // recursion alone (G* at the tips; H* singular when an articulated inertia is not positive),
     // so that a robot of thousands of links is checked in linear time (issue 35, item 7).
     const bool dense = model->nj() <= kDenseCheckJoints;
-    std::optional<FreeFloatingSolver> solver;  // its n x n workspaces only when used
+    std::optional<FreeFloatingSolver> solver;      // its n x n workspaces only when used
+    std::optional<RecursiveExIITSolver> recursive;  // else the O(n) route alone
     if (dense) solver.emplace(model);
-    RecursiveExIITSolver recursive(model);
-    const int rc = dense ? solver->compute(State(*model)) : recursive.compute(State(*model));
+    else recursive.emplace(model);
+    const int rc = dense ? solver->compute(State(*model)) : recursive->compute(State(*model));
     if (rc != E_NOERROR) {
       report.errors.push_back(rules::error(
           "singular_inertia", ElementType::File, "",
@@ -71,7 +72,7 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     }
     for (const std::string& link : contacts) {
       Matrix6d G;
-      const int rc_G = dense ? solver->G_star(model->contact(link), G) : recursive.G_star(model->contact(link), G);
+      const int rc_G = dense ? solver->G_star(model->contact(link), G) : recursive->G_star(model->contact(link), G);
       summary.condition_G_star.emplace_back(link, rc_G == E_NOERROR ? spectralFigures(G).condition : inf);
     }
     conditions = dense ? "at q = 0, cond(H*) = " + rules::number(summary.condition_H_star) : "at q = 0";
