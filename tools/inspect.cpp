@@ -11,6 +11,7 @@
 #include "detail/text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/inspection.hpp"
 #include "kdl_space/multibody/poses.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
@@ -137,41 +138,96 @@ void printJointMargins(std::ostream& out, const FloatingModel& model, const KDL:
               model.jointNames(), {"above lower", "below upper", "margin"}, width);
 }
 
-/// The text's head: the model, its mass and CoM, I_g, H* and the joints' margins (none of the last
-/// two for a robot without joints).
+/// The note on a model above kDenseJoints: H* is not formed.
+std::string largeModelNote(const FloatingModel& model) {
+  return "note: " + std::to_string(model.nj()) + " joints: H* (n x n) is not formed above " +
+         std::to_string(kDenseJoints) + " joints (the JSON's H_star is null); G*, the grounded G and J* come from the "
+         "O(n) routes (the recursion of RecursiveExIITSolver), equal to the dense ones to round-off";
+}
+
+/// The diagnostic on a contact's grounded G (singular, or unavailable), or "".
+std::string groundedDiagnostic(const ContactInspection& c, const std::string& link) {
+  if (!c.G_grounded) return "contact '" + link + "': grounded G unavailable: H is not positive definite";
+  const SpectralFigures f = spectralFigures(*c.G_grounded);
+  if (f.rank == 6) return "";
+  std::ostringstream s;
+  s << "contact '" << link << "': grounded G = J H^-1 J^T is singular (rank " << f.rank
+    << " of 6): a grounded arm cannot move this point in every direction here";
+  return s.str();
+}
+
+Json contactJson(const ContactInspection& c, const Contact& h, const std::string& link) {
+  return Json{{"link", link},
+              {"offset", toJson(toEigen(h.offset))},
+              {"point", toJson(c.point)},
+              {"J_star", toJsonRows(c.J_star)},  // 6 x n, even for n = 1
+              {"G_star", toJson(c.G_star)},
+              {"G_grounded", c.G_grounded ? toJson(*c.G_grounded) : Json(nullptr)},
+              {"G_locked", toJson(c.G_locked)},
+              {"pose", poseJson(poseFigures(c.frame))},
+              {"conditioning", conditioningJson(c.conditioning)}};
+}
+
+/// One contact point's part of the text report.
+void printContact(std::ostream& report, const FloatingModel& model, const ContactInspection& c, const Contact& h,
+                  const std::string& link, std::size_t i, std::size_t width) {
+  std::ostringstream where;
+  where << "Contact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", " << h.offset.y()
+        << ", " << h.offset.z() << ") m, at (" << c.point.x() << ", " << c.point.y() << ", " << c.point.z()
+        << ") m in the world";
+  report << "\n";
+  printWrapped(report, where.str(), width);
+  // Transposed, so that each joint's row carries its name; the JSON's J_star is J* (6 x n).
+  if (model.nj() == 0)
+    printWrapped(report, "J*: none, 6 x 0 (the robot has no movable joint: the contact point moves only with the base)",
+                 width);
+  else
+    printMatrix(report, "J*^T (J* of eq. 4, transposed: n x 6, one row per joint; columns the twist (v; w) per "
+                "unit rate)", c.J_star.transpose(), model.jointNames(), twistLabels(), width);
+  printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", c.G_star, twistLabels(), twistLabels(), width);
+  if (c.G_grounded)
+    printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", *c.G_grounded, twistLabels(), twistLabels(), width);
+  printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", c.G_locked, twistLabels(), twistLabels(), width);
+  printPoseAndConditioning(report, poseFigures(c.frame), c.conditioning, width);
+}
+
+/// The text's head: the model, its mass and CoM, I_g, H* (up to kDenseJoints) and the joints'
+/// margins (none of the last two for a robot without joints).
 void printModelSummary(std::ostream& out, const std::string& urdf, const FloatingModel& model,
-                       const FreeFloatingSolver& solver, const State& state, std::size_t width) {
+                       const Inspection& figures, const State& state, std::size_t width) {
   const unsigned int n = model.nj();
   std::ostringstream what;
   what << "Free-floating model " << urdf << ": base '" << model.bodies()[0].name << "', "
        << model.bodies().size() << " links, "
        << (n == 0 ? std::string("no movable joint (a rigid body: J* is 6 x 0, G* its inverse inertia at the point)")
                   : std::to_string(n) + " movable joints");
-  what << "\nTotal mass w = " << solver.w() << " kg\nSystem CoM r_g = (" << solver.r_g().x() << ", "
-       << solver.r_g().y() << ", " << solver.r_g().z() << ") m";
+  what << "\nTotal mass w = " << figures.mass << " kg\nSystem CoM r_g = (" << figures.r_g.x() << ", "
+       << figures.r_g.y() << ", " << figures.r_g.z() << ") m";
   printWrapped(out, what.str(), width);
-  printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", solver.I_g(), {"x", "y", "z"},
+  printMatrix(out, "I_g (locked inertia about the CoM, eq. 3) [kg m^2]", figures.I_g, {"x", "y", "z"},
               {"x", "y", "z"}, width);
-  if (n > 0) {
-    printMatrix(out, "H* (generalized inertia, eq. 7)", solver.H_star().data, model.jointNames(), model.jointNames(), width);
-    printJointMargins(out, model, state.q, width);
-  }
+  if (n == 0) return;
+  if (figures.dense)
+    printMatrix(out, "H* (generalized inertia, eq. 7)", figures.H_star, model.jointNames(), model.jointNames(), width);
+  else
+    printWrapped(out, "H* (generalized inertia, eq. 7): not formed for " + std::to_string(n) + " joints (above " +
+                 std::to_string(kDenseJoints) + ")", width);
+  printJointMargins(out, model, state.q, width);
 }
 
-Json inspectJson(const FreeFloatingSolver& solver, const State& state, const Json& json_contacts,
-                 const Eigen::MatrixXd& G_all, const std::vector<std::string>& diagnostics,
-                 const std::vector<Diagnostic>& warnings) {
-  const FloatingModel* model = &solver.model();
+Json inspectJson(const FloatingModel& model, const Inspection& figures, const State& state, const Json& json_contacts,
+                 const std::vector<std::string>& diagnostics, const std::vector<Diagnostic>& warnings) {
   Json j;
-  j["mass"] = solver.w();
-  j["com"] = toJson(solver.r_g());
-  j["I_g"] = toJson(solver.I_g());
-  j["joint_names"] = model->jointNames();
-  j["joints_treated_as_fixed"] = fixedJointsJson(*model);
-  j["H_star"] = toJsonRows(solver.H_star().data);  // n x n, even for n = 1
+  j["mass"] = figures.mass;
+  j["com"] = toJson(figures.r_g);
+  j["I_g"] = toJson(figures.I_g);
+  j["joint_names"] = model.jointNames();
+  j["joints_treated_as_fixed"] = fixedJointsJson(model);
+  // n x n, even for n = 1; null above kDenseJoints joints (not formed: a diagnostic says so)
+  j["H_star"] = figures.dense ? toJsonRows(figures.H_star) : Json(nullptr);
   j["contacts"] = json_contacts;
-  j["G_star_all"] = toJson(G_all);
-  j["joint_margins"] = jointMarginsJson(*model, jointMargins(*model, state.q));
+  j["G_star_all"] = toJson(figures.G_star_all);
+  j["joint_margins"] = jointMarginsJson(model, jointMargins(model, state.q));
   j["diagnostics"] = diagnostics;
   j["warnings"] = warningsJson(warnings);
   return j;
@@ -252,112 +308,56 @@ Inspected inspected(const InspectOptions& o, const std::vector<ContactRequest>& 
 void runInspect(const CLI::App& command, const InspectOptions& o, std::ostream& out) {
   const std::vector<ContactRequest> requests = pairContacts(command, o);
   const Inspected in = inspected(o, requests);
-  const std::shared_ptr<const FloatingModel>& model = in.model;
-  const State& state = in.state;
+  const FloatingModel& model = *in.model;
   const std::vector<Contact>& contacts = in.contacts;
-  const std::map<std::string, double>& q_by_name = in.q_by_name;
 
   stopIfInterrupted("inspect " + o.urdf + ": after loading it");
-  FreeFloatingSolver solver(model);
-  if (const int rc = solver.compute(state))
-    throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
-                     "--base-rpy): " + strError(rc));
+  Inspection figures;
+  const auto ctrl_c = [] { return interruptFlag().load(std::memory_order_relaxed); };
+  if (const int rc = inspect(in.model, in.state, contacts, figures, ctrl_c)) {
+    const std::string why = strError(rc);
+    if (figures.failed_at < 0)
+      throw InputError(o.urdf + ": the free-floating quantities cannot be computed at this state (--q, --base-pos, "
+                       "--base-rpy): " + why);
+    if (figures.failed_at >= static_cast<int>(contacts.size()))
+      throw InputError("--tip: G* over all contact points cannot be computed: " + why);
+    throw InputError(contactOption(requests[figures.failed_at]) + ": the " + figures.failed + " cannot be computed: " + why);
+  }
 
   // The configuration's warnings: joints outside their limits here, then (per contact) J* near a
   // singularity. They are also diagnostics (inspect's one list of what to look at).
-  std::vector<Diagnostic> warnings = configurationWarnings(*model, state.q, nullptr, "");
-  std::vector<std::string> diagnostics = modelDiagnostics(*model, q_by_name);
-  Kinematics kin(*model);
-  if (const int rc = forwardKinematics(*model, state, kin))
-    throw InputError(o.urdf + ": the link poses cannot be computed at this state: " + strError(rc));
-  const std::vector<std::string>& joints = model->jointNames();
-  const unsigned int n = model->nj();
+  std::vector<Diagnostic> warnings = configurationWarnings(model, in.state.q, nullptr, "");
+  std::vector<std::string> diagnostics = modelDiagnostics(model, in.q_by_name);
+  if (!figures.dense) diagnostics.push_back(largeModelNote(model));
   const std::size_t width = outputWidth();
-
   Json json_contacts = Json::array();
   std::ostringstream report;
   for (std::size_t i = 0; i < contacts.size(); ++i) {
-    stopIfInterrupted("inspect " + o.urdf + ": at contact " + std::to_string(i + 1) + " of " + std::to_string(contacts.size()));
-    const Contact& h = contacts[i];
+    const ContactInspection& c = figures.contacts[i];
     const std::string& link = requests[i].link;
-    Vector3d p_h;
-    KDL::Jacobian J_star(n);
-    Matrix6d G_star, G_grounded, G_locked;
-    int rc = solver.contactPoint(h, p_h);
-    if (rc == E_NOERROR) rc = solver.J_star(h, J_star);
-    if (rc == E_NOERROR) rc = solver.G_star(h, G_star);
-    if (rc == E_NOERROR) rc = solver.G_locked(h, G_locked);
-    if (rc) throw InputError(contactOption(requests[i]) + ": the contact quantities cannot be computed: " + strError(rc));
-    const int rc_grounded = solver.G_grounded(h, G_grounded);
-    if (rc_grounded != E_NOERROR && rc_grounded != E_NOT_POSITIVE_DEFINITE)
-      throw InputError(contactOption(requests[i]) + ": the grounded G cannot be computed: " + strError(rc_grounded));
-    const bool grounded = rc_grounded == E_NOERROR;
-    KDL::Jacobian J(n);
-    if (const int rc_J = solver.J(h, J))
-      throw InputError(contactOption(requests[i]) + ": the fixed-base J cannot be computed: " + strError(rc_J));
-    const Conditioning cond = conditioning(J_star.data, J.data);
-    const PoseFigures frame = poseFigures(contactFrame(kin, h));
-    for (const Diagnostic& d : configurationWarnings(*model, state.q, &cond, "contact '" + link + "'"))
+    for (const Diagnostic& d : configurationWarnings(model, in.state.q, &c.conditioning, "contact '" + link + "'"))
       if (d.kind == "near_singular") warnings.push_back(d);
-    if (grounded) {
-      const SpectralFigures f = spectralFigures(G_grounded);
-      if (f.rank < 6) {
-        std::ostringstream s;
-        s << "contact '" << link << "': grounded G = J H^-1 J^T is singular (rank " << f.rank
-          << " of 6): a grounded arm cannot move this point in every direction here";
-        diagnostics.push_back(s.str());
-      }
-    } else {
-      diagnostics.push_back("contact '" + link + "': grounded G unavailable: H is not positive definite");
-    }
-    json_contacts.push_back(Json{{"link", link},
-                                 {"offset", toJson(toEigen(h.offset))},
-                                 {"point", toJson(p_h)},
-                                 {"J_star", toJsonRows(J_star.data)},  // 6 x n, even for n = 1
-                                 {"G_star", toJson(G_star)},
-                                 {"G_grounded", grounded ? toJson(G_grounded) : Json(nullptr)},
-                                 {"G_locked", toJson(G_locked)},
-                                 {"pose", poseJson(frame)},
-                                 {"conditioning", conditioningJson(cond)}});
-    if (!o.json) {
-      std::ostringstream where;
-      where << "Contact point " << i + 1 << ": link '" << link << "', offset (" << h.offset.x() << ", "
-            << h.offset.y() << ", " << h.offset.z() << ") m, at (" << p_h.x() << ", " << p_h.y() << ", "
-            << p_h.z() << ") m in the world";
-      report << "\n";
-      printWrapped(report, where.str(), width);
-      // Transposed, so that each joint's row carries its name; the JSON's J_star is J* (6 x n).
-      if (n == 0)
-        printWrapped(report, "J*: none, 6 x 0 (the robot has no movable joint: the contact point moves only with the base)",
-                     width);
-      else
-        printMatrix(report, "J*^T (J* of eq. 4, transposed: n x 6, one row per joint; columns the twist (v; w) per "
-                    "unit rate)", J_star.data.transpose(), joints, twistLabels(), width);
-      printMatrix(report, "G* (Ex-IIT, eq. 11) [twist per impulse]", G_star, twistLabels(), twistLabels(), width);
-      if (grounded)
-        printMatrix(report, "G grounded (J H^-1 J^T, eq. 22)", G_grounded, twistLabels(), twistLabels(), width);
-      printMatrix(report, "G locked (R_h M_a^-1 R_h^T, eq. 20)", G_locked, twistLabels(), twistLabels(), width);
-      printPoseAndConditioning(report, frame, cond, width);
-    }
+    diagnostics.push_back(groundedDiagnostic(c, link));
+    if (diagnostics.back().empty()) diagnostics.pop_back();
+    json_contacts.push_back(contactJson(c, contacts[i], link));
+    if (!o.json) printContact(report, model, c, contacts[i], link, i, width);
   }
-  Eigen::MatrixXd G_all(6 * contacts.size(), 6 * contacts.size());
-  if (const int rc = solver.G_star(contacts, G_all))
-    throw InputError("--tip: G* over all contact points cannot be computed: " + std::string(strError(rc)));
 
   for (const Diagnostic& d : warnings) diagnostics.push_back("warning: " + describe(d));
   if (!o.json) warnOnStderr(warnings);
   if (o.json) {
-    out << std::setprecision(17) << jsonText(inspectJson(solver, state, json_contacts, G_all, diagnostics, warnings), 2)
-        << "\n";
+    out << std::setprecision(17)
+        << jsonText(inspectJson(model, figures, in.state, json_contacts, diagnostics, warnings), 2) << "\n";
     return;
   }
-  printModelSummary(out, o.urdf, *model, solver, state, width);
+  printModelSummary(out, o.urdf, model, figures, in.state, width);
   out << report.str();
   if (contacts.size() > 1) {
     std::vector<std::string> labels;
     for (const ContactRequest& r : requests)
       for (const std::string& l : twistLabels()) labels.push_back(r.link + ":" + l);
-    printMatrix(out, "\nG* over all contact points (with cross-coupling blocks)", G_all, labels, labels, width);
+    printMatrix(out, "\nG* over all contact points (with cross-coupling blocks)", figures.G_star_all, labels, labels,
+                width);
   }
   out << "\nDiagnostics:" << (diagnostics.empty() ? " none" : "") << "\n";
   for (const std::string& d : diagnostics) printWrapped(out, d, width, "  - ", "    ");

@@ -12,7 +12,8 @@ namespace {
 /// A solver with its model, whether its last compute succeeded, and the lock of one thread at a time.
 template <class Solver>
 struct Wrapped {
-  explicit Wrapped(const Model& m) : model(m), solver(m.ptr) {}
+  template <class... Options>
+  explicit Wrapped(const Model& m, Options... options) : model(m), solver(m.ptr, options...) {}
   Model model;
   Solver solver;
   bool computed = false;
@@ -56,6 +57,13 @@ py::array_t<double> jacobian(FFS& w, const PyContact& c, const char* who, Jac q)
   return toNumpy(J.data);
 }
 
+/// A query of H or H* on a solver built with extent 'jacobians' (it forms neither): say so.
+void needsMassMatrix(const FFS& w, const std::string& who) {
+  if (w.solver.extent() == FreeFloatingSolver::Extent::Jacobians)
+    throw ComputeError(E_NOT_COMPUTED, who + ": this solver was built with extent='jacobians' and forms no H or H* "
+                                             "(build FreeFloatingSolver(model) for it, or use RecursiveExIITSolver)");
+}
+
 template <class Get>
 auto result(FFS& w, const char* who, Get get) {
   w.ready(who);
@@ -69,7 +77,15 @@ void bindSolvers(py::module_& m) {
                   "The paper's dense quantities at one state: w, r_g, I_g, M_a, A_m, H, H* and, per contact, "
                   "J, J*, G*, grounded and locked G (world frame; joint-indexed rows and columns in "
                   "`joint_names` order). compute(state) first; one thread at a time per solver.")
-      .def(py::init<const Model&>(), py::arg("model"), "A solver for `model` (build one per thread).")
+      .def(py::init([](const Model& m, const std::string& extent) {
+             if (extent != "full" && extent != "jacobians")
+               throw py::value_error("extent: '" + extent + "' is not one of 'full', 'jacobians'");
+             return std::make_unique<FFS>(m, extent == "full" ? FreeFloatingSolver::Extent::Full
+                                                              : FreeFloatingSolver::Extent::Jacobians);
+           }), py::arg("model"), py::arg("extent") = "full",
+           "A solver for `model` (build one per thread). extent 'jacobians': compute forms the centroid terms "
+           "and A_m only, O(n) with no n x n matrix (J, J*, momentum, G_locked answer; H and H* are empty; "
+           "G_star, G_grounded raise ComputeError E_NOT_COMPUTED): for J* of a robot of thousands of links.")
       .def_property_readonly("joint_names", [](const FFS& w) { return w.model.ptr->jointNames(); },
                              "The order of joint-indexed values.")
       .def("compute", [](FFS& w, const PyState& s) { w.compute(s, "FreeFloatingSolver.compute"); }, py::arg("state"),
@@ -101,9 +117,11 @@ void bindSolvers(py::module_& m) {
         return jacobian(w, c, "J_star", [](FreeFloatingSolver& s, const Contact& h, KDL::Jacobian& J) { return s.J_star(h, J); });
       }, py::arg("contact"), "Generalized Jacobian J* = J - R_h M_a^-1 A_m (eq. 4), (6, nj).")
       .def("G_star", [](FFS& w, const PyContact& c) {
+        needsMassMatrix(w, "G_star");
         return contact6(w, c, "G_star", [](FreeFloatingSolver& s, const Contact& h, Matrix6d& G) { return s.G_star(h, G); });
       }, py::arg("contact"), "Ex-IIT G* (eq. 11), twist per impulse, (6, 6).")
       .def("G_star", [](FFS& w, const std::vector<PyContact>& cs) {
+        needsMassMatrix(w, "G_star");
         std::vector<Contact> contacts;
         for (const PyContact& c : cs) {
           checkContact(*w.model.ptr, c);
@@ -120,6 +138,7 @@ void bindSolvers(py::module_& m) {
         return toNumpy(G);
       }, py::arg("contacts"), "The (6k, 6k) G* over k contacts: blocks J*_i H*^-1 J*_j^T + R_i M_a^-1 R_j^T.")
       .def("G_grounded", [](FFS& w, const PyContact& c) {
+        needsMassMatrix(w, "G_grounded");
         return contact6(w, c, "G_grounded", [](FreeFloatingSolver& s, const Contact& h, Matrix6d& G) { return s.G_grounded(h, G); });
       }, py::arg("contact"), "Grounded G = J H^-1 J^T (eq. 22), base held; may be singular, (6, 6).")
       .def("G_locked", [](FFS& w, const PyContact& c) {

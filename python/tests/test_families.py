@@ -245,8 +245,9 @@ def test_g_star_at_every_link_is_the_numpy_routes(family):
     base = ([0.3, -0.1, 0.2], [0.4, -0.3, 0.2])
     state = kdl_space.State(model, q=q, base_pose=base)
     solver, recursive = kdl_space.FreeFloatingSolver(model), kdl_space.RecursiveExIITSolver(model)
-    solver.compute(state)
-    recursive.compute(state)
+    light = kdl_space.FreeFloatingSolver(model, extent="jacobians")  # J* without an n x n matrix
+    for s in (solver, recursive, light):
+        s.compute(state)
     route = NumpyRobot(path, model.joint_names)
     world_T_base = homogeneous(rpy_matrix(*base[1]), base[0])
     offset = (0.05, -0.02, 0.1)
@@ -259,10 +260,17 @@ def test_g_star_at_every_link_is_the_numpy_routes(family):
             assert np.abs(G - G_ref).max() <= 1e-10 * scale, (family.name, link, G - G_ref)
         assert solver.J_star(contact).shape == (6, family.joints)
         assert solver.J(contact).shape == (6, family.joints)
+        assert np.array_equal(light.J_star(contact), solver.J_star(contact))
+        assert np.array_equal(light.J(contact), solver.J(contact))
+        with pytest.raises(kdl_space.ComputeError, match="extent='jacobians'"):
+            light.G_star(contact)
         figures = kdl_space.inspect_contact(state, contact)
         assert len(figures["J_star_singular_values"]) == min(6, family.joints)
     assert solver.w == pytest.approx(route.composite(world_T_base)[0], rel=1e-12)
     assert solver.H_star.shape == (family.joints, family.joints)
+    assert light.H_star.shape == (0, 0)
+    with pytest.raises(ValueError, match="extent: 'sparse' is not one of"):
+        kdl_space.FreeFloatingSolver(model, extent="sparse")
 
 
 @pytest.mark.parametrize("family", RIGID, ids=[f.name for f in RIGID])

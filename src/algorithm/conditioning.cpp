@@ -65,7 +65,7 @@ std::vector<Diagnostic> configurationWarnings(const FloatingModel& model, const 
 int checkConfiguration(const std::shared_ptr<const FloatingModel>& model, const State& state, const Contact& h,
                        Conditioning& c, std::vector<Diagnostic>& warnings) {
   warnings = configurationWarnings(*model, state.q, nullptr, "");
-  FreeFloatingSolver solver(model);
+  FreeFloatingSolver solver(model, FreeFloatingSolver::Extent::Jacobians);  // J* and J alone: O(n)
   KDL::Jacobian J_star(model->nj()), J(model->nj());
   int rc = solver.compute(state);
   if (rc == E_NOERROR) rc = solver.J_star(h, J_star);

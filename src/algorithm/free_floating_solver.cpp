@@ -8,13 +8,17 @@ namespace kdl_space {
 // The factorisations are sized here, constructed in place (assigning Eigen::LLT(n) would copy
 // its uninitialised info member: undefined behaviour, reported by UBSan; factorising the identity
 // to size them cost n^3 / 3 flops, seconds at thousands of joints).
-FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model)
+// With Extent::Jacobians every n x n member stays 0 x 0.
+FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> model, Extent extent)
     : model_(std::move(model)),
-      H_star_llt_(model_ ? static_cast<Eigen::Index>(model_->nj()) : 0),
-      H_llt_(model_ ? static_cast<Eigen::Index>(model_->nj()) : 0) {
+      extent_(extent),
+      H_star_llt_(model_ && extent == Extent::Full ? static_cast<Eigen::Index>(model_->nj()) : 0),
+      H_llt_(model_ && extent == Extent::Full ? static_cast<Eigen::Index>(model_->nj()) : 0) {
   if (!model_) throw ModelError("FreeFloatingSolver: null model");
+  if (extent != Extent::Full && extent != Extent::Jacobians) throw ModelError("FreeFloatingSolver: no such extent");
   const std::size_t nb = model_->bodies().size();
   const unsigned int n = model_->nj();
+  const unsigned int n_dense = extent == Extent::Full ? n : 0;
   world_T_body_.resize(nb);
   own_ = Kinematics(*model_);
   state_ = State(*model_);
@@ -26,11 +30,11 @@ FreeFloatingSolver::FreeFloatingSolver(std::shared_ptr<const FloatingModel> mode
   J_work_.setZero(6, n);
   X_work_.setZero(n, 6);
   dqdot_work_.setZero(n);
-  H_.resize(n);
-  H_star_.resize(n);
-  reserveContacts(2);  // dual-arm without allocation
+  H_.resize(n_dense);
+  H_star_.resize(n_dense);
+  if (extent == Extent::Full) reserveContacts(2);  // dual-arm without allocation
   locked_.assign(n, false);
-  H_locked_work_.setZero(n, n);
+  H_locked_work_.setZero(n_dense, n_dense);
 }
 
 void FreeFloatingSolver::setLocked(const std::vector<bool>& locked) {
@@ -65,6 +69,7 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
   if (kin.model != model_.get() || kin.R.size() != bodies.size()) return E_SIZE_MISMATCH;
   if (!kin.valid) return E_NOT_COMPUTED;
   world_T_base_ = kin.state.world_T_base;
+  const bool full = extent_ == Extent::Full;
   H_.data.setZero();
   for (std::size_t i = 0; i < bodies.size(); ++i) world_T_body_[i] = kin.pose(static_cast<int>(i));
   r_g_ = kin.r_g;
@@ -86,6 +91,7 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
     if (j < 0) continue;
     const Vector6d F = I_c_[b] * Sb_[b];  // momentum about r_g of the subtree moved by this joint
     A_m_.col(j) += F;
+    if (!full) continue;  // Extent::Jacobians: A_m only
     H_(j, j) += Sb_[b].dot(F);
     for (int a = bodies[b].parent; a >= 0; a = bodies[a].parent) {
       const int k = bodies[a].joint;
@@ -95,7 +101,8 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
       H_(j, k) += x;
     }
   }
-  for (unsigned int j = 0; j < n; ++j) H_(j, j) += model_->armature()[j];
+  if (full)
+    for (unsigned int j = 0; j < n; ++j) H_(j, j) += model_->armature()[j];
 
   I_g_ = I_c_[0].bottomRightCorner<3, 3>();  // eq. 3 (about r_g the coupling block vanishes)
   M_a_ = centroidInertia(w(), I_g_);          // eq. 12
@@ -106,6 +113,7 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
 
   Am_work_ = A_m_;
   M_a_solveInPlace(Am_work_);
+  if (!full) return finish(kin.state);
   H_star_.data = H_.data;
   H_star_.data.noalias() -= A_m_.transpose().lazyProduct(Am_work_);  // eq. 7
   symmetrize(H_star_.data);
@@ -133,10 +141,19 @@ int FreeFloatingSolver::compute(const Kinematics& kin) {
     H_star_llt_.compute(H_star_.data);
   }
   if (H_star_llt_.info() != Eigen::Success) return E_NOT_POSITIVE_DEFINITE;
-  state_.world_T_base = kin.state.world_T_base;
-  state_.q.data = kin.state.q.data;
+  return finish(kin.state);
+}
+
+int FreeFloatingSolver::finish(const State& state) {
+  state_.world_T_base = state.world_T_base;
+  state_.q.data = state.q.data;
   computed_ = true;
   return E_NOERROR;
+}
+
+int FreeFloatingSolver::readyDense(const Contact& h) const {
+  if (const int rc = ready(h)) return rc;
+  return extent_ == Extent::Full ? E_NOERROR : E_NOT_COMPUTED;
 }
 
 void FreeFloatingSolver::M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const {
@@ -175,7 +192,7 @@ int FreeFloatingSolver::baseTwist(const Vector6d& PL_g, const KDL::JntArray& qdo
 
 int FreeFloatingSolver::kineticEnergy(const KDL::Twist& base_twist, const KDL::JntArray& qdot,
                                       double& T) const {
-  if (!computed_) return E_NOT_COMPUTED;
+  if (!computed_ || extent_ != Extent::Full) return E_NOT_COMPUTED;
   if (qdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!allFinite(base_twist) || !qdot.data.allFinite()) return E_NOT_FINITE;
   const Vector6d y = shiftTwist(toEigen(base_twist), r_g_ - toEigen(world_T_base_.p));
@@ -254,6 +271,7 @@ int FreeFloatingSolver::G_locked(const Contact& h, Matrix6d& G) const {
 }
 
 int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
+  if (const int rc = readyDense(h)) return rc;
   Matrix6d G_star;
   if (const int rc = G_locked(h, G_star)) return rc;
   generalizedJacobian(h, J_work_);
@@ -268,7 +286,7 @@ int FreeFloatingSolver::G_star(const Contact& h, Matrix6d& G) {
 }
 
 int FreeFloatingSolver::G_grounded(const Contact& h, Matrix6d& G) {
-  if (const int rc = ready(h)) return rc;
+  if (const int rc = readyDense(h)) return rc;
   if (!H_ok_) return E_NOT_POSITIVE_DEFINITE;
   fixedBaseJacobian(h, J_work_);
   dropLocked(J_work_);
@@ -314,6 +332,8 @@ int FreeFloatingSolver::velocityJump(const Contact& h, Response response, const 
   if (const int rc = R_h(h, R)) return rc;
   if (dqdot.rows() != model_->nj()) return E_SIZE_MISMATCH;
   if (!F.allFinite()) return E_NOT_FINITE;
+  if (response != Response::JointsLocked)
+    if (const int rc = readyDense(h)) return rc;
   Vector6d dPL = Vector6d::Zero();
   dqdot_work_.setZero();
   switch (response) {
@@ -354,7 +374,7 @@ void FreeFloatingSolver::reserveContacts(std::size_t k) {
 int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::MatrixXd& G) {
   const Eigen::Index k = static_cast<Eigen::Index>(contacts.size());
   for (const Contact& h : contacts)
-    if (const int rc = ready(h)) return rc;
+    if (const int rc = readyDense(h)) return rc;
   if (G.rows() != 6 * k || G.cols() != 6 * k) return E_SIZE_MISMATCH;
   reserveContacts(contacts.size());  // no allocation up to the reserved count
   auto J_all = J_all_work_.topRows(6 * k);

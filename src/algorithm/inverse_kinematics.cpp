@@ -285,7 +285,7 @@ double reactionMeasure(const FloatingModel& model, const State& state, const Con
                        const std::vector<int>& joints) {
   // Not owned: the solver lives only for this call, within the caller's model's lifetime.
   const std::shared_ptr<const FloatingModel> shared(&model, [](const FloatingModel*) {});
-  FreeFloatingSolver solver(shared);
+  FreeFloatingSolver solver(shared, FreeFloatingSolver::Extent::Jacobians);
   KDL::Jacobian J_h(model.nj()), J_base(model.nj());
   int rc = solver.compute(state);
   if (rc == E_NOERROR) rc = solver.J_star(contact, J_h);

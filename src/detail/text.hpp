@@ -45,10 +45,13 @@ inline std::string number(double x) {
   return s.str();
 }
 
-/// "a, b, c" of names, for messages that list what a model has ("none" for an empty list).
+/// "a, b, c" of names, for messages that list what a model has ("none" for an empty list); of a
+/// longer list than 40 names the first 40 and "... and N more" (a model of thousands of links).
 inline std::string listNames(const std::vector<std::string>& names) {
+  constexpr std::size_t kShown = 40;
   std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  for (std::size_t i = 0; i < names.size() && i < kShown; ++i) list += (list.empty() ? "" : ", ") + names[i];
+  if (names.size() > kShown) list += ", ... and " + std::to_string(names.size() - kShown) + " more";
   return list.empty() ? "none" : list;
 }
 

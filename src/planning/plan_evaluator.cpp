@@ -89,7 +89,7 @@ void PlanEvaluator::setUpClosing() {
                      "moved to close on the grasp; plan with free joints");
   // The system's momentum is what the scenario's state gives: the arm's rates before the capture
   // change, the servicer's momentum does not (the base moves as they make it: MATH.md eq. 4).
-  dynamics_ = std::make_unique<FreeFloatingSolver>(robot.model);
+  dynamics_ = std::make_unique<FreeFloatingSolver>(robot.model, FreeFloatingSolver::Extent::Jacobians);
   if (const int rc = dynamics_->compute(robot.state))
     throw ModelError(std::string("closing_speed: the robot's dynamics at the scenario's state: ") + strError(rc));
   if (const int rc = dynamics_->momentum(robot.velocity.base_twist, robot.velocity.qdot, PL_g_))
@@ -97,7 +97,7 @@ void PlanEvaluator::setUpClosing() {
   if (const auto* other = std::get_if<FloatingSystem>(&scenario_.capture.target)) {
     // A free-floating target stays where the scenario puts it (timing is for a rigid one): its
     // grasp point's twist, once.
-    FreeFloatingSolver target(other->model);
+    FreeFloatingSolver target(other->model, FreeFloatingSolver::Extent::Jacobians);
     Vector6d PL_g;
     KDL::Twist t;
     int rc = target.compute(other->state);

@@ -37,7 +37,7 @@ ApproachController::ApproachController(std::shared_ptr<const FloatingModel> mode
 ApproachController::ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand,
                                        ApproachSpec spec, std::shared_ptr<ApproachTarget> target)
     : model_(std::move(model)), hand_(hand), spec_(std::move(spec)), target_(std::move(target)),
-      solver_(model_ ? model_ : throw ModelError("ApproachController: null model")) {
+      solver_(model_ ? model_ : throw ModelError("ApproachController: null model"), FreeFloatingSolver::Extent::Jacobians) {
   if (!target_) refuse("null target");
   const unsigned int n = model_->nj();
   if (hand_.body < 0 || hand_.body >= static_cast<int>(model_->bodies().size())) refuse("the hand is no body of the model");

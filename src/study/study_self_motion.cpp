@@ -8,7 +8,7 @@
 namespace kdl_space {
 
 SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact& h, const State& nominal)
-    : solver_(model), h_(h), J_(model->nj()) {
+    : solver_(model, FreeFloatingSolver::Extent::Jacobians), h_(h), J_(model->nj()) {
   if (solver_.compute(nominal) != E_NOERROR || solver_.J(h_, J_) != E_NOERROR)
     throw InputError("robot.self_motion: the arm's Jacobian cannot be computed at the scenario's state");
   for (unsigned int j = 0; j < model->nj(); ++j)

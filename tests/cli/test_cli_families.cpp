@@ -528,6 +528,63 @@ TEST_P(CliFamilies, CheckFindsNoError) {
   EXPECT_EQ(j.at("model").at("joint_names").size(), f.joints) << j.at("model").dump();
 }
 
+// Above kDenseJoints (a 501-link tree): inspect and capture take the O(n) routes (issue 35, item 8).
+// inspect's G* at each point and over both (cross blocks) equal the dense solver's, computed here;
+// H* is null and a diagnostic says why; capture conserves momentum.
+TEST(CliLargeModel, InspectAndCaptureTakeTheLinearRoutes) {
+  const std::string urdf = scratchIn("cli_large", "tree.urdf");
+  spit(urdf, largeTree(501));
+  const ToolRun run = kdlSpace("inspect --urdf " + urdf + " --tip l50 --offset 0.1 0 0 --tip l300 --q j3=0.4 j250=-1.1 --json");
+  ASSERT_TRUE(noSignal(run, "inspect"));
+  ASSERT_EQ(run.rc, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_TRUE(j.at("H_star").is_null());
+  bool noted = false;
+  for (const json& d : j.at("diagnostics")) noted |= d.get<std::string>().find("H* (n x n) is not formed above 400") != std::string::npos;
+  EXPECT_TRUE(noted) << j.at("diagnostics").dump();
+
+  const auto model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf));
+  State s(*model);
+  s.q(model->jointIndex("j3")) = 0.4;
+  s.q(model->jointIndex("j250")) = -1.1;
+  FreeFloatingSolver dense(model);
+  ASSERT_EQ(dense.compute(s), 0);
+  const std::vector<Contact> contacts{model->contact("l50", KDL::Vector(0.1, 0, 0)), model->contact("l300")};
+  Eigen::MatrixXd G_all(12, 12);
+  ASSERT_EQ(dense.G_star(contacts, G_all), 0);
+  const double scale = G_all.norm();
+  EXPECT_TRUE(near(matrixOf(j.at("G_star_all")), G_all, 0, 1e-10 * scale, "G* over both points"));
+  for (int i = 0; i < 2; ++i) {
+    Matrix6d G, G_grounded;
+    ASSERT_EQ(dense.G_star(contacts[i], G), 0);
+    ASSERT_EQ(dense.G_grounded(contacts[i], G_grounded), 0);
+    const json& c = j.at("contacts").at(i);
+    EXPECT_TRUE(near(matrixOf(c.at("G_star")), G, 0, 1e-10 * scale, "G*"));
+    EXPECT_TRUE(near(matrixOf(c.at("G_grounded")), G_grounded, 0, 1e-10 * scale, "G grounded"));
+    EXPECT_EQ(c.at("J_star").at(0).size(), 500u);
+  }
+
+  // A link it has not: the message lists the first 40 of its 501 links, not all.
+  const ToolRun missing = kdlSpace("inspect --urdf " + urdf + " --tip l9999");
+  EXPECT_EQ(missing.rc, 3) << missing.err;
+  EXPECT_NE(missing.err.find("has no link 'l9999' (its links: base, l1, l2,"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find(", l39, ... and 461 more)"), std::string::npos) << missing.err;
+  EXPECT_LT(missing.err.size(), 600u) << missing.err;
+
+  const std::string scenario = scratchIn("cli_large", "capture.yaml");
+  spit(scenario, "robot:\n  urdf: tree.urdf\n  contact: {link: l50}\n"
+                 "  base: {position: [0, 0, 0], rpy: [0, 0, 0], twist: [0.002, 0, 0, 0, 0, 0.001]}\n"
+                 "target:\n  mass: 50\n  inertia: [[2.1, 0, 0], [0, 2.6, 0], [0, 0, 3.0]]\n"
+                 "  pose: {position: [20, 0, 0], rpy: [0.3, -0.2, 0.5]}\n"
+                 "  twist: [0.03, -0.02, 0.01, 0.05, 0.08, -0.06]\nlaw:\n  type: capture\n");
+  const ToolRun cap = kdlSpace("capture " + scenario + " --json");
+  ASSERT_TRUE(noSignal(cap, "capture"));
+  ASSERT_EQ(cap.rc, 0) << cap.err;
+  const json c = json::parse(cap.out);
+  const Eigen::MatrixXd before = matrixOf(c.at("momentum_before")), after = matrixOf(c.at("momentum_after"));
+  EXPECT_TRUE(near(after, before, 0, 1e-10 * before.norm(), "momentum"));
+}
+
 std::string familyName(const ::testing::TestParamInfo<ModelFamily>& info) { return info.param.name; }
 INSTANTIATE_TEST_SUITE_P(EveryKindOfRobot, CliFamilies, ::testing::ValuesIn(modelFamilies()), familyName);
 

@@ -146,6 +146,55 @@ TEST_F(SolverCodes, WrongOutputSizesAndEnumValues) {
 
 // --- ForwardDynamicsSolver ---------------------------------------------------------------------
 
+// Extent::Jacobians: J, J*, momentum and the hand's twist as the full solver's (bit for bit: the
+// same operations); no n x n matrix; the queries that need H or H* return E_NOT_COMPUTED and
+// leave their outputs untouched.
+TEST_F(SolverCodes, TheJacobiansExtentAnswersWhatNeedsNoMassMatrix) {
+  FreeFloatingSolver light(model, FreeFloatingSolver::Extent::Jacobians);
+  EXPECT_EQ(light.extent(), FreeFloatingSolver::Extent::Jacobians);
+  State s(*model);
+  for (unsigned int j = 0; j < n; ++j) s.q(j) = 0.3 * j - 0.7;
+  ASSERT_EQ(solver.compute(s), E_NOERROR);
+  ASSERT_EQ(light.compute(s), E_NOERROR);
+  EXPECT_EQ(light.H().rows(), 0u);
+  EXPECT_EQ(light.H_star().rows(), 0u);
+  KDL::Jacobian J_full(n), J_light(n), Js_full(n), Js_light(n);
+  ASSERT_EQ(solver.J(tip, J_full), E_NOERROR);
+  ASSERT_EQ(light.J(tip, J_light), E_NOERROR);
+  ASSERT_EQ(solver.J_star(tip, Js_full), E_NOERROR);
+  ASSERT_EQ(light.J_star(tip, Js_light), E_NOERROR);
+  EXPECT_EQ(J_full.data, J_light.data);
+  EXPECT_EQ(Js_full.data, Js_light.data);
+  KDL::JntArray qdot(n);
+  for (unsigned int j = 0; j < n; ++j) qdot(j) = 0.1 * j;
+  const KDL::Twist base(KDL::Vector(0.01, 0.02, -0.01), KDL::Vector(0.001, 0.002, 0.003));
+  Vector6d PL_full, PL_light;
+  ASSERT_EQ(solver.momentum(base, qdot, PL_full), E_NOERROR);
+  ASSERT_EQ(light.momentum(base, qdot, PL_light), E_NOERROR);
+  EXPECT_EQ(PL_full, PL_light);
+  KDL::Twist t_full, t_light;
+  ASSERT_EQ(solver.handTwist(tip, qdot, PL_full, t_full), E_NOERROR);
+  ASSERT_EQ(light.handTwist(tip, qdot, PL_light, t_light), E_NOERROR);
+  EXPECT_TRUE(same(t_full, t_light));
+  Matrix6d G = Matrix6d::Constant(kSentinel), G_locked;
+  EXPECT_EQ(light.G_star(tip, G), E_NOT_COMPUTED);
+  EXPECT_EQ(light.G_grounded(tip, G), E_NOT_COMPUTED);
+  EXPECT_EQ(light.G(tip, Response::FreeFloating, G), E_NOT_COMPUTED);
+  EXPECT_EQ(G, Matrix6d::Constant(kSentinel));
+  EXPECT_EQ(light.G(tip, Response::JointsLocked, G_locked), E_NOERROR);
+  Eigen::MatrixXd G_all = Eigen::MatrixXd::Constant(6, 6, kSentinel);
+  EXPECT_EQ(light.G_star(std::vector<Contact>{tip}, G_all), E_NOT_COMPUTED);
+  Vector6d dPL = Vector6d::Constant(kSentinel);
+  KDL::JntArray dq(n);
+  EXPECT_EQ(light.velocityJump(tip, Response::FreeFloating, Vector6d::Ones(), dPL, dq), E_NOT_COMPUTED);
+  EXPECT_EQ(dPL, Vector6d::Constant(kSentinel));
+  EXPECT_EQ(light.velocityJump(tip, Response::JointsLocked, Vector6d::Ones(), dPL, dq), E_NOERROR);
+  double T = kSentinel;
+  EXPECT_EQ(light.kineticEnergy(base, qdot, T), E_NOT_COMPUTED);
+  EXPECT_EQ(T, kSentinel);
+  EXPECT_FALSE(light.groundedAvailable());
+}
+
 TEST(ForwardDynamicsCodes, CartToJntChecksEverySizeAndValue) {
   const ModelPtr model = arm7();
   const unsigned int n = model->nj();

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -20,6 +21,7 @@
 
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/algorithm/inspection.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/algorithm/recursive_ex_iit.hpp"
 #include "kdl_space/impact/capture.hpp"
@@ -171,6 +173,80 @@ TEST_P(Families, GStarAtEveryLinkEqualsTheVirtualJointRoute) {
       Conditioning k2;
       std::vector<Diagnostic> warnings;
       EXPECT_EQ(checkConfiguration(model, s, h, k2, warnings), 0);
+    }
+  }
+}
+
+/// The independent route's G* over several points and grounded G at one: the virtual-joint
+/// tree's J_full C and C^T M_full C; the grounded G from their joint blocks (J and H), or none
+/// where H is not positive definite.
+struct IndependentInertia {
+  Eigen::MatrixXd G_all;
+  std::vector<std::optional<Eigen::MatrixXd>> G_grounded;
+};
+IndependentInertia independentInertia(const FloatingModel& free, const State& u, const Coupling& c,
+                                      const std::vector<LinkPoint>& points) {
+  const VirtualJointTree vt(free, u);
+  const int n = static_cast<int>(c.T.cols()), m = static_cast<int>(c.T.rows());
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(6 + m, 6 + n);
+  C.topLeftCorner(6, 6).setIdentity();
+  C.bottomRightCorner(m, n) = c.T;
+  const Eigen::MatrixXd M = C.transpose() * vt.M_full() * C;
+  const Eigen::Index k = static_cast<Eigen::Index>(points.size());
+  Eigen::MatrixXd J(6 * k, 6 + n);
+  for (Eigen::Index i = 0; i < k; ++i) J.middleRows(6 * i, 6) = vt.J_full(points[i]) * C;
+  IndependentInertia out{J * M.llt().solve(J.transpose()), {}};
+  const Eigen::LLT<Eigen::MatrixXd> H(M.bottomRightCorner(n, n));
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const Eigen::MatrixXd Jq = J.block(6 * i, 6, 6, n);
+    if (n > 0 && H.info() != Eigen::Success) out.G_grounded.emplace_back();
+    else out.G_grounded.emplace_back(n == 0 ? Eigen::MatrixXd(Eigen::MatrixXd::Zero(6, 6)) : Eigen::MatrixXd(Jq * H.solve(Jq.transpose())));
+  }
+  return out;
+}
+
+// inspect's two routes (the dense one, and the O(n) one it takes above kDenseJoints, forced here
+// by dense_joints = 0) against the virtual-joint route: G* over all points with its cross
+// blocks, G* and the grounded G at each; J* and G_locked the same on both.
+TEST_P(Families, InspectionByBothRoutesEqualsTheVirtualJointRoute) {
+  const ModelFamily& f = GetParam();
+  const auto model = load(f);
+  const auto free = loadUncoupled(f);
+  const Coupling c = coupling(*model, *free);
+  std::mt19937 rng(35);
+  const KDL::Vector offset(0.05, -0.02, 0.1);
+  std::vector<std::string> links{f.contact, model->bodies()[0].name};
+  if (!f.other_contact.empty()) links.push_back(f.other_contact);
+  std::vector<Contact> contacts;
+  std::vector<LinkPoint> points;
+  for (const std::string& link : links) {
+    contacts.push_back(model->contact(link, offset));
+    points.push_back(LinkPoint{link, offset});
+  }
+  for (int trial = 0; trial < 3; ++trial) {
+    const State s = randomStateInLimits(*model, rng);
+    const IndependentInertia ref = independentInertia(*free, uncoupledState(s, *free, c), c, points);
+    Inspection dense, linear;
+    ASSERT_EQ(inspect(model, s, contacts, dense), 0) << f.name;
+    ASSERT_EQ(inspect(model, s, contacts, linear, {}, 0), 0) << f.name;
+    EXPECT_TRUE(dense.dense);
+    EXPECT_EQ(linear.dense, model->nj() == 0);  // no joint: nothing n x n to avoid
+    EXPECT_EQ(linear.H_star.size(), 0);
+    EXPECT_EQ(dense.H_star.rows(), static_cast<Eigen::Index>(model->nj()));
+    const double scale = ref.G_all.norm();
+    for (const Inspection* in : {&dense, &linear}) {
+      const std::string route = f.name + (in == &dense ? " dense" : " O(n)");
+      EXPECT_TRUE(near(in->G_star_all, ref.G_all, 0, 1e-10 * scale, route + ": G* over all points"));
+      ASSERT_EQ(in->contacts.size(), contacts.size());
+      for (std::size_t i = 0; i < contacts.size(); ++i) {
+        const ContactInspection& ci = in->contacts[i];
+        EXPECT_TRUE(near(ci.G_star, ref.G_all.block(6 * i, 6 * i, 6, 6), 0, 1e-10 * scale, route + " G* at " + links[i]));
+        ASSERT_EQ(ci.G_grounded.has_value(), ref.G_grounded[i].has_value()) << route << " at " << links[i];
+        if (ci.G_grounded)
+          EXPECT_TRUE(near(*ci.G_grounded, *ref.G_grounded[i], 0, 1e-10 * scale, route + " G grounded at " + links[i]));
+        EXPECT_TRUE(near(ci.J_star, dense.contacts[i].J_star, 0, 1e-12 * (1.0 + ci.J_star.norm()), route + " J*"));
+        EXPECT_TRUE(near(ci.G_locked, dense.contacts[i].G_locked, 0, 1e-14 * scale, route + " G locked"));
+      }
     }
   }
 }

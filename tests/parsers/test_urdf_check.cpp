@@ -2,6 +2,8 @@
 // file without errors loads, a file the loader refuses has errors, with the loader's words).
 #include <gtest/gtest.h>
 
+#include "model_families.hpp"
+
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -313,32 +315,10 @@ TEST(UrdfCheckMassRatio, SaysWhenTheLightLinkHangsOnAFixedJoint) {
 namespace kdl_space::test {
 namespace {
 
-/// A tree of `links` links: 10 arms of revolute joints (alternating axes) from a heavy base.
-std::string treeOf(int links) {
-  std::ostringstream x;
-  x << "<robot name=\"tree\">\n";
-  const auto link = [&](const std::string& name, double mass) {
-    x << "<link name=\"" << name << "\"><inertial><mass value=\"" << mass
-      << "\"/><inertia ixx=\"0.01\" iyy=\"0.02\" izz=\"0.015\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n";
-  };
-  link("base", 100.0);
-  const int arm = (links - 1) / 10;
-  for (int i = 1; i < links; ++i) {
-    link("l" + std::to_string(i), 1.0 + 0.001 * i);
-    const bool first = (i - 1) % arm == 0;
-    x << "<joint name=\"j" << i << "\" type=\"revolute\"><parent link=\"" << (first ? "base" : "l" + std::to_string(i - 1))
-      << "\"/><child link=\"l" << i << "\"/><origin xyz=\"0.1 0.02 0\" rpy=\"0 0 " << (first ? 0.6 * (i / arm) : 0.1)
-      << "\"/><axis xyz=\"" << (i % 3 == 0) << " " << (i % 3 == 1) << " " << (i % 3 == 2)
-      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>\n";
-  }
-  x << "</robot>\n";
-  return x.str();
-}
-
 TEST(UrdfCheck, ALargeModelIsMeasuredByTheLinearRouteWithTheSameGStar) {
-  // 501 links (500 joints), above kDenseCheckJoints: cond(H*) not computed (a note says why),
+  // 501 links (500 joints), above kDenseJoints: cond(H*) not computed (a note says why),
   // cond(G*) at the leaves by the O(n) recursion, equal to the dense route's (computed here).
-  const std::string xml = treeOf(501);
+  const std::string xml = largeTree(501);
   const UrdfReport r = checkUrdfString(xml, "tree.urdf");
   ASSERT_TRUE(r.errors.empty()) << ::testing::PrintToString(summary(r.errors));
   EXPECT_TRUE(std::isnan(r.model.condition_H_star));
@@ -355,7 +335,7 @@ TEST(UrdfCheck, ALargeModelIsMeasuredByTheLinearRouteWithTheSameGStar) {
     EXPECT_NEAR(condition, spectralFigures(G).condition, 1e-7 * spectralFigures(G).condition) << link;
   }
   // Below the bound the dense route still measures cond(H*).
-  EXPECT_TRUE(std::isfinite(checkUrdfString(treeOf(101), "small.urdf").model.condition_H_star));
+  EXPECT_TRUE(std::isfinite(checkUrdfString(largeTree(101), "small.urdf").model.condition_H_star));
 }
 
 }  // namespace

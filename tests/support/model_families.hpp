@@ -8,6 +8,7 @@
 
 #include <fstream>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,29 @@ inline const std::vector<ModelFamily>& modelFamilies() {
       {"massless_parts", "a_tool", {0, 0, 0}, "b_fore", 5, false},
   };
   return families;
+}
+
+/// Above the families: a tree of `links` links (the commands' O(n) routes from kDenseJoints = 400
+/// joints): 10 arms of revolute joints (alternating axes) from a heavy base.
+inline std::string largeTree(int links) {
+  std::ostringstream x;
+  x << "<robot name=\"tree\">\n";
+  const auto link = [&](const std::string& name, double mass) {
+    x << "<link name=\"" << name << "\"><inertial><mass value=\"" << mass
+      << "\"/><inertia ixx=\"0.01\" iyy=\"0.02\" izz=\"0.015\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n";
+  };
+  link("base", 100.0);
+  const int arm = (links - 1) / 10;
+  for (int i = 1; i < links; ++i) {
+    link("l" + std::to_string(i), 1.0 + 0.001 * i);
+    const bool first = (i - 1) % arm == 0;
+    x << "<joint name=\"j" << i << "\" type=\"revolute\"><parent link=\"" << (first ? "base" : "l" + std::to_string(i - 1))
+      << "\"/><child link=\"l" << i << "\"/><origin xyz=\"0.1 0.02 0\" rpy=\"0 0 " << (first ? 0.6 * (i / arm) : 0.1)
+      << "\"/><axis xyz=\"" << (i % 3 == 0) << " " << (i % 3 == 1) << " " << (i % 3 == 2)
+      << "\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>\n";
+  }
+  x << "</robot>\n";
+  return x.str();
 }
 
 }  // namespace kdl_space::test

@@ -18,6 +18,12 @@
 
 namespace kdl_space {
 
+/// \brief Up to this many joints the commands form the n x n matrices (H, H*, their
+/// factorisations and eigenvalues: O(n^2) memory, O(n^3) time); above it they take the O(n)
+/// routes (RecursiveExIITSolver, FreeFloatingSolver::Extent::Jacobians) and say so (note
+/// `large_model`), so that a robot of thousands of links is checked in linear time.
+constexpr unsigned int kDenseJoints = 400;
+
 /// \brief Computes, for one state of a FloatingModel, the centroid terms (w, r_g, I_g, M_a,
 /// A_m), the fixed-base H and the generalized inertia H* (eq. 7), and at any contact point the
 /// fixed-base J, the generalized Jacobian J* (eq. 4), the Ex-IIT G* (eq. 11), the grounded
@@ -39,7 +45,20 @@ namespace kdl_space {
 /// lie in [0, bodies().size()) or [0, nj()).
 class KDL_SPACE_EXPORT FreeFloatingSolver {
  public:
-  explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model);
+  /// \brief What compute() forms.
+  enum class Extent {
+    /// Everything above (H, H*, both factorised).
+    Full,
+    /// The centroid terms and A_m only, in O(n * depth) time and O(n) memory (no n x n matrix is
+    /// ever allocated): contactPoint, R_h, J, J*, G_locked, momentum, baseTwist and handTwist
+    /// answer; H() and H_star() are empty (0 x 0); G_star, G_grounded, G (but JointsLocked),
+    /// velocityJump (but JointsLocked) and kineticEnergy return E_NOT_COMPUTED; compute()
+    /// returns E_NOT_POSITIVE_DEFINITE only for a singular I_g. For the callers that need J* alone
+    /// (a configuration's conditioning, inverse kinematics, the approach's control law).
+    Jacobians
+  };
+  explicit FreeFloatingSolver(std::shared_ptr<const FloatingModel> model, Extent extent = Extent::Full);
+  Extent extent() const { return extent_; }
 
   const FloatingModel& model() const { return *model_; }
   const std::shared_ptr<const FloatingModel>& sharedModel() const { return model_; }
@@ -147,6 +166,10 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
 
  private:
   int ready(const Contact& h) const;
+  /// ready(h), and E_NOT_COMPUTED for a query that needs H or H* under Extent::Jacobians.
+  int readyDense(const Contact& h) const;
+  /// Keeps the state of a successful compute and marks the result ready.
+  int finish(const State& state);
   /// Fixed-base Jacobian of h into J (6 x n, sized).
   void fixedBaseJacobian(const Contact& h, Eigen::Ref<Matrix6Xd> J) const;
   /// J* of h into J_star (6 x n, sized), eq. 4.
@@ -157,6 +180,7 @@ class KDL_SPACE_EXPORT FreeFloatingSolver {
   void M_a_solveInPlace(Eigen::Ref<Matrix6Xd> x) const;
 
   std::shared_ptr<const FloatingModel> model_;
+  Extent extent_ = Extent::Full;
   Kinematics own_;  ///< for compute(State) only
   bool computed_ = false;
   bool H_ok_ = false;

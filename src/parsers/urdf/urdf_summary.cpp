@@ -33,10 +33,10 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
     summary.joints_treated_as_fixed = model->fixedJoints();
     summary.total_mass = model->totalMass();
     const double inf = std::numeric_limits<double>::infinity();
-    // Up to kDenseCheckJoints the dense route (H*, its eigenvalues: O(n^3)); above, the O(n)
+    // Up to kDenseJoints the dense route (H*, its eigenvalues: O(n^3)); above, the O(n)
     // recursion alone (G* at the tips; H* singular when an articulated inertia is not positive),
     // so that a robot of thousands of links is checked in linear time (issue 35, item 7).
-    const bool dense = model->nj() <= kDenseCheckJoints;
+    const bool dense = model->nj() <= kDenseJoints;
     std::optional<FreeFloatingSolver> solver;      // its n x n workspaces only when used
     std::optional<RecursiveExIITSolver> recursive;  // else the O(n) route alone
     if (dense) solver.emplace(model);
@@ -53,7 +53,7 @@ std::string measureModel(const std::string& xml, const std::vector<std::string>&
       if (!dense)
         report.notes.push_back(rules::note(
             "large_model", ElementType::File, "",
-            std::to_string(model->nj()) + " joints: cond(H*) is not computed above " + std::to_string(kDenseCheckJoints) +
+            std::to_string(model->nj()) + " joints: cond(H*) is not computed above " + std::to_string(kDenseJoints) +
                 " joints (a dense eigen-decomposition, O(n^3)); cond(G*) at the tips is, by the O(n) recursion"));
     } else {
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(solver->H_star().data, Eigen::EigenvaluesOnly);

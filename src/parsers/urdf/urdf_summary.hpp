@@ -17,10 +17,9 @@ namespace kdl_space::detail {
 /// file, `refused_by_loader` in the loader's words.
 /// \return the condition numbers in words, for a message ("at q = 0, cond(H*) = ..."), or why
 /// they were not computed.
-/// The most joints measured by the dense route (cond(H*) by its eigenvalues, O(n^3)); a larger
-/// model's G* at the tips comes from the O(n) recursion and cond(H*) is not computed (a note says so).
-constexpr unsigned int kDenseCheckJoints = 400;
-
+/// Up to kDenseJoints (free_floating_solver.hpp) the dense route (cond(H*) by its eigenvalues,
+/// O(n^3)); a larger model's G* at the tips comes from the O(n) recursion and cond(H*) is not
+/// computed (the note `large_model` says so).
 std::string measureModel(const std::string& xml, const std::vector<std::string>& tips, UrdfReport& report);
 
 }  // namespace kdl_space::detail
