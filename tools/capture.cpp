@@ -15,7 +15,7 @@
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/operation/overlap_check.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
-#include "scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 
 namespace kdl_space::cli {
 namespace {

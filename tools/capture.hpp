@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
-#include "scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/parsers/scenario/scenario_errors.hpp"
 

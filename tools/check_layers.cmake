@@ -2,6 +2,7 @@
 # A layer is a folder, the same under include/kdl_space/ and src/:
 #   0 spatial (and src/detail/)   1 multibody   2 algorithm   3 impact   4 simulation
 #   5 parsers (urdf/, scenario/)  6 operation   7 study       8 planning
+#   9 report (the JSON of the results, the output files: its own target over the library)
 #   (tools/, python/: anything)
 # A file of the library may include only files of its own folder's layer or lower ones, named by
 # their folder ("kdl_space/impact/capture.hpp", "multibody/model_rules.hpp", "detail/lanes.hpp");
@@ -11,8 +12,8 @@
 # Run: cmake -DSOURCE_DIR=<repo> -P tools/check_layers.cmake (ctest: layers).
 cmake_minimum_required(VERSION 3.16)
 
-set(kdl_space_layers spatial detail multibody algorithm impact simulation parsers operation study planning)
-set(kdl_space_ranks 0 0 1 2 3 4 5 6 7 8)
+set(kdl_space_layers spatial detail multibody algorithm impact simulation parsers operation study planning report)
+set(kdl_space_ranks 0 0 1 2 3 4 5 6 7 8 9)
 
 # The rank of a folder name (the first component of a path below include/kdl_space/ or src/).
 function(rank_of folder out)

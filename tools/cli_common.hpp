@@ -13,6 +13,8 @@
 #include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/parsers/input_file.hpp"  // checkInputFile, parseFiniteNumber
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 
 namespace CLI {
 class Validator;
@@ -34,44 +36,21 @@ const std::atomic<bool>& interruptFlag();
 struct Interrupted : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-/// \brief Why the last write failed, for a message: the system's reason (strerror(errno): "No
-/// space left on device"), or "disk full?" when the stream kept none.
-std::string writeFailure();
 
 /// \brief Throws Interrupted(`where` + "; no output written") once interruptFlag() is set: the
 /// commands without a long loop of their own (check, inspect, capture) poll it between their steps
 /// and before they write anything.
 void stopIfInterrupted(const std::string& where);
 
-/// A command-line mistake (exit 2).
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+// The report layer (JSON, output files, the writers) by its names: the shell calls it.
+using namespace kdl_space::report;
+/// A command-line mistake (exit 2): the report layer's, which refuses an output that would
+/// replace an input.
+using UsageError = report::UsageError;
+
 /// A model or an input that cannot be used (exit 3): the library's, which the scenario loader
 /// and the capture throw too.
 using InputError = kdl_space::InputError;
-
-using Json = nlohmann::ordered_json;
-
-/// \brief A JSON document as text (`indent` -1: one line). Whatever bytes a string holds are
-/// written: control characters escaped (`\u001b`), bytes that are not UTF-8 replaced by U+FFFD,
-/// never an exception at the end of a run (nlohmann's default throws type_error 316).
-inline std::string jsonText(const Json& j, int indent = -1) {
-  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
-}
-
-/// A matrix as a JSON array of rows; a column vector as a flat array.
-Json toJson(const Eigen::MatrixXd& m);
-
-/// The joints of the description that are not coordinates: [{"joint", "reason"}] (JSON key
-/// `joints_treated_as_fixed` beside every `joint_names`).
-Json fixedJointsJson(const FloatingModel& model);
-/// A matrix as a JSON array of rows, always: an r x c matrix is r arrays of c numbers, a column
-/// (c = 1) included (for matrices whose column count is the number of joints: J*, H*).
-Json toJsonRows(const Eigen::MatrixXd& m);
-
-/// Row labels of a twist or wrench: vx vy vz wx wy wz.
-const std::vector<std::string>& twistLabels();
 
 /// Smallest output width the text reports are laid out for.
 constexpr std::size_t kMinOutputWidth = 40;
@@ -114,53 +93,5 @@ std::pair<std::string, double> parseAssignment(const std::string& text, const st
 CLI::Validator finiteNumber();   ///< any finite number
 CLI::Validator positiveNumber(); ///< a finite number > 0
 
-/// \brief Refuses, before any work, an output file that could not be written: its folder is
-/// missing, not a folder or not writable, or the path is a folder. Throws InputError naming the
-/// option (e.g. "--csv run.csv: the folder 'out' does not exist").
-void checkOutputFile(const std::string& path, const std::string& option);
-
-/// A file a run reads, with what it is for messages ("the scenario file", "the robot's URDF").
-struct InputFile {
-  std::string what, path;
-};
-
-/// \brief No output replaces an input: throws UsageError (exit 2, before any work) when the output
-/// `path` of `option` is one of `inputs`, by canonical path or as the same file (device and inode:
-/// a hard or symbolic link to it), naming both ("--csv a.urdf: is the robot's URDF
-/// robots/a.urdf; it would be overwritten").
-void refuseOverwritingInputs(const std::string& option, const std::string& path, const std::vector<InputFile>& inputs);
-
-/// \brief Creates a new empty file `folder`/`stem`PID-XXXXXX (six random characters), exclusively
-/// (O_CREAT | O_EXCL: an existing name, a planted symbolic link included, is never opened or
-/// followed; mkostemp draws another), mode 0600, and returns its path; `fd`, if given, receives
-/// the open descriptor (else it is closed). The PID in the name lets a later run remove the
-/// temporaries of runs that are gone (removeStaleTemporaries). Throws InputError `where` +
-/// "cannot create a file in the folder ...: REASON".
-std::string createFreshFile(const std::string& folder, const std::string& stem, const std::string& where,
-                            int* fd = nullptr);
-
-/// \brief A file written under a fresh temporary name in the same folder (createFreshFile: created
-/// at construction, unpredictable, never through a link someone planted) and renamed into place by
-/// commit(), so that a failed run never leaves a partial file that looks complete; the temporary
-/// is removed if the object is destroyed without a commit.
-class AtomicFile {
- public:
-  /// `option` names the file in messages (e.g. "--csv"). Creates the temporary `.NAME.tmpPID-XXXXXX`
-  /// beside `path`; throws InputError if it cannot.
-  AtomicFile(std::string path, std::string option);
-  ~AtomicFile();
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-  const std::string& path() const { return path_; }
-  const std::string& tmp() const { return tmp_; }
-  /// Renames the temporary to the final name; throws InputError if that fails.
-  void commit();
-  /// Removes the final file after a commit (a later output failed); best effort.
-  void retract();
-
- private:
-  std::string path_, option_, tmp_;
-  bool committed_ = false;
-};
 
 }  // namespace kdl_space::cli

@@ -15,7 +15,7 @@
 #include "html_page.hpp"
 #include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
-#include "scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 
 namespace kdl_space::cli {
 namespace {

@@ -3,11 +3,11 @@
 #include <cmath>
 #include <sstream>
 
-#include "approach_report.hpp"
+#include "kdl_space/report/approach_report.hpp"
 #include "capture.hpp"
 #include "detail/text.hpp"
 #include "inspect.hpp"
-#include "motion_report.hpp"
+#include "kdl_space/report/motion_report.hpp"
 
 namespace kdl_space::cli {
 

@@ -11,7 +11,7 @@
 
 #include "cli_common.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
-#include "scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 
 namespace kdl_space::cli {
 

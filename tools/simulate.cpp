@@ -11,12 +11,12 @@
 
 #include "capture.hpp"
 #include "cli_common.hpp"
-#include "csv_writer.hpp"
+#include "kdl_space/report/csv_writer.hpp"
 #include "html_writer.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "operation_report.hpp"
-#include "plot_writer.hpp"
-#include "scene_writer.hpp"
+#include "kdl_space/report/plot_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 
 namespace kdl_space::cli {
 namespace {

@@ -16,9 +16,9 @@
 #include "capture.hpp"
 #include "html_writer.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
-#include "plot_writer.hpp"
-#include "study_plot.hpp"
-#include "study_table.hpp"
+#include "kdl_space/report/plot_writer.hpp"
+#include "kdl_space/report/study_plot.hpp"
+#include "kdl_space/report/study_table.hpp"
 
 namespace kdl_space::cli {
 namespace fs = std::filesystem;

@@ -10,7 +10,7 @@
 #include <kdl/frames.hpp>
 #include <sstream>
 
-#include "../../tools/scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 #include "cli_runner.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
@@ -18,8 +18,8 @@ namespace kdl_space::test {
 namespace {
 
 namespace fs = std::filesystem;
-using cli::equivalentBox;
-using cli::equivalentBoxEdges;
+using report::equivalentBox;
+using report::equivalentBoxEdges;
 
 const std::string kScenarios = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/";
 
@@ -39,7 +39,7 @@ TEST(EquivalentBox, ABoxsInertiaGivesBackItsEdges) {
   const Matrix3d Rm = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R.data);
   const Matrix3d I = Rm * boxMoments(m, e).asDiagonal() * Rm.transpose();
   const Vector3d com(0.32, -2.88, 1.69);
-  const cli::SceneBox box = equivalentBox(m, I, com);
+  const report::SceneBox box = equivalentBox(m, I, com);
   EXPECT_LT((box.size - Vector3d(1.1, 0.7, 0.4)).cwiseAbs().maxCoeff(), 1e-12) << box.size.transpose();
   EXPECT_LT((toEigen(box.pose.p) - com).norm(), 1e-15);
   const Matrix3d B = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(box.pose.M.data);

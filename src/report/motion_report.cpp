@@ -1,9 +1,9 @@
-#include "motion_report.hpp"
+#include "kdl_space/report/motion_report.hpp"
 
 #include <cmath>
 #include <sstream>
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 namespace {
 
 Json finiteOrNull(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
@@ -135,4 +135,4 @@ void printMotionReport(std::ostream& out, const MotionRecord& r) {
   if (!advice.empty()) out << "Hint: " << advice << "\n";
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

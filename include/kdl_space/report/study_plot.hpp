@@ -8,10 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 #include "kdl_space/study/study.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// \brief Histograms of the outcomes of the computed samples (status 0) of the table file `table`
 /// into out.tmp(): impulse force and moment, base rate (and the motion's peak), largest joint rate
@@ -35,4 +36,4 @@ std::vector<HeatMapCell> studyHeatMapCells(const Study& study, const StudySummar
 /// OUTCOME.STATISTIC) instead of a picture.
 void writeStudyHeatMap(const AtomicFile& out, const Study& study, const StudySummary& summary);
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

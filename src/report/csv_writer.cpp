@@ -1,11 +1,11 @@
-#include "csv_writer.hpp"
+#include "kdl_space/report/csv_writer.hpp"
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <iomanip>
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact)
     : file_(path, "--csv"), base_control_(base_control), contact_(contact) {
@@ -60,4 +60,4 @@ void CsvWriter::failed() const {
                    (errno ? std::string(": ") + std::strerror(errno) : std::string()));
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -12,10 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/study/study.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// The study's fingerprint as the table's head line and the summary JSON write it (16 hex digits).
 std::string fingerprintText(const Study& study);
@@ -115,4 +117,4 @@ class TableLock {
 /// Call it holding the table's lock. Best effort.
 void removeStaleTemporaries(const std::string& table, const std::string& parts);
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -12,12 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
-#include "gnuplot_text.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/report/gnuplot_text.hpp"
 #include "kdl_space/operation/motion_sample.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 constexpr std::size_t kJointsPerPanel = 10;
 
@@ -71,4 +72,4 @@ void writePlot(const AtomicFile& out, const std::vector<MotionSample>& samples, 
                const std::string& title, bool torques,
                double capture_time = std::numeric_limits<double>::quiet_NaN());
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -6,10 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 #include "kdl_space/operation/motion_sample.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 class CsvWriter {
  public:
@@ -36,4 +37,4 @@ class CsvWriter {
   [[noreturn]] void failed() const;
 };
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

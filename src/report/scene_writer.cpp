@@ -1,4 +1,4 @@
-#include "scene_writer.hpp"
+#include "kdl_space/report/scene_writer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@
 
 #include "kdl_space/multibody/kinematics.hpp"
 
-#include "gnuplot_text.hpp"
+#include "kdl_space/report/gnuplot_text.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 namespace {
 
 namespace fs = std::filesystem;
@@ -260,4 +260,4 @@ void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapsh
   runGnuplot(script.path(), file.tmp(), where);
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -1,10 +1,10 @@
-#include "approach_report.hpp"
+#include "kdl_space/report/approach_report.hpp"
 
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 Json approachJson(const Scenario& sc, const ApproachOutcome& o) {
   const ApproachRecord& r = o.record;
@@ -42,4 +42,4 @@ void printApproach(std::ostream& out, const Scenario& sc, const ApproachOutcome&
       << r.base_rotation * 180 / M_PI << " deg\n\n";
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -6,10 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 #include "kdl_space/operation/motion_record.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 Json limitViolationsJson(const MotionRecord& r);
 Json saturationJson(const MotionRecord& r);
@@ -25,4 +26,4 @@ Json frictionJson(const MotionRecord& r);
 /// base control, stiffness advice.
 void printMotionReport(std::ostream& out, const MotionRecord& r);
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

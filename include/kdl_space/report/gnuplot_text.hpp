@@ -14,9 +14,10 @@
 #include <sstream>
 #include <string>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// A scratch file removed when it goes out of scope (gnuplot's data, script and log), beside an
 /// AtomicFile's fresh temporary (its name + ".dat", ".gp"): created empty at once, exclusively
@@ -72,4 +73,4 @@ inline void runGnuplot(const std::string& script, const std::string& output, con
     throw InputError(where + "gnuplot failed" + (why.str().empty() ? std::string() : ": " + why.str()));
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

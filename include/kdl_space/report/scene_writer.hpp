@@ -16,14 +16,15 @@
 
 #include <kdl/frames.hpp>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/multibody/model.hpp"
 #include "kdl_space/multibody/overlap.hpp"
 #include "kdl_space/spatial/spatial.hpp"
 #include "kdl_space/multibody/state.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// A box: its centre and orientation (pose) and its edge lengths along its own axes [m].
 struct SceneBox {
@@ -74,4 +75,4 @@ std::string sceneTerminal(const std::string& path, std::size_t panels = 1, const
 void writeScene(const AtomicFile& file, const std::vector<SceneSnapshot>& snapshots, const std::string& title,
                 const std::string& option = "--scene");
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -1,4 +1,4 @@
-#include "study_plot.hpp"
+#include "kdl_space/report/study_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,11 +6,11 @@
 #include <iomanip>
 #include <limits>
 
-#include "gnuplot_text.hpp"
-#include "plot_writer.hpp"
-#include "study_table.hpp"
+#include "kdl_space/report/gnuplot_text.hpp"
+#include "kdl_space/report/plot_writer.hpp"
+#include "kdl_space/report/study_table.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 namespace {
 
 constexpr int kBins = 40;
@@ -138,4 +138,4 @@ void writeStudyHeatMap(const AtomicFile& out, const Study& study, const StudySum
   runGnuplot(script.path(), out.tmp(), where);
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

@@ -1,4 +1,4 @@
-#include "plot_writer.hpp"
+#include "kdl_space/report/plot_writer.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -9,7 +9,7 @@
 
 #include <kdl/frames.hpp>
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 namespace fs = std::filesystem;
 
@@ -168,4 +168,4 @@ void writePlot(const AtomicFile& out, const std::vector<MotionSample>& samples, 
   plot.draw(title, torques, capture_time);
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

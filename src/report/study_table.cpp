@@ -1,4 +1,4 @@
-#include "study_table.hpp"
+#include "kdl_space/report/study_table.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -13,7 +13,7 @@
 #include <ctime>
 #include <filesystem>
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 namespace fs = std::filesystem;
 
 std::string fingerprintText(const Study& study) {
@@ -319,4 +319,4 @@ void removeStaleTemporaries(const std::string& table, const std::string& parts) 
   }
 }
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report
