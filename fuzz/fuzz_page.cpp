@@ -17,8 +17,7 @@
 #include <sstream>
 #include <string>
 
-#include "cli_common.hpp"
-#include "html_writer.hpp"
+#include "kdl_space/report/html_writer.hpp"
 #include "input_folder.hpp"
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
@@ -89,8 +88,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const Scenario sc = loadScenario((root / "robot" / "scenario.yaml").string());
     const CaptureResult result = solveCapture(sc.capture);
-    cli::AtomicFile file(page, "--html");
-    cli::writeCaptureHtml(file, sc, result, "fuzz", {(root / "share").string()});
+    report::AtomicFile file(page, "--html");
+    report::writeCaptureHtml(file, sc, result, "fuzz", {(root / "share").string()});
     file.commit();
   } catch (const Error&) {
     return 0;  // a refused robot or scenario: the expected outcome for most inputs

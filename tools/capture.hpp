@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "kdl_space/report/capture_report.hpp"
 #include "kdl_space/report/scene_writer.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/parsers/scenario/scenario_errors.hpp"
@@ -33,20 +34,6 @@ auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
   return inScenarioFile(scenario, std::forward<F>(f));
 }
 
-/// The files a scenario makes a run read: the scenario, the robot's URDF, the target's URDF.
-std::vector<InputFile> scenarioInputs(const Scenario& scenario);
-
-/// \brief `point` (world) in the frame of `problem`'s target: a rigid target's `pose` frame, a
-/// free-floating target's base frame, at the problem's states.
-std::optional<Vector3d> pointInTargetFrame(const CaptureProblem& problem, const Vector3d& point);
-/// The `grasp` object of the capture JSON: robot.place: grasp's residuals; null without it.
-Json graspJson(const Scenario& scenario);
-/// The capture JSON object (the keys are a contract: see the README).
-Json captureJson(const Scenario& scenario, const CaptureResult& result);
-/// \brief The warnings about the robot's configuration at the capture (`problem`'s state and
-/// contact): a joint outside its limits, J* near a singularity (checkConfiguration), and a robot
-/// link that penetrates the target (overlapWarnings, moment "capture": the scenario's visuals).
-std::vector<Diagnostic> captureWarnings(const Scenario& scenario, const CaptureProblem& problem);
 /// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
 void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
 /// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr (the text runs'
@@ -55,16 +42,10 @@ void warnOnStderr(const std::vector<Diagnostic>& warnings);
 
 /// The readable summary.
 void printCaptureSummary(std::ostream& out, const Scenario& scenario, const CaptureResult& result);
-/// The `compliant` object of the capture and simulate JSON (law type compliant): what the contact
-/// gave, in the terms of captureJson's keys, and its history as columns.
-Json compliantJson(const CompliantCaptureResult& contact);
 /// The compliant contact's summary beside `limit`, the impulsive capture of the same contact.
 void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& contact, const CaptureResult& limit);
 
 CLI::App* addCapture(CLI::App& app, CaptureOptions& options);
-/// The picture of the impact instant: one snapshot "impact" (the robot at its state, its
-/// contact point, the target; a free-floating target's contact point as the grasp point).
-SceneSnapshot impactSnapshot(const Scenario& scenario);
 
 void runCapture(const CaptureOptions& options, std::ostream& out);
 

@@ -153,6 +153,21 @@ CLI::Validator positiveNumber() {
       "", "positive number");
 }
 
+CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs) {
+  const CLI::Validator folder(
+      [](std::string& dir) {
+        std::error_code ec;
+        return std::filesystem::is_directory(dir, ec) ? std::string() : dir + " is not a folder (give the folder that holds the package folders)";
+      },
+      "");
+  return cmd->add_option("--mesh-path", dirs,
+                         "A folder where the URDF's package://PACKAGE/... meshes are looked for (as DIR/PACKAGE/..., or "
+                         "DIR/... when DIR is named PACKAGE); repeatable, searched in order before ROS_PACKAGE_PATH")
+      ->type_name("DIR")->check(folder)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+
+
 namespace {
 std::atomic<bool> interrupt_flag{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the flag is set from a signal handler");

@@ -17,6 +17,8 @@
 #include "kdl_space/report/output_file.hpp"
 
 namespace CLI {
+class App;
+class Option;
 class Validator;
 }
 
@@ -92,6 +94,11 @@ std::pair<std::string, double> parseAssignment(const std::string& text, const st
 /// CLI11 validators with messages a user can act on (CLI11's own Range prints 300-digit bounds).
 CLI::Validator finiteNumber();   ///< any finite number
 CLI::Validator positiveNumber(); ///< a finite number > 0
+
+/// \brief `--mesh-path DIR` (repeatable) on a subcommand that writes a page: folders where a
+/// URDF's package:// meshes are looked for (DIR/PACKAGE/..., or DIR itself when it is named
+/// PACKAGE), before ROS_PACKAGE_PATH's. A DIR that is not a folder is a usage error.
+CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
 
 
 }  // namespace kdl_space::cli

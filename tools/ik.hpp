@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "kdl_space/report/ik_json.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
@@ -27,14 +28,6 @@ struct IkCliOptions {
 };
 
 CLI::App* addIk(CLI::App& app, IkCliOptions& options);
-
-/// The solution's keys (joint_names, q, q_by_name, moved_joints, the residuals, iterations,
-/// attempts, preference_gradient, reaction_measure); also kdl_space.ik's dict.
-Json ikSolutionJson(const FloatingModel& model, const IkResult& result);
-
-/// The JSON object of a solution: the scenario, contact and goal, then ikSolutionJson (keys are a
-/// contract: see the README).
-Json ikJson(const Scenario& scenario, const KDL::Frame& goal, const IkResult& result);
 
 void runIk(const IkCliOptions& options, std::ostream& out);
 

@@ -7,20 +7,11 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "kdl_space/report/inspection_json.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/multibody/poses.hpp"
 
 namespace kdl_space::cli {
-
-/// A pose as JSON: position, rotation (rows), quaternion (x, y, z, w), rpy.
-Json poseJson(const PoseFigures& figures);
-/// Conditioning as JSON: J_star_singular_values, J_star_condition_number (null if singular),
-/// J_star_manipulability, J_manipulability.
-Json conditioningJson(const Conditioning& c);
-/// Joint name -> {margin, to_lower, to_upper} (null for a continuous joint, or a side without limit).
-Json jointMarginsJson(const FloatingModel& model, const std::vector<JointMargin>& margins);
-/// The "warnings" list of the JSON outputs: [{kind, element, message}].
-Json warningsJson(const std::vector<Diagnostic>& warnings);
 
 struct InspectOptions {
   std::string urdf;

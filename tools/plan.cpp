@@ -48,18 +48,6 @@ void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
 
 }  // namespace
 
-Json termsJson(const PlanTerms& t) {
-  Json j;
-  j["objective"] = t.objective;
-  j["base_rate"] = t.base_rate;
-  j["impulse"] = t.impulse;
-  j["joint_rate_jump"] = t.joint_rate_jump;
-  j["feasible"] = t.feasible;
-  j["violation"] = t.violation;
-  if (!t.feasible) j["infeasible"] = t.infeasible;
-  return j;
-}
-
 CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
   CLI::App* cmd = app.add_subcommand(
       "plan", "Capture planning: over the self-motion, the wrist roll, the capture instant and the hand's closing "
@@ -115,34 +103,6 @@ PlanOptions planOptions(const PlanCliOptions& o) {
   p.polish_starts = o.polish_starts;
   p.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
   return p;
-}
-
-Json planJson(const Scenario& sc, const PlanOptions& options, const CapturePlan& plan) {
-  Json by_name = Json::object(), nominal_by_name = Json::object(), params = Json::object(), weights = Json::object();
-  for (std::size_t j = 0; j < plan.joint_names.size(); ++j) {
-    by_name[plan.joint_names[j]] = plan.q[j];
-    nominal_by_name[plan.joint_names[j]] = plan.nominal_q[j];
-  }
-  for (const auto& [name, value] : plan.parameters) params[name] = value;
-  for (const auto& [name, w] : options.weights) weights[name] = w;
-  Json j;
-  j["scenario"] = sc.file;
-  j["weights"] = weights;
-  j["joint_names"] = plan.joint_names;
-  j["q"] = plan.q;
-  j["q_by_name"] = by_name;
-  j["qdot_before"] = plan.qdot_before;
-  j["base_twist_before"] = plan.base_twist_before;
-  j["qdot_after"] = plan.qdot_after;
-  j["parameters"] = params;
-  j["searched"] = plan.searched;
-  j["objective"] = plan.optimum.objective;
-  j["optimum"] = termsJson(plan.optimum);
-  j["nominal_objective"] = plan.nominal.objective;
-  j["nominal"] = termsJson(plan.nominal);
-  j["nominal_q_by_name"] = nominal_by_name;
-  j["evaluations"] = plan.evaluations;
-  return j;
 }
 
 void runPlan(const PlanCliOptions& o, std::ostream& out) {

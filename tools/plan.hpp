@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "kdl_space/report/plan_json.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 
 namespace kdl_space::cli {
@@ -29,13 +30,6 @@ struct PlanCliOptions {
 };
 
 CLI::App* addPlan(CLI::App& app, PlanCliOptions& options);
-
-/// One configuration's terms: objective, base_rate, impulse, joint_rate_jump, feasible, violation
-/// (and infeasible: why not); also kdl_space.plan_capture's `optimum` and `nominal` dicts.
-Json termsJson(const PlanTerms& terms);
-
-/// The JSON object of a plan (keys are a contract: see the README).
-Json planJson(const Scenario& scenario, const PlanOptions& options, const CapturePlan& plan);
 
 /// \brief The library's options from the command line's. \throws UsageError naming the option.
 PlanOptions planOptions(const PlanCliOptions& options);

@@ -12,9 +12,10 @@
 #include "capture.hpp"
 #include "cli_common.hpp"
 #include "kdl_space/report/csv_writer.hpp"
-#include "html_writer.hpp"
+#include "kdl_space/report/html_writer.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
-#include "operation_report.hpp"
+#include "kdl_space/report/operation_report.hpp"
+#include "operation_text.hpp"
 #include "kdl_space/report/plot_writer.hpp"
 #include "kdl_space/report/scene_writer.hpp"
 
@@ -83,6 +84,7 @@ struct Streams {
     if (!o.html.empty()) {
       html_file = std::make_unique<AtomicFile>(o.html, "--html");
       html.emplace(sc, std::move(visuals));
+      warnOnStderr(html->warnings());  // the meshes it draws as boxes
     }
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {

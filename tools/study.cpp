@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "capture.hpp"
-#include "html_writer.hpp"
+#include "kdl_space/report/html_writer.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/report/plot_writer.hpp"
 #include "kdl_space/report/study_plot.hpp"
@@ -63,10 +63,11 @@ std::unique_ptr<AtomicFile> nominalSamplePage(const Study& st, const std::string
   const std::string title = "kdl_space study " + fs::path(st.file).filename().string() + ": the nominal sample";
   if (!(st.motion_duration > 0.0)) {
     const CaptureResult r = inScenario(sc, [&] { return solveCapture(sc.capture); });
-    writeCaptureHtml(*file, sc, r, title, mesh_search_path);
+    warnOnStderr(writeCaptureHtml(*file, sc, r, title, mesh_search_path));
     return file;
   }
   HtmlWriter page(sc, mesh_search_path);
+  warnOnStderr(page.warnings());  // the meshes it draws as boxes
   OperationOptions o;  // what a sample's motion runs (StudyEvaluator's motionPeaks)
   o.approach = false;
   o.duration = st.motion_duration;

@@ -5,8 +5,7 @@
 #include <filesystem>
 #include <functional>
 
-#include "cli_common.hpp"
-#include "html_writer.hpp"
+#include "kdl_space/report/html_writer.hpp"
 
 namespace kdl_space::python {
 namespace {
@@ -20,23 +19,32 @@ struct PyOperationRun {
 
 py::handle operation_result_type;  // kdl_space.OperationResult (kept alive by the module)
 
+/// The page's warnings (a mesh drawn as its box, a reference dropped) as Python warnings, each
+/// naming its link, as the tool prints them on stderr.
+void warnInPython(const std::vector<Diagnostic>& warnings) {
+  for (const Diagnostic& d : warnings) {
+    const std::string text = (d.element.empty() ? "" : d.element + ": ") + d.message;
+    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+  }
+}
+
 /// Refused as the tool refuses --html (three.js missing, a folder that cannot hold the file: OSError;
 /// a path that is one of the run's inputs: ValueError), then written under a temporary name and
 /// renamed: a failed call leaves no file. Every message names the path.
 void writePage(const std::string& path, const Scenario& sc, const std::vector<std::string>& mesh_search_path,
-               const std::function<void(const cli::AtomicFile&)>& draw) {
+               const std::function<void(const report::AtomicFile&)>& draw) {
   try {
-    if (path.empty()) throw cli::UsageError("to_html: the file name is empty");
-    cli::checkHtmlLibrary("to_html", path);
-    cli::checkOutputFile(path, "to_html");
-    std::vector<cli::InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
+    if (path.empty()) throw report::UsageError("to_html: the file name is empty");
+    report::checkHtmlLibrary("to_html", path);
+    report::checkOutputFile(path, "to_html");
+    std::vector<report::InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
                                           {"the target's URDF", sc.target_urdf}};
-    for (cli::InputFile& mesh : cli::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
-    cli::refuseOverwritingInputs("to_html", path, inputs);
-    cli::AtomicFile file(path, "to_html");
+    for (report::InputFile& mesh : report::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
+    report::refuseOverwritingInputs("to_html", path, inputs);
+    report::AtomicFile file(path, "to_html");
     draw(file);
     file.commit();
-  } catch (const cli::UsageError& e) {
+  } catch (const report::UsageError& e) {
     throw py::value_error(e.what());
   } catch (const InputError& e) {
     PyErr_SetString(PyExc_OSError, e.what());
@@ -48,7 +56,7 @@ void writePage(const std::string& path, const Scenario& sc, const std::vector<st
 /// tool's --mesh-path: each must be a folder (ValueError naming it); ROS_PACKAGE_PATH's come after.
 std::vector<std::string> meshSearchPathOf(const py::object& mesh_path) {
   std::vector<std::string> dirs;
-  if (mesh_path.is_none()) return cli::meshSearchPath(dirs);
+  if (mesh_path.is_none()) return report::meshSearchPath(dirs);
   const py::object fspath = py::module_::import("os").attr("fspath");
   const bool one = py::isinstance<py::str>(mesh_path) || py::hasattr(mesh_path, "__fspath__");
   for (const py::handle dir : one ? py::list(py::make_tuple(mesh_path)) : py::list(mesh_path)) {
@@ -58,7 +66,7 @@ std::vector<std::string> meshSearchPathOf(const py::object& mesh_path) {
       throw py::value_error("to_html: mesh_path " + d + " is not a folder (give the folder that holds the package folders)");
     dirs.push_back(d);
   }
-  return cli::meshSearchPath(dirs);
+  return report::meshSearchPath(dirs);
 }
 
 Phase phaseOf(const std::string& name) {
@@ -88,8 +96,9 @@ void operationToHtml(py::object self, const std::string& path, const py::object&
                           "not those run_operation returned");
   const std::string title = "kdl_space.run_operation " + std::filesystem::path(run.scenario->file).filename().string();
   const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
-  writePage(path, *run.scenario, search_path, [&](const cli::AtomicFile& file) {
-    cli::HtmlWriter page(*run.scenario, search_path);
+  writePage(path, *run.scenario, search_path, [&](const report::AtomicFile& file) {
+    report::HtmlWriter page(*run.scenario, search_path);
+    warnInPython(page.warnings());
     MotionSample x;
     x.q.resize(n);
     for (py::ssize_t i = 0; i < k; ++i) {
@@ -110,7 +119,7 @@ void captureToHtml(const PyResult& x, const std::string& path, const py::object&
   const std::string title = "kdl_space.solve_capture " + std::filesystem::path(x.scenario->file).filename().string();
   const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
   writePage(path, *x.scenario, search_path,
-            [&](const cli::AtomicFile& file) { cli::writeCaptureHtml(file, *x.scenario, x.r, title, search_path); });
+            [&](const report::AtomicFile& file) { warnInPython(report::writeCaptureHtml(file, *x.scenario, x.r, title, search_path)); });
 }
 
 py::object operationResultOf(py::dict d, std::shared_ptr<const Scenario> scenario, OperationResult result) {

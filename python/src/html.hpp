@@ -11,7 +11,7 @@
 
 namespace kdl_space::python {
 
-/// CaptureResult.to_html: the capture's instant (cli::writeCaptureHtml) into `path`; `mesh_path`
+/// CaptureResult.to_html: the capture's instant (report::writeCaptureHtml) into `path`; `mesh_path`
 /// (None, a folder, or a list of folders) as the tool's --mesh-path, ROS_PACKAGE_PATH's after it.
 void captureToHtml(const PyResult& result, const std::string& path, const py::object& mesh_path);
 

@@ -3,7 +3,8 @@
 // residuals and angles as attributes, when the pose is out of reach.
 #include "capture_types.hpp"
 #include "conversions.hpp"
-#include "ik.hpp"
+#include "json_objects.hpp"
+#include "kdl_space/report/ik_json.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "simulation_types.hpp"
 
@@ -12,7 +13,7 @@ namespace {
 
 /// The CLI's JSON keys (ikSolutionJson), q as a NumPy array.
 py::dict solutionDict(const FloatingModel& model, const IkResult& r) {
-  py::dict d = py::module_::import("json").attr("loads")(cli::jsonText(cli::ikSolutionJson(model, r), -1));
+  py::dict d = toPython(report::ikSolutionJson(model, r));
   d["q"] = toNumpyVec(r.q.data);
   return d;
 }

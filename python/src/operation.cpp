@@ -5,12 +5,13 @@
 #include <cmath>
 #include <exception>
 
-#include "capture.hpp"
+#include "kdl_space/report/capture_report.hpp"
 #include "capture_types.hpp"
 #include "conversions.hpp"
+#include "json_objects.hpp"
 #include "html.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
-#include "operation_report.hpp"
+#include "kdl_space/report/operation_report.hpp"
 #include "simulation_types.hpp"
 
 namespace kdl_space::python {
@@ -116,7 +117,7 @@ py::object runOperation(const PyScenario& ps, py::object duration, py::object ou
     if (partial) reportWarnings(partial->warnings);
     std::rethrow_exception(failed);
   }
-  const py::dict d = py::module_::import("json").attr("loads")(cli::jsonText(cli::operationJson(sc, r), -1));
+  const py::dict d = toPython(report::operationJson(sc, r));
   reportWarnings(r.warnings);  // the motion's warnings (also in d["warnings"]) as RuntimeWarnings
   d["samples"] = samplesDict(r);
   return operationResultOf(d, std::make_shared<const Scenario>(sc), std::move(r));  // a dict with to_html
@@ -158,7 +159,7 @@ py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object
       e.rethrowWithContext(sc.file + ": ");
     }
   }
-  return py::module_::import("json").attr("loads")(cli::jsonText(cli::compliantJson(c), -1));
+  return toPython(report::compliantJson(c));
 }
 
 }  // namespace

@@ -5,7 +5,8 @@
 #include "capture_types.hpp"
 #include "conversions.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
-#include "plan.hpp"
+#include "json_objects.hpp"
+#include "kdl_space/report/plan_json.hpp"
 #include "simulation_types.hpp"
 
 namespace kdl_space::python {
@@ -16,8 +17,8 @@ struct PyPlan {
   std::string scenario;
 };
 
-/// The tool's JSON of the terms (cli::termsJson) as a dict.
-py::dict termsDict(const PlanTerms& t) { return py::module_::import("json").attr("loads")(cli::jsonText(cli::termsJson(t), -1)); }
+/// The JSON of the terms (report::termsJson, as `plan --json` writes them) as a dict.
+py::dict termsDict(const PlanTerms& t) { return toPython(report::termsJson(t)); }
 
 std::optional<PlanRange> rangeOf(py::handle r, const char* name) {
   if (r.is_none()) return std::nullopt;

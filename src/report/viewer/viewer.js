@@ -1,63 +1,3 @@
-// The page of `--html` (html_writer.cpp): its head (the error hooks, before three.js loads) and
-// its body (the view, the controls and the script that poses the frames). The data
-// (window.KDL_DATA) and three.js are written between the two.
-#pragma once
-
-namespace kdl_space::cli {
-
-inline const char* const kHtmlHead = R"HTML(<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>kdl_space</title>
-<style>
- html, body { margin: 0; height: 100%; font: 13px sans-serif; background: #f4f5f7; color: #222; }
- #view { position: absolute; top: 0; left: 0; right: 0; bottom: 74px; }
- #bar { position: absolute; left: 0; right: 0; bottom: 0; height: 74px; padding: 4px 10px; box-sizing: border-box; background: #fff; border-top: 1px solid #ccc; }
- #slider { width: 100%; margin: 0; }
- #phasebar { position: relative; height: 8px; margin: 0 8px; }
- #phasebar div { position: absolute; top: 0; height: 8px; }
- #info { position: absolute; top: 6px; left: 10px; background: rgba(255,255,255,0.85); padding: 4px 8px; border-radius: 4px; max-width: 60%; }
- #note { color: #b00; font-weight: bold; }
- #selftest { display: none; }
- button, select, label { margin-right: 8px; }
- /* The linked plots (issue 27, item 3): two rows of small canvases between the view and the bar. */
- #plots { position: absolute; left: 0; right: 0; bottom: 74px; height: 240px; display: none; background: #fff; border-top: 1px solid #ccc; }
- body.with-plots #plots { display: grid; grid-template-rows: 1fr 1fr; grid-auto-flow: column; }
- body.with-plots #view { bottom: 314px; }
- #plots canvas { width: 100%; height: 100%; display: block; cursor: crosshair; min-width: 0; min-height: 0; }
- #plots div { position: relative; min-width: 0; min-height: 0; border-left: 1px solid #eee; }
-</style>
-<script>
- // The page's errors, kept for its tests (window.kdlSpace.errors) from the first script on.
- window.kdlSpace = { ready: false, errors: [], frameCount: 0 };
- window.addEventListener('error', function (e) { window.kdlSpace.errors.push(String(e.message || e)); });
- (function () {
-   var original = console.error;
-   console.error = function () {
-     window.kdlSpace.errors.push(Array.prototype.map.call(arguments, String).join(' '));
-     original.apply(console, arguments);
-   };
- })();
-</script>
-)HTML";
-
-inline const char* const kHtmlBody = R"HTML(</head><body>
-<div id="view"></div>
-<div id="plots"></div>
-<div id="info"><div id="title"></div><div id="note"></div><div id="time"></div><div id="legend"></div></div>
-<div id="bar">
- <div id="phasebar"></div>
- <input id="slider" type="range" min="0" max="0" value="0">
- <div>
-  <button id="play">play</button>
-  <label>speed <select id="speed"><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option><option>4</option><option>10</option></select></label>
-  <button id="impact">step to impact</button>
-  <label><input id="follow" type="checkbox"> camera follows the base</label>
-  <span>drag: orbit, wheel: zoom, right drag: pan</span>
- </div>
-</div>
-<pre id="selftest"></pre>
-<script>
 // --- The linked plots (issue 27, item 3) --------------------------------------------------------
 // Small canvas 2-D plots of the run's series (D.plots, D.series: float32, one row per frame, the
 // frames' times), the phases shaded as on the time line, a cursor at the slider's frame; a click
@@ -617,8 +557,3 @@ function kdlSpaceMain() {
    targetVisualBoxes: ok && K.targetVisualBoxes ? K.targetVisualBoxes() : [],
    targetLinkPoses: ok && K.targetLinkPose ? Array.apply(null, Array(K.targetLinkCount)).map(function (_, i) { return K.targetLinkPose(k, i); }) : [] });
 })();
-</script>
-</body></html>
-)HTML";
-
-}  // namespace kdl_space::cli

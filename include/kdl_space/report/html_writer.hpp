@@ -12,16 +12,15 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
+#include "kdl_space/report/output_file.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/parsers/urdf/urdf_visuals.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// Where the page's 3-D library comes from (Debian's libjs-three).
 inline const char* const kThreeJs = "/usr/share/javascript/three/three.min.js";
@@ -31,10 +30,6 @@ inline const char* const kOrbitControlsJs = "/usr/share/javascript/three/example
 inline const char* const kStlLoaderJs = "/usr/share/javascript/three/examples/js/loaders/STLLoader.js";
 inline const char* const kColladaLoaderJs = "/usr/share/javascript/three/examples/js/loaders/ColladaLoader.js";
 
-/// \brief `--mesh-path DIR` (repeatable) on a subcommand that writes a page: folders where a
-/// URDF's package:// meshes are looked for (DIR/PACKAGE/..., or DIR itself when it is named
-/// PACKAGE), before ROS_PACKAGE_PATH's. A DIR that is not a folder is a usage error.
-CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
 /// \brief The folders package:// meshes are searched in, in order: `mesh_path_options` (the
 /// --mesh-path folders), then the ROS_PACKAGE_PATH environment variable's (colon-separated). The
 /// tool reads the environment; the library is given the list (resolveMeshFile).
@@ -171,4 +166,4 @@ class HtmlWriter {
 std::vector<Diagnostic> writeCaptureHtml(const AtomicFile& file, const Scenario& scenario, const CaptureResult& result,
                       const std::string& title, const std::vector<std::string>& mesh_search_path = {});
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report

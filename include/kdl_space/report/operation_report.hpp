@@ -1,6 +1,6 @@
-// What `kdl_space simulate` reports of a capture operation (runCaptureOperation's result): its JSON
-// object (keys are a contract: add, never rename; also what Python's run_operation returns), its
-// text, and the scene at the start, the contact and the end.
+// What the reports say of a capture operation (runCaptureOperation's result): its JSON object (keys
+// are a contract: add, never rename; `simulate --json`, Python's run_operation), and the scene at
+// the start, the contact and the end.
 #pragma once
 
 #include <memory>
@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "kdl_space/report/json.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/report/scene_writer.hpp"
 
-namespace kdl_space::cli {
+namespace kdl_space::report {
 
 /// The output files named in the report (empty: none).
 struct OperationFiles {
@@ -23,9 +23,6 @@ struct OperationFiles {
 /// The JSON object of `kdl_space simulate --json`.
 Json operationJson(const Scenario& sc, const OperationResult& r, const OperationFiles& files = {});
 
-/// The readable summary of `kdl_space simulate`.
-void printOperation(std::ostream& out, const Scenario& sc, const OperationResult& r, const OperationFiles& files = {});
-
 /// The target's joints in the joined model, by their name there, and the sign of their coordinate.
 Json targetSigns(const JoinedSystem& joint, const std::shared_ptr<const FloatingModel>& model);
 
@@ -33,4 +30,4 @@ Json targetSigns(const JoinedSystem& joint, const std::shared_ptr<const Floating
 /// of the run.
 std::vector<SceneSnapshot> sceneSnapshots(const Scenario& sc, const OperationResult& r);
 
-}  // namespace kdl_space::cli
+}  // namespace kdl_space::report
