@@ -10,6 +10,8 @@ import numpy.typing as npt
 
 ArrayLike = npt.ArrayLike
 Array = npt.NDArray[np.float64]
+# Every call that takes a scenario takes a loaded Scenario or the path of its file.
+ScenarioLike = Union["Scenario", str, os.PathLike[str]]
 JointValues = Union[ArrayLike, Mapping[str, float]]
 Pose = Union[ArrayLike, Tuple[ArrayLike, ArrayLike]]
 
@@ -202,19 +204,19 @@ class OperationResult(dict[str, Any]):  # run_operation's dict (`simulate --json
     def to_html(self, path: str, mesh_path: Union[None, str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]] = None) -> None: ...  # the run as `kdl_space simulate --html` draws it; mesh_path: --mesh-path's folders
 
 def load_scenario(path: str) -> Scenario: ...
-def run_operation(scenario: Scenario, *, duration: Optional[float] = None, output_step: Optional[float] = None,
+def run_operation(scenario: ScenarioLike, *, duration: Optional[float] = None, output_step: Optional[float] = None,
                   approach: bool = True, motion: bool = True,
                   observer: Optional[Callable[[float, str, Array, Array], None]] = None,
                   controller: Optional["Controller"] = None, control_rate: Optional[float] = None,
                   max_output_rows: int = 10_000_000, check_gains: bool = True) -> OperationResult: ...
-def solve_capture(scenario_or_problem: Union[Scenario, CaptureProblem]) -> CaptureResult: ...
+def solve_capture(scenario_or_problem: Union[ScenarioLike, CaptureProblem]) -> CaptureResult: ...
 @overload
 def inverse_kinematics(state: State, contact: Contact, goal: Union[ArrayLike, Tuple[ArrayLike, ArrayLike]], *,
                        preferred: Union[None, ArrayLike, Mapping[str, float]] = None,
                        position_tolerance: float = 1e-10, orientation_tolerance: float = 1e-10,
                        restarts: int = 16, max_iterations: int = 500) -> dict[str, Any]: ...
 @overload
-def inverse_kinematics(scenario: Scenario, goal: Union[ArrayLike, Tuple[ArrayLike, ArrayLike]], *,
+def inverse_kinematics(scenario: ScenarioLike, goal: Union[ArrayLike, Tuple[ArrayLike, ArrayLike]], *,
                        preferred: Union[None, ArrayLike, Mapping[str, float]] = None,
                        position_tolerance: float = 1e-10, orientation_tolerance: float = 1e-10,
                        restarts: int = 16, max_iterations: int = 500) -> dict[str, Any]: ...
@@ -236,18 +238,12 @@ class CapturePlan:
     nominal: dict[str, Any]
     nominal_q_by_name: dict[str, float]
     evaluations: int
-@overload
-def plan_capture(scenario: Scenario, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
+def plan_capture(scenario: ScenarioLike, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
                  self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
                  timing: Optional[Tuple[float, float]] = None, closing_speed: Optional[Tuple[float, float]] = None,
                  scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
 @overload
-def plan_capture(scenario: str, *, objective: str = "base_rate", weights: Optional[Mapping[str, float]] = None,
-                 self_motion: Optional[Tuple[float, float]] = None, wrist_roll: Optional[Tuple[float, float]] = None,
-                 timing: Optional[Tuple[float, float]] = None, closing_speed: Optional[Tuple[float, float]] = None,
-                 scan: int = 21, polish_starts: int = 5) -> CapturePlan: ...
-@overload
-def attach_target(scenario_or_problem: Scenario, result: CaptureResult) -> Model: ...
+def attach_target(scenario_or_problem: ScenarioLike, result: CaptureResult) -> Model: ...
 @overload
 def attach_target(scenario_or_problem: CaptureProblem, result: CaptureResult) -> Model: ...
 
@@ -327,7 +323,7 @@ class Simulator:
                  gravity: Optional[ArrayLike] = None, grounded: bool = False, effort_limits: bool = True,
                  joint_friction: bool = True, friction_velocity: float = 1e-3, friction_rate: float = 1e3) -> None: ...
     @staticmethod
-    def from_scenario(scenario: Scenario, model: Optional[Model] = None) -> Simulator: ...
+    def from_scenario(scenario: ScenarioLike, model: Optional[Model] = None) -> Simulator: ...
     model: Model
     joint_names: list[str]
     options: dict[str, object]
@@ -370,7 +366,7 @@ class Study:
     def summary(self, rows: ArrayLike) -> dict[str, Any]: ...
 
 def load_study(path: str) -> Study: ...
-def self_motion(scenario: Scenario, s: float) -> dict[str, float]: ...
+def self_motion(scenario: ScenarioLike, s: float) -> dict[str, float]: ...
 
 class StudyResult:
     study: Study

@@ -188,9 +188,10 @@ void bindCapture(py::module_& m) {
   m.def("load_scenario", [](const std::string& path) { return PyScenario{loadScenario(path)}; }, py::arg("path"),
         "Reads and checks a scenario file (YAML or JSON); InputError 'FILE[:LINE]: FIELD: what is wrong' (a URDF "
         "that loads no model: the loader's ModelError, with the same 'FILE:LINE: robot.urdf: ' in front).");
-  m.def("solve_capture", [](const PyScenario& s) {
-    if (!s.scenario.impact) throw py::value_error("scenario: '" + s.scenario.file + "' has no target and no law (a plain motion)");
-    return solve(s.scenario.capture, std::make_shared<const Scenario>(s.scenario), s.scenario.robot_urdf);
+  m.def("solve_capture", [](const ScenarioArg& s) {
+    const Scenario& sc = s.get();
+    if (!sc.impact) throw py::value_error("scenario: '" + sc.file + "' has no target and no law (a plain motion)");
+    return solve(sc.capture, std::make_shared<const Scenario>(sc), sc.robot_urdf);
   }, py::arg("scenario_or_problem"), "Solves a scenario's capture (GIL released): a CaptureResult; InputError (or a side's ModelError) naming "
      "the part.");
   m.def("solve_capture", [](const PyProblem& p) { return solve(p.problem, scenarioOf(p), ""); }, py::arg("scenario_or_problem"),
@@ -198,7 +199,7 @@ void bindCapture(py::module_& m) {
   const auto attach = [](const CaptureProblem& p, const PyResult& r, const std::string& source) {
     return Model{attachTarget(p, r.r), source};  // an Error naming the part
   };
-  m.def("attach_target", [attach](const PyScenario& s, const PyResult& r) { return attach(s.scenario.capture, r, s.scenario.robot_urdf); },
+  m.def("attach_target", [attach](const ScenarioArg& s, const PyResult& r) { return attach(s.get().capture, r, s.get().robot_urdf); },
         py::arg("scenario_or_problem"), py::arg("result"),
         "The Model that moves on after the impact solved by `result`: after a rigid capture of a rigid target, the "
         "robot with the target merged into its contact link (the same joints); after a point impact, the robot's "

@@ -92,9 +92,9 @@ void bindInverseKinematics(py::module_& m) {
       py::arg("max_iterations") = 500, doc);
   m.def(
       "inverse_kinematics",
-      [](const PyScenario& s, py::object goal, py::object preferred, const std::string& prefer,
+      [](const ScenarioArg& s, py::object goal, py::object preferred, const std::string& prefer,
          double position_tolerance, double orientation_tolerance, unsigned int restarts, unsigned int max_iterations) {
-        const FloatingSystem& robot = s.scenario.capture.robot;
+        const FloatingSystem& robot = s.get().capture.robot;
         return solve(robot.model, robot.state, robot.contact, goal, preferred, prefer, position_tolerance, orientation_tolerance,
                      restarts, max_iterations);
       },

@@ -56,10 +56,10 @@ py::dict samplesDict(const OperationResult& r) {
   return d;
 }
 
-py::object runOperation(const PyScenario& ps, py::object duration, py::object output_step, bool approach, bool motion,
+py::object runOperation(const ScenarioArg& ps, py::object duration, py::object output_step, bool approach, bool motion,
                       py::object observer, py::object controller, py::object control_rate,
                       std::uint64_t max_output_rows, bool check_gains) {
-  const Scenario& sc = ps.scenario;
+  const Scenario& sc = ps.get();
   OperationOptions o;
   if (!duration.is_none()) {
     o.duration = argumentAs<double>(duration, "duration", "a number of seconds");
@@ -142,9 +142,9 @@ CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damp
   return g;
 }
 
-py::object solveCompliant(const PyScenario& ps, py::object stiffness, py::object damping, py::object damping_time,
+py::object solveCompliant(const ScenarioArg& ps, py::object stiffness, py::object damping, py::object damping_time,
                           py::object catch_tolerance, py::object max_duration, py::object normal) {
-  const Scenario& sc = ps.scenario;
+  const Scenario& sc = ps.get();
   if (!sc.impact) throw py::value_error("scenario: a plain motion has no target to capture");
   const CompliantGrasp g = graspOf(sc, stiffness, damping, damping_time, catch_tolerance, max_duration, normal);
   CompliantCaptureResult c;

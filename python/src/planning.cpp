@@ -112,19 +112,9 @@ void bindPlanning(py::module_& m) {
       "for nothing to plan, an unknown term or a bad weight.";
   m.def(
       "plan_capture",
-      [=](const PyScenario& s, const std::string& objective, py::object weights, py::object self_motion, py::object wrist_roll,
+      [=](const ScenarioArg& s, const std::string& objective, py::object weights, py::object self_motion, py::object wrist_roll,
           py::object timing, py::object closing_speed, unsigned int scan, unsigned int polish_starts) {
-        return plan(s.scenario, {objective, weights, self_motion, wrist_roll, timing, closing_speed, scan, polish_starts});
-      },
-      py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
-      py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),
-      py::arg("closing_speed") = py::none(), py::arg("scan") = 21, py::arg("polish_starts") = 5, doc);
-  m.def(
-      "plan_capture",
-      [=](const std::string& path, const std::string& objective, py::object weights, py::object self_motion,
-          py::object wrist_roll, py::object timing, py::object closing_speed, unsigned int scan, unsigned int polish_starts) {
-        const Scenario sc = loadScenario(path);
-        return plan(sc, {objective, weights, self_motion, wrist_roll, timing, closing_speed, scan, polish_starts});
+        return plan(s.get(), {objective, weights, self_motion, wrist_roll, timing, closing_speed, scan, polish_starts});
       },
       py::arg("scenario"), py::kw_only(), py::arg("objective") = "base_rate", py::arg("weights") = py::none(),
       py::arg("self_motion") = py::none(), py::arg("wrist_roll") = py::none(), py::arg("timing") = py::none(),

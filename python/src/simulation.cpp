@@ -166,8 +166,8 @@ std::unique_ptr<PySimulator> makeSimulator(const Model& model, py::object integr
 /// The simulator as `kdl_space simulate` builds it from a scenario (makeSimulator, parsers/scenario/scenario.hpp),
 /// for the scenario's robot or `model`, after checking that `model` has every joint and link the scenario's
 /// simulation names (makeSimulator finds them by name and would be handed none).
-std::unique_ptr<PySimulator> fromScenario(const PyScenario& ps, py::object model_obj) {
-  const Scenario& sc = ps.scenario;
+std::unique_ptr<PySimulator> fromScenario(const ScenarioArg& ps, py::object model_obj) {
+  const Scenario& sc = ps.get();
   const FloatingSystem& robot = sc.capture.robot;
   const Model model = model_obj.is_none() ? Model{robot.model, sc.robot_urdf} : py::cast<Model>(model_obj);
   const auto need = [&](unsigned int j) {

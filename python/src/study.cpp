@@ -280,14 +280,14 @@ void bindStudy(py::module_& m) {
         return r.str();
       });
 
-  m.def("self_motion", [](const PyScenario& scenario, double s) {
+  m.def("self_motion", [](const ScenarioArg& scenario, double s) {
     std::vector<double> q;
     {
       py::gil_scoped_release nogil;
-      q = selfMotionJoints(scenario.scenario, s);
+      q = selfMotionJoints(scenario.get(), s);
     }
     py::dict out;
-    const std::vector<std::string>& names = scenario.scenario.capture.robot.model->jointNames();
+    const std::vector<std::string>& names = scenario.get().capture.robot.model->jointNames();
     for (std::size_t j = 0; j < names.size(); ++j) out[py::str(names[j])] = q[j];
     return out;
   }, py::arg("scenario"), py::arg("s"),

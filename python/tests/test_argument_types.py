@@ -39,3 +39,29 @@ def test_a_wrong_type_is_a_type_error_naming_the_argument(scenario, model, argum
         call(scenario, model)
     assert argument in str(e.value), str(e.value)
     assert "expected" in str(e.value), str(e.value)
+
+
+# One rule (issue 36): every call that takes a scenario takes a loaded Scenario or the path of its
+# file, as str or os.PathLike; the same answer either way; a path it cannot read is the loader's
+# InputError naming the file, anything else a TypeError.
+def test_every_scenario_call_takes_a_scenario_or_its_path(tmp_path):
+    import pathlib
+    import numpy as np
+    import kdl_space
+    from conftest import SOURCE_DIR
+    path = SOURCE_DIR / "scenarios" / "tumbling_box_capture.yaml"
+    loaded = kdl_space.load_scenario(str(path))
+    for given in (loaded, str(path), pathlib.Path(path)):
+        r = kdl_space.solve_capture(given)
+        assert np.array_equal(r.impulse.F, kdl_space.solve_capture(loaded).impulse.F)
+        assert kdl_space.attach_target(given, r).nj == loaded.robot.nj
+        assert kdl_space.run_operation(given, duration=0.05, approach=False)["capture"]["impulse"] == \
+            kdl_space.run_operation(loaded, duration=0.05, approach=False)["capture"]["impulse"]
+        assert kdl_space.self_motion(given, 0.1) == kdl_space.self_motion(loaded, 0.1)
+        assert kdl_space.Simulator.from_scenario(given).joint_names == loaded.robot.joint_names
+        plan = kdl_space.plan_capture(given, scan=3, polish_starts=1)
+        assert np.array_equal(plan.q, kdl_space.plan_capture(loaded, scan=3, polish_starts=1).q)
+    with pytest.raises(kdl_space.InputError, match="missing.yaml"):
+        kdl_space.run_operation(str(tmp_path / "missing.yaml"))
+    with pytest.raises(TypeError):
+        kdl_space.run_operation(42)
