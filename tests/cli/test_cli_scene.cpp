@@ -1,5 +1,5 @@
 // `kdl_space capture --scene FILE`: the 3-D picture of the impact (gnuplot, .svg or .png), and
-// the equivalent box of inertia it draws for every body (tools/scene_writer.hpp, header-only).
+// the equivalent box of inertia it draws for every body (kdl_space/report/scene_writer.hpp).
 #include <gtest/gtest.h>
 #include <unistd.h>
 

@@ -1,0 +1,51 @@
+"""The reports after they moved into the report layer (issue 36) against what the tool printed
+before (tests/data/golden/reports, README there): capture, ik, plan and inspect --json of the
+shipped scenarios, the same keys, strings and nulls and the numbers within 1e-9; and Python's
+dicts (run_operation, ik, plan_capture) from the same report JSON the tool prints."""
+import json
+import subprocess
+
+import pytest
+
+from conftest import SOURCE_DIR
+from test_operation import assert_same
+
+GOLDEN = SOURCE_DIR / "tests" / "data" / "golden" / "reports"
+SCENARIOS = SOURCE_DIR / "scenarios"
+
+
+def tool_json(cli, *args):
+    out = subprocess.run([cli, *args], capture_output=True, text=True, timeout=600, cwd=SCENARIOS)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("name", sorted(p.name.split(".")[0] for p in GOLDEN.glob("*.capture.json")))
+def test_capture_json_is_what_the_tool_printed_before(cli, name):
+    before = json.loads((GOLDEN / f"{name}.capture.json").read_text())
+    assert_same(before, tool_json(cli, "capture", f"{name}.yaml", "--json"), 1e-9, 1e-12)
+
+
+@pytest.mark.parametrize("what,args", [
+    ("ik", ["ik", "tumbling_box_capture.yaml", "--position", "0.6,0.2,0.3", "--json"]),
+    ("plan", ["plan", "tumbling_box_capture.yaml", "--json"]),
+    ("inspect", ["inspect", "--urdf", "../urdf/spacedyn_twolink.urdf", "--tip", "hand", "--json"]),
+])
+def test_ik_plan_and_inspect_json_are_what_the_tool_printed_before(cli, what, args):
+    before = json.loads((GOLDEN / f"{what}.json").read_text())
+    assert_same(before, tool_json(cli, *args), 1e-9, 1e-12)
+
+
+def test_python_dicts_are_the_tools_json(cli):
+    """Without text in between (json_objects.cpp): the same keys and values, exactly."""
+    import kdl_space
+    scenario = SCENARIOS / "tumbling_box_capture.yaml"
+    ik = kdl_space.ik(str(scenario), ([0.6, 0.2, 0.3], [0, 0, 0]))  # position, rpy
+    tool = tool_json(cli, "ik", "tumbling_box_capture.yaml", "--position", "0.6,0.2,0.3", "--json")
+    assert {"q_by_name", "position_residual", "moved_joints"} <= ik.keys() & tool.keys()
+    for key, value in ik.items():
+        if key in tool:
+            assert json.loads(json.dumps(value if not hasattr(value, "tolist") else value.tolist())) == tool[key], key
+    plan = kdl_space.plan_capture(scenario)
+    tool_plan = tool_json(cli, "plan", "tumbling_box_capture.yaml", "--json")
+    assert plan.optimum == tool_plan["optimum"] and plan.nominal == tool_plan["nominal"]
