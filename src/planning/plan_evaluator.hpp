@@ -12,7 +12,7 @@
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
-#include "study/study_self_motion.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 
 namespace kdl_space {
 

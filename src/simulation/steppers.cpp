@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "detail/rosenbrock.hpp"
+#include "simulation/rosenbrock.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space::detail {

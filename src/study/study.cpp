@@ -11,7 +11,7 @@
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 #include "study/study_sampling.hpp"
-#include "study/study_self_motion.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 
 namespace kdl_space {
 

@@ -12,7 +12,7 @@
 #include "kdl_space/study/study.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
 #include "study/study_sampling.hpp"
-#include "study/study_self_motion.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 
 namespace kdl_space {
 namespace {

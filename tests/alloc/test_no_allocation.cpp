@@ -20,7 +20,7 @@
 #include "kdl_space/simulation/simulation.hpp"
 #include "kdl_space/simulation/sampled_control.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
-#include "detail/rosenbrock.hpp"
+#include "simulation/rosenbrock.hpp"
 #include "generated_chain.hpp"
 #include "test_util.hpp"
 

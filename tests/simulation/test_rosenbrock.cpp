@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "detail/rosenbrock.hpp"
+#include "simulation/rosenbrock.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space::test {

@@ -8,7 +8,7 @@
 
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "study/study_sampling.hpp"
-#include "study/study_self_motion.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 
 namespace kdl_space {
 namespace {

@@ -1,4 +1,4 @@
-#include "study/study_self_motion.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 
 #include <Eigen/SVD>
 #include <cmath>

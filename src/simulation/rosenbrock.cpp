@@ -1,6 +1,6 @@
 // RODAS3 (Sandu et al. 1997): one step with its embedded error estimate. See rosenbrock.hpp for
 // the method's equations and the finite-difference Jacobian.
-#include "detail/rosenbrock.hpp"
+#include "simulation/rosenbrock.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,17 +1,18 @@
 // The self-motion of a redundant arm: joint motions that keep the hand's pose (the base held),
 // the one-parameter family of configurations that grasp the same point the same way. What a
-// study's `robot.self_motion` samples. Private to the library.
+// study's `robot.self_motion` samples and `plan` searches (kdl_space.self_motion in Python).
 #pragma once
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/export.hpp"
 
 namespace kdl_space {
 
 /// \brief Moves along the self-motion of the joints on the path to contact h.
-class SelfMotion {
+class KDL_SPACE_EXPORT SelfMotion {
  public:
   /// \throws InputError "robot.self_motion: ..." unless the path to h has exactly one joint more
   /// than its Jacobian's rank 6 at `nominal` (a one-parameter self-motion).
