@@ -6,8 +6,7 @@
 #   (tools/, python/: anything)
 # A file of the library may include only files of its own folder's layer or lower ones, named by
 # their folder ("kdl_space/impact/capture.hpp", "multibody/model_rules.hpp", "detail/lanes.hpp");
-# the flat paths include/kdl_space/<name>.hpp are forwarding headers for downstream code (one
-# release), which the library itself never includes. A folder with no layer fails the check: give
+# no header stands at include/kdl_space/<name>.hpp (the flat paths of an earlier release are gone). A folder with no layer fails the check: give
 # it one here and in docs/ARCHITECTURE.md. Also refuses a library file of more than 450 lines.
 # Run: cmake -DSOURCE_DIR=<repo> -P tools/check_layers.cmake (ctest: layers).
 cmake_minimum_required(VERSION 3.16)
@@ -27,7 +26,10 @@ function(rank_of folder out)
 endfunction()
 
 set(problems "")
-file(GLOB forwarders RELATIVE "${SOURCE_DIR}/include/kdl_space" "${SOURCE_DIR}/include/kdl_space/*.hpp")
+file(GLOB flat RELATIVE "${SOURCE_DIR}" "${SOURCE_DIR}/include/kdl_space/*.hpp")
+foreach(rel IN LISTS flat)
+  string(APPEND problems "${rel}: a header outside the layers' folders: move it into one (include/kdl_space/<layer>/)\n")
+endforeach()
 file(GLOB_RECURSE files RELATIVE "${SOURCE_DIR}" "${SOURCE_DIR}/include/kdl_space/*/*.hpp" "${SOURCE_DIR}/src/*.hpp"
      "${SOURCE_DIR}/src/*.cpp")
 foreach(rel IN LISTS files)
@@ -56,11 +58,7 @@ foreach(rel IN LISTS files)
     endif()
     string(REGEX REPLACE "/.*" "" theirs_folder "${path}")
     if(path STREQUAL theirs_folder)
-      if(path IN_LIST forwarders)
-        string(APPEND problems "${rel} includes ${included}, a forwarding header: name its folder (kdl_space/<layer>/...)\n")
-      else()
-        string(APPEND problems "${rel} includes ${included}, which is in no layer's folder\n")
-      endif()
+      string(APPEND problems "${rel} includes ${included}, which is in no layer's folder\n")
       continue()
     endif()
     rank_of("${theirs_folder}" theirs)
@@ -70,17 +68,6 @@ foreach(rel IN LISTS files)
       string(APPEND problems "${rel} (${folder}, layer ${mine}) includes ${included} (${theirs_folder}, layer ${theirs}): an upward edge\n")
     endif()
   endforeach()
-endforeach()
-# Every forwarding header names one header of a layer's folder that exists.
-foreach(name IN LISTS forwarders)
-  if(name STREQUAL "export.hpp")
-    continue()
-  endif()
-  file(STRINGS "${SOURCE_DIR}/include/kdl_space/${name}" target REGEX "^#include \"kdl_space/")
-  string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" target "${target}")
-  if(NOT target OR NOT EXISTS "${SOURCE_DIR}/include/${target}")
-    string(APPEND problems "include/kdl_space/${name}: a forwarding header must include the header it stands for\n")
-  endif()
 endforeach()
 # Python stands on the library and the report layer: a file of python/src/ includes the library's
 # headers (kdl_space/...) and the module's own, never the tool's (tools/).

@@ -1,4 +1,0 @@
-// Deprecated path, kept for one release: the header is now kdl_space/impact/collision.hpp.
-#pragma once
-
-#include "kdl_space/impact/collision.hpp"

@@ -1,4 +1,0 @@
-// Deprecated path, kept for one release: the header is now kdl_space/algorithm/forward_dynamics.hpp.
-#pragma once
-
-#include "kdl_space/algorithm/forward_dynamics.hpp"

@@ -1,4 +1,0 @@
-// Deprecated path, kept for one release: the header is now kdl_space/algorithm/momentum.hpp.
-#pragma once
-
-#include "kdl_space/algorithm/momentum.hpp"

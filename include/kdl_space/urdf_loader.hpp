@@ -1,4 +1,0 @@
-// Deprecated path, kept for one release: the header is now kdl_space/parsers/urdf/urdf_loader.hpp.
-#pragma once
-
-#include "kdl_space/parsers/urdf/urdf_loader.hpp"
