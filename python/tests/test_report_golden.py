@@ -33,7 +33,14 @@ def test_capture_json_is_what_the_tool_printed_before(cli, name):
 ])
 def test_ik_plan_and_inspect_json_are_what_the_tool_printed_before(cli, what, args):
     before = json.loads((GOLDEN / f"{what}.json").read_text())
-    assert_same(before, tool_json(cli, *args), 1e-9, 1e-12)
+    now = tool_json(cli, *args)
+    if what == "plan":
+        # The optimiser's path (BOBYQA's evaluations) follows the last bits of the objective, which
+        # move with the build (a unity batch's inlining into the x86-64-v3 clones, where GCC fuses
+        # multiply-adds): the count within 5 %, the optimum it finds at 1e-9.
+        a, b = before.pop("evaluations"), now.pop("evaluations")
+        assert abs(a - b) <= 0.05 * a, (a, b)
+    assert_same(before, now, 1e-9, 1e-12)
 
 
 def test_python_dicts_are_the_tools_json(cli):
