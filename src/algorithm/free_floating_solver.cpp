@@ -379,16 +379,22 @@ int FreeFloatingSolver::G_star(const std::vector<Contact>& contacts, Eigen::Matr
   reserveContacts(contacts.size());  // no allocation up to the reserved count
   auto J_all = J_all_work_.topRows(6 * k);
   auto X = X_all_work_.leftCols(6 * k);
+  const bool joints = model_->nj() > 0;  // none: no J* term (and no block of a 6k x 0 matrix: PITFALLS)
   for (Eigen::Index i = 0; i < k; ++i) {
     if (const int rc = R_h(contacts[i], R_all_work_[i])) return rc;
+    if (!joints) continue;
     generalizedJacobian(contacts[i], J_work_);
     dropLocked(J_work_);
     J_all.middleRows<6>(6 * i) = J_work_;
   }
-  X = J_all.transpose();
-  for (Eigen::Index c = 0; c < X.cols(); ++c) H_star_llt_.solveInPlace(X.col(c));  // one factorisation of H*
   auto G_all = G_all_work_.topLeftCorner(6 * k, 6 * k);
-  G_all.noalias() = J_all.lazyProduct(X);
+  if (joints) {
+    X = J_all.transpose();
+    for (Eigen::Index c = 0; c < X.cols(); ++c) H_star_llt_.solveInPlace(X.col(c));  // one factorisation of H*
+    G_all.noalias() = J_all.lazyProduct(X);
+  } else {
+    G_all.setZero();
+  }
   for (Eigen::Index i = 0; i < k; ++i) {
     Matrix6d Y = R_all_work_[i].transpose();
     M_a_solveInPlace(Y);
