@@ -93,17 +93,37 @@ State uncoupledState(const State& s, const FloatingModel& free, const Coupling& 
   return u;
 }
 
-/// G of the independent route: KDL's six-virtual-joint tree of the uncoupled robot, coupled by
-/// hand: (J_full C) (C^T M_full C)^-1 (J_full C)^T, C = diag(1_6, T).
-Eigen::MatrixXd independentG(const FloatingModel& free, const State& u, const Coupling& c, const LinkPoint& h) {
+/// The independent route: KDL's six-virtual-joint tree of the uncoupled robot, coupled by hand
+/// (C = diag(1_6, T)). G* over several points, (J_full C) (C^T M_full C)^-1 (J_full C)^T, and the
+/// grounded G at each from the joint blocks (J and H), or none where H is not positive definite.
+struct IndependentInertia {
+  Eigen::MatrixXd G_all;
+  std::vector<std::optional<Eigen::MatrixXd>> G_grounded;
+};
+IndependentInertia independentInertia(const FloatingModel& free, const State& u, const Coupling& c,
+                                      const std::vector<LinkPoint>& points) {
   const VirtualJointTree vt(free, u);
   const int n = static_cast<int>(c.T.cols()), m = static_cast<int>(c.T.rows());
   Eigen::MatrixXd C = Eigen::MatrixXd::Zero(6 + m, 6 + n);
   C.topLeftCorner(6, 6).setIdentity();
   C.bottomRightCorner(m, n) = c.T;
-  const Eigen::MatrixXd J = vt.J_full(h) * C;
   const Eigen::MatrixXd M = C.transpose() * vt.M_full() * C;
-  return J * M.llt().solve(J.transpose());
+  const Eigen::Index k = static_cast<Eigen::Index>(points.size());
+  Eigen::MatrixXd J(6 * k, 6 + n);
+  for (Eigen::Index i = 0; i < k; ++i) J.middleRows(6 * i, 6) = vt.J_full(points[i]) * C;
+  IndependentInertia out{J * M.llt().solve(J.transpose()), {}};
+  const Eigen::LLT<Eigen::MatrixXd> H(M.bottomRightCorner(n, n));
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const Eigen::MatrixXd Jq = J.block(6 * i, 6, 6, n);
+    if (n > 0 && H.info() != Eigen::Success) out.G_grounded.emplace_back();
+    else out.G_grounded.emplace_back(n == 0 ? Eigen::MatrixXd(Eigen::MatrixXd::Zero(6, 6)) : Eigen::MatrixXd(Jq * H.solve(Jq.transpose())));
+  }
+  return out;
+}
+
+/// G* at one point by the independent route.
+Eigen::MatrixXd independentG(const FloatingModel& free, const State& u, const Coupling& c, const LinkPoint& h) {
+  return independentInertia(free, u, c, {h}).G_all;
 }
 
 /// A scenario of the family with a rigid box at the contact, the law given, written into a folder
@@ -177,33 +197,6 @@ TEST_P(Families, GStarAtEveryLinkEqualsTheVirtualJointRoute) {
   }
 }
 
-/// The independent route's G* over several points and grounded G at one: the virtual-joint
-/// tree's J_full C and C^T M_full C; the grounded G from their joint blocks (J and H), or none
-/// where H is not positive definite.
-struct IndependentInertia {
-  Eigen::MatrixXd G_all;
-  std::vector<std::optional<Eigen::MatrixXd>> G_grounded;
-};
-IndependentInertia independentInertia(const FloatingModel& free, const State& u, const Coupling& c,
-                                      const std::vector<LinkPoint>& points) {
-  const VirtualJointTree vt(free, u);
-  const int n = static_cast<int>(c.T.cols()), m = static_cast<int>(c.T.rows());
-  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(6 + m, 6 + n);
-  C.topLeftCorner(6, 6).setIdentity();
-  C.bottomRightCorner(m, n) = c.T;
-  const Eigen::MatrixXd M = C.transpose() * vt.M_full() * C;
-  const Eigen::Index k = static_cast<Eigen::Index>(points.size());
-  Eigen::MatrixXd J(6 * k, 6 + n);
-  for (Eigen::Index i = 0; i < k; ++i) J.middleRows(6 * i, 6) = vt.J_full(points[i]) * C;
-  IndependentInertia out{J * M.llt().solve(J.transpose()), {}};
-  const Eigen::LLT<Eigen::MatrixXd> H(M.bottomRightCorner(n, n));
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const Eigen::MatrixXd Jq = J.block(6 * i, 6, 6, n);
-    if (n > 0 && H.info() != Eigen::Success) out.G_grounded.emplace_back();
-    else out.G_grounded.emplace_back(n == 0 ? Eigen::MatrixXd(Eigen::MatrixXd::Zero(6, 6)) : Eigen::MatrixXd(Jq * H.solve(Jq.transpose())));
-  }
-  return out;
-}
 
 // inspect's two routes (the dense one, and the O(n) one it takes above kDenseJoints, forced here
 // by dense_joints = 0) against the virtual-joint route: G* over all points with its cross
