@@ -19,7 +19,7 @@
 
 namespace kdl_space::fuzz {
 
-/// inspect's quantities at the scenario's robot contact (tools/inspect.cpp's calls).
+/// inspect's quantities at the scenario's robot contact (tools/inspect_command.cpp's calls).
 inline void driveInspect(const FloatingSystem& robot) {
   const auto& model = robot.model;
   FreeFloatingSolver solver(model);

@@ -88,7 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const Scenario sc = loadScenario((root / "robot" / "scenario.yaml").string());
     const CaptureResult result = solveCapture(sc.capture);
-    report::AtomicFile file(page, "--html");
+    AtomicFile file(page, "--html");
     report::writeCaptureHtml(file, sc, result, "fuzz", {(root / "share").string()});
     file.commit();
   } catch (const Error&) {

@@ -18,7 +18,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space::cli {
 
@@ -187,6 +187,16 @@ const std::atomic<bool>& interruptFlag() { return interrupt_flag; }
 
 void stopIfInterrupted(const std::string& where) {
   if (interrupt_flag.load()) throw Interrupted(where + "; no output written");
+}
+
+void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings) {
+  for (const Diagnostic& d : warnings)
+    out << "Warning: " << (d.element.empty() ? "" : d.element + ": ") << d.message << "\n";
+}
+
+void warnOnStderr(const std::vector<Diagnostic>& warnings) {
+  for (const Diagnostic& d : warnings)
+    std::cerr << "kdl_space: warning: " << (d.element.empty() ? "" : d.element + ": ") << d.message << "\n";
 }
 
 }  // namespace kdl_space::cli

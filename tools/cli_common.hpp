@@ -14,7 +14,9 @@
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/parsers/input_file.hpp"  // checkInputFile, parseFiniteNumber
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/parsers/scenario/scenario_errors.hpp"
 
 namespace CLI {
 class App;
@@ -48,7 +50,7 @@ void stopIfInterrupted(const std::string& where);
 using namespace kdl_space::report;
 /// A command-line mistake (exit 2): the report layer's, which refuses an output that would
 /// replace an input.
-using UsageError = report::UsageError;
+
 
 /// A model or an input that cannot be used (exit 3): the library's, which the scenario loader
 /// and the capture throw too.
@@ -99,6 +101,21 @@ CLI::Validator positiveNumber(); ///< a finite number > 0
 /// URDF's package:// meshes are looked for (DIR/PACKAGE/..., or DIR itself when it is named
 /// PACKAGE), before ROS_PACKAGE_PATH's. A DIR that is not a folder is a usage error.
 CLI::Option* addMeshPathOption(CLI::App* cmd, std::vector<std::string>& dirs);
+
+
+/// \brief Runs `f` (a library call on the scenario's capture problem); an Error it throws
+/// ("target: ...") comes back of the same kind with the scenario's file in front ("FILE: target:
+/// ...").
+template <typename F>
+auto inScenario(const Scenario& scenario, F&& f) -> decltype(f()) {
+  return inScenarioFile(scenario, std::forward<F>(f));
+}
+
+/// One line "Warning: ELEMENT: MESSAGE" per warning (the text reports' form of a warning).
+void printWarnings(std::ostream& out, const std::vector<Diagnostic>& warnings);
+/// \brief One line "kdl_space: warning: ELEMENT: MESSAGE" per warning on stderr (the text runs'
+/// warnings, and an approach's start warnings before it runs, which a failed run shows no other way).
+void warnOnStderr(const std::vector<Diagnostic>& warnings);
 
 
 }  // namespace kdl_space::cli

@@ -3,14 +3,14 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "capture.hpp"
-#include "check.hpp"
+#include "capture_command.hpp"
+#include "check_command.hpp"
 #include "cli_common.hpp"
-#include "ik.hpp"
-#include "inspect.hpp"
-#include "plan.hpp"
-#include "simulate.hpp"
-#include "study.hpp"
+#include "ik_command.hpp"
+#include "inspect_command.hpp"
+#include "plan_command.hpp"
+#include "simulate_command.hpp"
+#include "study_command.hpp"
 #include "terminal_text.hpp"
 
 int main(int argc, char** argv) {
@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
   } catch (const kdl_space::Cancelled& e) {  // a library call polled the Ctrl-C flag
     std::cerr << "kdl_space: interrupted: " << e.what() << "; no output written\n";
     return kInterrupted;
-  } catch (const UsageError& e) {
+  } catch (const kdl_space::UsageError& e) {
     std::cerr << "kdl_space: " << e.what() << "\n";
     return kUsage;
   } catch (const kdl_space::Error& e) {  // a model or an input the library refused: its message

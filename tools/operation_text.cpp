@@ -3,8 +3,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "capture.hpp"
-#include "detail/text.hpp"
+#include "capture_text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/report/approach_report.hpp"
 #include "kdl_space/report/motion_report.hpp"
 

@@ -84,7 +84,7 @@ from ._kdl_space import (  # noqa: F401  (re-exported)
     E_CANCELLED,
     NEAR_SINGULAR_RATIO,
 )
-from .study import StudyResult, study  # noqa: F401  (the engines: threads, Dask)
+from .study import StudyResult, study, study_to_table  # noqa: F401  (the engines: threads, Dask)
 
 ik = inverse_kinematics  # the short name (as the command `kdl_space ik`)
 
@@ -97,7 +97,7 @@ __all__ = [
     "check_urdf", "codes", "ik", "inverse_kinematics",
     "load_scenario", "load_study", "load_urdf", "plan_capture", "run_operation", "self_motion", "solve_capture",
     "solve_compliant_capture", "solve_impact",
-    "str_error", "study", "virtual_mass",
+    "str_error", "study", "study_to_table", "virtual_mass",
     "E_NOERROR", "E_SIZE_MISMATCH", "E_NOT_COMPUTED", "E_NOT_FINITE", "E_NOT_POSITIVE_DEFINITE",
     "E_BAD_CONTACT", "E_MAX_STEPS", "E_BAD_ARGUMENT", "E_STEP_UNDERFLOW", "E_CANCELLED",
 ]

@@ -15,13 +15,12 @@ cluster's shared file system, or the same checkout on every machine); a worker w
 import math
 import os
 import threading
-import zlib
 
 import numpy as np
 
 from ._kdl_space import InputError, Study, load_study
 
-__all__ = ["study", "StudyResult"]
+__all__ = ["study", "study_to_table", "StudyResult"]
 
 _ENGINES = ("threads", "dask")
 
@@ -207,11 +206,32 @@ def study(study, *, engine="threads", threads=0, client=None, scheduler=None, ch
     return StudyResult(s, table)
 
 
-def _c_double(x):
-    """x as C's printf("%.17g") writes it (glibc): Python's %-formatting agrees, but for NaN's sign."""
-    if x != x:
-        return "-nan" if math.copysign(1.0, x) < 0 else "nan"
-    return "%.17g" % x
+def study_to_table(study, table, *, threads=0, shard=None, merge=(), chunk_size=None):
+    """Runs a study to its table file, as ``kdl_space study STUDY -o TABLE`` does (the library's
+    runStudyToTable): the rows in chunks kept in ``TABLE.parts/`` until the table is whole (a call
+    stopped by Ctrl-C keeps them, and the same call resumes), one run at a time on a table (its
+    lock), the summary from the rows as they are written (never the whole table in memory).
+
+    study: a study file's path, or a :class:`Study`. threads: 0 for all cores. shard: ``(i, n)``,
+    rows of shard i of n only (1 <= i <= n <= samples), for a batch scheduler's job array.
+    merge: the paths of parts (shards) to join into the whole table instead of computing.
+    chunk_size: samples per chunk kept on disk (default: the study's ``default_chunk_size``).
+
+    Returns a dict: ``table``, ``begin`` and ``end`` (its rows), ``computed``, ``resumed`` (rows
+    taken from a stopped run's chunks), ``threads``, ``seconds``, ``how`` (a sentence) and
+    ``summary`` (``kdl_space study --json``'s dict; None for a shard). A stale lock removed is a
+    UserWarning."""
+    s = _resolve(study)
+    threads = _count(threads, "threads", 0)
+    chunk_size = 0 if chunk_size is None else _count(chunk_size, "chunk_size", 1)
+    if isinstance(merge, (str, os.PathLike)):
+        raise TypeError("merge: expected a list of paths, got one path")
+    if shard is not None:
+        if not (isinstance(shard, (tuple, list)) and len(shard) == 2):
+            raise TypeError(f"shard: expected a pair (i, n), got {shard!r}")
+        shard = (_count(shard[0], "shard[0]", 1), _count(shard[1], "shard[1]", 1))
+    return s.to_table(os.fspath(table), threads=threads, shard=shard, merge=[os.fspath(p) for p in merge],
+                      chunk_size=chunk_size)
 
 
 class StudyResult:
@@ -258,28 +278,10 @@ class StudyResult:
         return int(np.count_nonzero(self.table[:, 1] != 0.0))
 
     def to_csv(self, path):
-        """Writes the table as ``kdl_space study -o`` does, byte for byte: so the command-line tool
-        can merge it (``--merge``), resume from it, plot it. Its last line is the CRC-32 of the row
-        lines (``zlib.crc32``, as the tool checks it)."""
-        s, n = self.study, self.table.shape[0]
-        head = (f"# kdl_space study; fingerprint {s.fingerprint:016x}; samples {s.samples}; rows 0-{n}\n"
-                + ",".join(self.columns) + "\n")
-        row_format = "%.0f,%.0f" + ",%.17g" * (len(self.columns) - 2)
-        negative_nan = np.isnan(self.table) & np.signbit(self.table)
-        lines = []
-        for r, row in enumerate(self.table.tolist()):
-            if negative_nan[r].any():
-                lines.append("%.0f,%.0f" % (row[0], row[1]) + "".join("," + _c_double(x) for x in row[2:]))
-            else:
-                lines.append(row_format % tuple(row))
-        body = ("\n".join(lines) + "\n").encode("ascii") if lines else b""
-        end = f"# end; rows 0-{n}; crc32 {zlib.crc32(body):08x}\n"
-        tmp = f"{path}.tmp{os.getpid()}"
-        with open(tmp, "wb") as f:
-            f.write(head.encode("ascii") + body + end.encode("ascii"))
-            f.flush()
-            os.fsync(f.fileno())  # the bytes on the disk before the name, as the tool does
-        os.replace(tmp, path)
+        """Writes the table as ``kdl_space study -o`` does, byte for byte (the library's writer, the
+        tool's): so the command-line tool can merge it (``--merge``), resume from it, plot it. Whole
+        or not at all; a path that is one of the study's inputs is refused (ValueError)."""
+        self.study.write_table(self.table, os.fspath(path))
 
     def to_npz(self, path):
         """Writes the table with np.savez: one array per column (by its name), plus ``columns``

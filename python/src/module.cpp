@@ -2,7 +2,7 @@
 // state, solvers, impact laws, capture, forward dynamics, simulation, studies); the package kdl_space
 // (python/kdl_space) re-exports it.
 #include "conversions.hpp"
-#include "html.hpp"
+#include "expose_html.hpp"
 
 PYBIND11_MODULE(_kdl_space, m) {
   m.doc() = "Free-floating space manipulator dynamics (kdl_space, Yoshida et al.): the C++ library's "

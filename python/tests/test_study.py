@@ -1,15 +1,13 @@
 """Capture studies from Python: Study.rows equals the command-line tool's table bit for bit (the
 same rows whatever computes them: threads, a Dask LocalCluster of 2 workers, 3 shards merged);
 the result's CSV is the tool's file byte for byte, its .npz round-trips, its summary is the tool's
---json; a missing or wrong study file and bad arguments are errors that
+--json; study_to_table is the tool's run to a table (shards, merge, lock, Ctrl-C and resume); a missing or wrong study file and bad arguments are errors that
 name what is wrong (an unusable scheduler: test_study_dask.py)."""
-import ctypes
 import json
 import math
 import os
 import pathlib
 import signal
-import struct
 import subprocess
 import threading
 import time
@@ -20,7 +18,7 @@ import pytest
 
 import kdl_space
 from conftest import CAPTURE_SCENARIO, SOURCE_DIR
-from kdl_space.study import _c_double, study_chunk_rows
+from kdl_space.study import study_chunk_rows
 
 GRASP_STUDY = SOURCE_DIR / "scenarios" / "study_grasp_configuration.yaml"
 
@@ -188,24 +186,6 @@ def test_to_csv_ends_with_the_crc32_the_tool_checks(cli, small, small_tool, tmp_
     assert not (tmp_path / "never.csv").exists()
 
 
-def test_to_csv_formats_doubles_as_c_does():
-    libc = ctypes.CDLL(None)
-    buf = ctypes.create_string_buffer(64)
-
-    def c(x):
-        libc.snprintf(buf, 64, b"%.17g", ctypes.c_double(x))
-        return buf.value.decode()
-
-    rng = np.random.default_rng(5)
-    values = [0.0, -0.0, 1.0, -1.5, 1e16, 1e17, 123456789012345678.0, 1e-5, 1e-4, 5e-324, 2.2250738585072014e-308,
-              1.7976931348623157e308, math.inf, -math.inf, math.nan, -math.nan, 0.1, 1 / 3, 2.5e-7]
-    values += [struct.unpack("<d", struct.pack("<Q", int(b)))[0] for b in rng.integers(0, 2**64, 3000, dtype=np.uint64)]
-    values += list(rng.normal(size=2000) * 10.0 ** rng.integers(-30, 30, 2000))
-    for x in values:
-        assert _c_double(x) == c(x), x
-    assert _c_double(-math.nan) == "-nan" and _c_double(math.nan) == "nan"
-
-
 def test_to_npz_round_trips(small, tmp_path):
     r = kdl_space.study(str(small), threads=2)
     r.to_npz(tmp_path / "t.npz")
@@ -243,7 +223,7 @@ def test_summary_is_the_tool_json(small, small_tool, grasp_tool):
         expected = dict(expected)
         del expected["table"]  # the tool's file; a result in memory has none
         assert expected.pop("html") is None  # the tool's page of the nominal sample (--html): none asked
-        expected.setdefault("quantile_rank_error", 0.0)  # until the tool's --json writes it: exact here
+        assert r.summary == expected  # the same writer (report::studySummaryJson): equal, not close
         same(r.summary, expected, "summary")
         assert r.summary["samples"] == r.study.samples and r.summary["failed"] == r.failed == 0
         assert r.summary["fingerprint"] == f"{r.study.fingerprint:016x}"
@@ -385,3 +365,91 @@ def test_summary_states_its_quantile_rank_error(small):
     assert summary["outcomes"]["base_rate"]["min"] == ordered[0] and summary["outcomes"]["base_rate"]["max"] == ordered[-1]
     # the mean: the exact sum rounded once (math.fsum is correctly rounded too), over n
     assert summary["outcomes"]["base_rate"]["mean"] == math.fsum(ordered) / n
+
+
+def test_study_to_table_is_the_tool_run(small, small_tool, tmp_path):
+    # The library's runStudyToTable, as `kdl_space study -o` runs it: the same bytes, the same summary
+    table, expected = small_tool
+    for given in (small, str(small), kdl_space.load_study(str(small))):  # a path or a loaded Study
+        out = tmp_path / "mine.csv"
+        done = kdl_space.study_to_table(given, out, threads=2)
+        assert out.read_bytes() == table.read_bytes()
+        summary = dict(expected)
+        assert summary.pop("html") is None
+        summary["table"] = str(out)
+        assert done["summary"] == summary
+        assert (done["table"], done["begin"], done["end"], done["computed"], done["resumed"]) == (str(out), 0, 60, 60, 0)
+        assert done["threads"] == 2 and done["how"].startswith("60 computed on 2 threads in ")
+        out.unlink()
+    assert sorted(os.listdir(tmp_path)) == []  # no chunks, lock or temporary left
+
+
+def test_study_to_table_shards_merge_into_the_whole_table(small, small_tool, tmp_path):
+    parts = []
+    for i in (1, 2, 3):
+        part = tmp_path / f"part{i}.csv"
+        done = kdl_space.study_to_table(small, part, shard=(i, 3), chunk_size=7)
+        assert done["summary"] is None and (done["begin"], done["end"]) == ((i - 1) * 20, i * 20)
+        parts.append(part)
+    merged = kdl_space.study_to_table(small, tmp_path / "merged.csv", merge=parts[::-1])
+    assert (tmp_path / "merged.csv").read_bytes() == small_tool[0].read_bytes()
+    assert merged["how"] == "3 parts merged" and merged["computed"] == 0
+    assert merged["summary"]["samples"] == 60
+    # a missing shard, a shard out of range, shard and merge together, an output on an input
+    with pytest.raises(kdl_space.InputError, match="rows 40-60 are in no part"):
+        kdl_space.study_to_table(small, tmp_path / "never.csv", merge=parts[:2])
+    with pytest.raises(ValueError, match="shard 4/3"):
+        kdl_space.study_to_table(small, tmp_path / "never.csv", shard=(4, 3))
+    with pytest.raises(ValueError, match="61 shards of 60 samples"):
+        kdl_space.study_to_table(small, tmp_path / "never.csv", shard=(1, 61))
+    with pytest.raises(ValueError, match="shard and merge"):
+        kdl_space.study_to_table(small, tmp_path / "never.csv", shard=(1, 3), merge=parts)
+    with pytest.raises(TypeError, match="merge"):
+        kdl_space.study_to_table(small, tmp_path / "never.csv", merge=parts[0])
+    before = small.read_bytes()
+    with pytest.raises(ValueError, match="the study file"):
+        kdl_space.study_to_table(small, small)
+    with pytest.raises(ValueError, match="the study file"):
+        kdl_space.study(small).to_csv(small)
+    assert small.read_bytes() == before
+    assert not (tmp_path / "never.csv").exists()
+
+
+def test_study_to_table_takes_a_stale_lock_with_a_warning_and_refuses_a_live_one(small, small_tool, tmp_path):
+    table = tmp_path / "t.csv"
+    lock = tmp_path / "t.csv.lock"
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    lock.write_text(f"pid {dead.pid}\nhost {os.uname().nodename}\nsince 2026-11-26T10:00:00Z\n")
+    with pytest.warns(UserWarning, match="removed a stale lock"):
+        kdl_space.study_to_table(small, table)
+    assert table.read_bytes() == small_tool[0].read_bytes() and not lock.exists()
+    lock.write_text(f"pid {os.getpid()}\nhost {os.uname().nodename}\nsince 2026-11-26T10:00:00Z\n")
+    with pytest.raises(kdl_space.InputError, match="is being written by kdl_space"):
+        kdl_space.study_to_table(small, tmp_path / "t.csv")
+    assert lock.exists()
+
+
+def test_study_to_table_answers_ctrl_c_and_the_same_call_resumes(tmp_path):
+    # 2,000 samples of a capture and 0.5 s of motion (about 6 ms each) in chunks of 50 on two
+    # threads: about 6 s. SIGINT after 1 s: KeyboardInterrupt saying what is kept; the chunks stay;
+    # the same call computes only the rest, and the table is the uninterrupted run's.
+    path = tmp_path / "long_study.yaml"
+    path.write_text(SMALL_STUDY.replace("samples: 60", "samples: 2000") + "motion: {duration: 0.5}\n")
+    table = tmp_path / "t.csv"
+    timer = threading.Timer(1.0, lambda: signal.pthread_kill(threading.main_thread().ident, signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt, match="chunks kept in"):
+            kdl_space.study_to_table(path, table, threads=2, chunk_size=50)
+    finally:
+        timer.cancel()
+        timer.join()
+    kept = sorted(os.listdir(str(table) + ".parts"))
+    assert kept and not table.exists() and not (tmp_path / "t.csv.lock").exists()
+    done = kdl_space.study_to_table(path, table, threads=2, chunk_size=50)
+    assert done["resumed"] == 50 * len(kept) and done["computed"] == 2000 - done["resumed"]
+    whole = kdl_space.study(path, threads=2)
+    whole.to_csv(tmp_path / "whole.csv")
+    assert table.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    assert not os.path.exists(str(table) + ".parts")

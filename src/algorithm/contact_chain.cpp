@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {

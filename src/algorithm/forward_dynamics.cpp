@@ -3,7 +3,7 @@
 #include "algorithm/mimic_coupling.hpp"
 #include "algorithm/set_up.hpp"
 #include "detail/multiversion.hpp"
-#include "detail/symmetric6d.hpp"
+#include "spatial/symmetric6d.hpp"
 
 namespace kdl_space {
 

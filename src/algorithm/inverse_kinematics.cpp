@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "algorithm/contact_chain.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 

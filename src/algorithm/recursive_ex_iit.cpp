@@ -7,7 +7,7 @@
 #include "multibody/joint_motion.hpp"
 #include "detail/multiversion.hpp"
 #include "detail/lane_symmetric6d.hpp"
-#include "detail/symmetric6d.hpp"
+#include "spatial/symmetric6d.hpp"
 
 namespace kdl_space {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/multibody/model.hpp"
 
 namespace kdl_space::detail {

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "detail/lanes.hpp"
-#include "detail/symmetric6d.hpp"
+#include "spatial/symmetric6d.hpp"
 
 namespace kdl_space::detail {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 
 namespace kdl_space {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "multibody/mimic_route.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "multibody/model_rules.hpp"
 
 namespace kdl_space {

@@ -10,7 +10,7 @@
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/spatial/spatial.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "multibody/model_build.hpp"
 
 namespace kdl_space {
@@ -131,11 +131,8 @@ SideView view(const FloatingSystem& s, const FloatingVelocity& after, const std:
   return v;
 }
 
-}  // namespace
-
-JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& robot_after,
-                         const FloatingSystem& target, const FloatingVelocity& target_after, GraspJoint grasp,
-                         double touch_tolerance) {
+/// The grasp and the touch tolerance asked for, and a target the join supports (no mimic joints).
+void checkGrasp(const FloatingSystem& target, GraspJoint grasp, double touch_tolerance) {
   if (grasp != GraspJoint::Rigid && grasp != GraspJoint::Spherical && grasp != GraspJoint::Compliant)
     throw InputError("grasp: not one of the grasp joints");
   if (!(touch_tolerance >= 0.0) || !std::isfinite(touch_tolerance))
@@ -147,13 +144,15 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
     throw InputError("target: the model has mimic joints (" + detail::listNames(names) +
                      "): joining a target with mimic joints to the robot is not supported yet");
   }
-  const SideView r = view(robot, robot_after, "robot"), t = view(target, target_after, "target");
+}
+
+/// The contact points touch, and (but for a compliant grasp) move together after the capture, as
+/// the capture law leaves them (else the joined velocity would not continue both motions).
+void checkTouching(const SideView& r, const SideView& t, GraspJoint grasp, double touch_tolerance) {
   const double gap = (t.point - r.point).norm();
   if (!(gap <= touch_tolerance))
     throw InputError("target.contact: the target's contact point is " + detail::number(gap) +
                      " m from the robot's; they must touch (within " + detail::number(touch_tolerance) + " m)");
-  // The capture law's condition on the velocities after (else the joined velocity would not
-  // continue both motions).
   const Vector6d dt = t.t - r.t;
   const double scale = r.t.norm() + t.t.norm();
   const double mismatch = grasp == GraspJoint::Rigid ? dt.norm() : dt.head<3>().norm();
@@ -162,6 +161,72 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
                      (grasp == GraspJoint::Rigid ? "twists" : "linear velocities") + " differ by " +
                      detail::number(mismatch) + "): give the velocities after a " +
                      (grasp == GraspJoint::Rigid ? "capture" : "translational capture"));
+}
+
+/// Each joint's armature in the joined tree's joint order (the target's by their prefixed names).
+std::vector<double> jointArmature(const KDL::Tree& joined, const FloatingModel& rm, const FloatingModel& tm,
+                                  const Naming& nm) {
+  std::map<std::string, double> armature_by_name;
+  for (unsigned int j = 0; j < rm.nj(); ++j) armature_by_name[rm.jointNames()[j]] = rm.armature()[j];
+  for (unsigned int j = 0; j < tm.nj(); ++j) armature_by_name[nm.link(tm.jointNames()[j])] = tm.armature()[j];
+  std::vector<double> armature(joined.getNrOfJoints(), 0.0);
+  for (const auto& [name, element] : joined.getSegments()) {
+    const KDL::Joint& j = GetTreeElementSegment(element).getJoint();
+    if (j.getType() == KDL::Joint::None) continue;
+    const auto a = armature_by_name.find(j.getName());
+    if (a != armature_by_name.end()) armature[GetTreeElementQNr(element)] = a->second;
+  }
+  return armature;
+}
+
+/// The joints' properties by name in the joined model; a reversed target joint's limits negated.
+std::map<std::string, JointProperties> jointProperties(const FloatingModel& rm, const FloatingModel& tm, const Naming& nm,
+                                                       const std::map<std::string, double>& sign_of) {
+  std::map<std::string, JointProperties> props;
+  for (unsigned int j = 0; j < rm.nj(); ++j) props[rm.jointNames()[j]] = rm.jointProperties()[j];
+  for (unsigned int j = 0; j < tm.nj(); ++j) {
+    JointProperties p = tm.jointProperties()[j];
+    if (sign_of.count(tm.jointNames()[j])) {  // q negated: [lower, upper] -> [-upper, -lower]
+      const double lower = p.lower;
+      p.lower = -p.upper;
+      p.upper = -lower;
+    }
+    props[nm.link(tm.jointNames()[j])] = p;
+  }
+  return props;
+}
+
+/// The grasp joints' rates after the capture (js.grasp_joints set): a ball's, the relative angular
+/// velocity in the robot contact link's axes; a compliant grasp's slides too.
+void graspRates(JoinedSystem& js, const KDL::Frame& W_r, const SideView& r, const SideView& t) {
+  if (js.grasp == GraspJoint::Spherical) {
+    // The relative angular velocity in the robot contact link's axes = ballAxes * rates.
+    const Vector3d w_rel = toEigen(W_r.M).transpose() * (t.t.tail<3>() - r.t.tail<3>());
+    const Vector3d rates = ballAxes(0.0, 0.0).fullPivLu().solve(w_rel);
+    for (int k = 0; k < 3; ++k) js.velocity.qdot(js.grasp_joints[k]) = rates(k);
+  }
+  if (js.grasp == GraspJoint::Compliant) {
+    // The target's material point at the robot's contact point, relative to the robot's, in the
+    // robot contact link's axes (the slides' rates); the relative rotation in the ball's axes.
+    const Matrix3d R = toEigen(W_r.M);
+    const Vector3d v_t = t.t.head<3>() + t.t.tail<3>().cross(r.point - t.point);
+    const Vector3d slide_rates = R.transpose() * (v_t - r.t.head<3>());
+    const Vector3d ball_rates = ballAxes(0.0, 0.0).fullPivLu().solve(R.transpose() * (t.t.tail<3>() - r.t.tail<3>()));
+    for (int k = 0; k < 3; ++k) {
+      js.velocity.qdot(js.grasp_joints[k]) = slide_rates(k);
+      js.velocity.qdot(js.grasp_joints[3 + k]) = ball_rates(k);
+    }
+  }
+}
+
+}  // namespace
+
+JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& robot_after,
+                         const FloatingSystem& target, const FloatingVelocity& target_after, GraspJoint grasp,
+                         double touch_tolerance) {
+  checkGrasp(target, grasp, touch_tolerance);
+  const SideView r = view(robot, robot_after, "robot"), t = view(target, target_after, "target");
+  checkTouching(r, t, grasp, touch_tolerance);
 
   const FloatingModel& rm = *robot.model;
   const FloatingModel& tm = *target.model;
@@ -232,16 +297,7 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
   }
 
   // Armature (tree joint order), the robot's mimic joints, then the properties by name.
-  std::map<std::string, double> armature_by_name;
-  for (unsigned int j = 0; j < rm.nj(); ++j) armature_by_name[rm.jointNames()[j]] = rm.armature()[j];
-  for (unsigned int j = 0; j < tm.nj(); ++j) armature_by_name[nm.link(tm.jointNames()[j])] = tm.armature()[j];
-  std::vector<double> armature(joined.getNrOfJoints(), 0.0);
-  for (const auto& [name, element] : joined.getSegments()) {
-    const KDL::Joint& j = GetTreeElementSegment(element).getJoint();
-    if (j.getType() == KDL::Joint::None) continue;
-    const auto a = armature_by_name.find(j.getName());
-    if (a != armature_by_name.end()) armature[GetTreeElementQNr(element)] = a->second;
-  }
+  const std::vector<double> armature = jointArmature(joined, rm, tm, nm);
   std::vector<Diagnostic> notes{{"", "joined after a capture: the target re-rooted at its contact link " +
                                          quoted(nm.link(tb[target.contact.body].name)) + ", hung on " +
                                          quoted(robot_link) +
@@ -250,18 +306,7 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
                                                                            : " by a compliant 6-joint grasp"),
                                  "joined", Severity::Note}};
   FloatingModel model(joined, detail::kdlInertia(rm.bodies()[0]), armature, notes, rm.mimic());
-  std::map<std::string, JointProperties> props;
-  for (unsigned int j = 0; j < rm.nj(); ++j) props[rm.jointNames()[j]] = rm.jointProperties()[j];
-  for (unsigned int j = 0; j < tm.nj(); ++j) {
-    JointProperties p = tm.jointProperties()[j];
-    if (sign_of.count(tm.jointNames()[j])) {  // q negated: [lower, upper] -> [-upper, -lower]
-      const double lower = p.lower;
-      p.lower = -p.upper;
-      p.upper = -lower;
-    }
-    props[nm.link(tm.jointNames()[j])] = p;
-  }
-  js.model = std::make_shared<const FloatingModel>(model.withJointProperties(props));
+  js.model = std::make_shared<const FloatingModel>(model.withJointProperties(jointProperties(rm, tm, nm, sign_of)));
   const FloatingModel& jm = *js.model;
 
   // Where each joint went; the state and velocity.
@@ -285,25 +330,9 @@ JoinedSystem joinAtGrasp(const FloatingSystem& robot, const FloatingVelocity& ro
     js.state.q(js.target_joints[j]) = js.target_joint_sign[j] * target.state.q(j);
     js.velocity.qdot(js.target_joints[j]) = js.target_joint_sign[j] * target_after.qdot(j);
   }
-  if (grasp == GraspJoint::Spherical) {
+  if (grasp != GraspJoint::Rigid) {
     for (const std::string& b : ball) js.grasp_joints.push_back(indexOf(b, "grasp"));
-    // The relative angular velocity in the robot contact link's axes = ballAxes * rates.
-    const Vector3d w_rel = toEigen(W_r.M).transpose() * (t.t.tail<3>() - r.t.tail<3>());
-    const Vector3d rates = ballAxes(0.0, 0.0).fullPivLu().solve(w_rel);
-    for (int k = 0; k < 3; ++k) js.velocity.qdot(js.grasp_joints[k]) = rates(k);
-  }
-  if (grasp == GraspJoint::Compliant) {
-    for (const std::string& b : ball) js.grasp_joints.push_back(indexOf(b, "grasp"));
-    // The target's material point at the robot's contact point, relative to the robot's, in the
-    // robot contact link's axes (the slides' rates); the relative rotation in the ball's axes.
-    const Matrix3d R = toEigen(W_r.M);
-    const Vector3d v_t = t.t.head<3>() + t.t.tail<3>().cross(r.point - t.point);
-    const Vector3d slide_rates = R.transpose() * (v_t - r.t.head<3>());
-    const Vector3d ball_rates = ballAxes(0.0, 0.0).fullPivLu().solve(R.transpose() * (t.t.tail<3>() - r.t.tail<3>()));
-    for (int k = 0; k < 3; ++k) {
-      js.velocity.qdot(js.grasp_joints[k]) = slide_rates(k);
-      js.velocity.qdot(js.grasp_joints[3 + k]) = ball_rates(k);
-    }
+    graspRates(js, W_r, r, t);
   }
   return js;
 }

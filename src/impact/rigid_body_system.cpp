@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "kdl_space/spatial/errors.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 

@@ -1,6 +1,6 @@
 #include "kdl_space/multibody/diagnostics.hpp"
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 

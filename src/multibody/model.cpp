@@ -9,7 +9,7 @@
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/spatial/spatial.hpp"
 #include "multibody/joint_motion.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "multibody/model_build.hpp"
 #include "multibody/mimic_route.hpp"
 #include "multibody/model_rules.hpp"

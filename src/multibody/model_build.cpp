@@ -5,7 +5,7 @@
 
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/spatial/spatial.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 namespace detail {

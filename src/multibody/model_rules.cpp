@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space::rules {
 

@@ -3,7 +3,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "operation/phases.hpp"
 
 namespace kdl_space::operation {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 namespace {

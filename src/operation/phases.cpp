@@ -3,7 +3,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/impact/rigid_body_system.hpp"
 #include "kdl_space/operation/overlap_check.hpp"

@@ -11,7 +11,7 @@
 #include <locale>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 

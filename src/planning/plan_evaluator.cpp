@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 
 namespace kdl_space {

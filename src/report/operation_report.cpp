@@ -5,7 +5,7 @@
 
 #include "kdl_space/report/approach_report.hpp"
 #include "kdl_space/report/capture_report.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/report/inspection_json.hpp"
 #include "kdl_space/report/motion_report.hpp"
 

@@ -8,7 +8,7 @@
 
 #include "kdl_space/report/gnuplot_text.hpp"
 #include "kdl_space/report/plot_writer.hpp"
-#include "kdl_space/report/study_table.hpp"
+#include "kdl_space/study/study_table.hpp"
 
 namespace kdl_space::report {
 namespace {

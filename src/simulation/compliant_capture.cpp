@@ -10,7 +10,7 @@
 #include "kdl_space/impact/rigid_body_system.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/spatial/errors.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "simulation/compliant_probe.hpp"
 
 namespace kdl_space {
@@ -93,6 +93,39 @@ EndCriteria endCriteria(Probe& probe, const CompliantGrasp& grasp, const EndScal
   return c;
 }
 
+/// The contact's slowest time scale (the output step is a fortieth of it): tau_a = min(sqrt(m/K), m/D) (its
+/// period, or its rate's relaxation when overdamped; m the apparent inertia the grasp joint
+/// meets) among the axes that carry at least 1e-3 of the relative motion (K qdot^2): they decide
+/// when it is caught. (A light, heavily damped axis relaxes within the first samples; the
+/// integrator's steps resolve it.) The samples are the force history's; the end of the contact
+/// is located between them.
+double contactTimeScale(Simulator& sim, const SimulationState& s, const JoinedSystem& js, const Vector6d& K,
+                        const Vector6d& D, double s0, double max_duration) {
+  double scale = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    double m = 0.0;
+    if (const int rc = sim.apparentInertia(s, js.grasp_joints[k], m))
+      throw InputError(std::string("contact: the grasp's inertia cannot be computed: ") + strError(rc));
+    const int a = kAxisOf[k];
+    double tau = std::sqrt(m / K(a));
+    if (D(a) > 0.0) tau = std::min(tau, m / D(a));
+    if (K(a) * std::pow(s.velocity.qdot(js.grasp_joints[k]), 2) >= 1e-3 * s0) scale = std::max(scale, tau);
+  }
+  if (scale == 0.0) scale = max_duration;
+  return std::min(scale, max_duration);
+}
+
+/// The history's peak force (and its wrench) and peak moment.
+void setPeaks(CompliantCaptureResult& res) {
+  for (const ContactSample& c : res.history) {
+    if (c.wrench.head<3>().norm() > res.peak_force) {
+      res.peak_force = c.wrench.head<3>().norm();
+      res.peak_force_wrench = c.wrench;
+    }
+    res.peak_moment = std::max(res.peak_moment, c.wrench.tail<3>().norm());
+  }
+}
+
 CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& target, const CompliantGrasp& grasp,
                              const CompliantRun& run) {
   const SimulationOptions& options = run.options;
@@ -124,25 +157,8 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   s.velocity = js.velocity;
   if (const int rc = sim.energyAndMomentum(s, res.energy_before, res.momentum_before))
     throw InputError(std::string("contact: the joined system cannot be evaluated: ") + strError(rc));
-  // The output step: a fortieth of the slowest time scale tau_a = min(sqrt(m/K), m/D) (its
-  // period, or its rate's relaxation when overdamped; m the apparent inertia the grasp joint
-  // meets) among the axes that carry at least 1e-3 of the relative motion (K qdot^2): they decide
-  // when it is caught. (A light, heavily damped axis relaxes within the first samples; the
-  // integrator's steps resolve it.) The samples are the force history's; the end of the contact
-  // is located between them.
   const double s0 = probe.relativeSpeed2(s);
-  double scale = 0.0;
-  for (int k = 0; k < 6; ++k) {
-    double m = 0.0;
-    if (const int rc = sim.apparentInertia(s, js.grasp_joints[k], m))
-      throw InputError(std::string("contact: the grasp's inertia cannot be computed: ") + strError(rc));
-    const int a = kAxisOf[k];
-    double tau = std::sqrt(m / K(a));
-    if (D(a) > 0.0) tau = std::min(tau, m / D(a));
-    if (K(a) * std::pow(s.velocity.qdot(js.grasp_joints[k]), 2) >= 1e-3 * s0) scale = std::max(scale, tau);
-  }
-  if (scale == 0.0) scale = grasp.max_duration;
-  scale = std::min(scale, grasp.max_duration);
+  const double scale = contactTimeScale(sim, s, js, K, D, s0, grasp.max_duration);
   const double dt = scale / 40.0;
   // (The steps end at the outputs: the end criteria, sampled at the steps' ends, are seen at least
   // this often.)
@@ -183,13 +199,7 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   }
   res.end = end;
   res.duration = s.t;
-  for (const ContactSample& c : res.history) {
-    if (c.wrench.head<3>().norm() > res.peak_force) {
-      res.peak_force = c.wrench.head<3>().norm();
-      res.peak_force_wrench = c.wrench;
-    }
-    res.peak_moment = std::max(res.peak_moment, c.wrench.tail<3>().norm());
-  }
+  setPeaks(res);
   // Energy: the callback's work is -(spring energy now) - (the dampers' work).
   Vector6d h;
   double T_end = 0.0;

@@ -1,6 +1,6 @@
 #include "kdl_space/simulation/integrator.hpp"
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {

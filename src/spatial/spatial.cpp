@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "detail/symmetric6d.hpp"
+#include "spatial/symmetric6d.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {

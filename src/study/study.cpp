@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"

@@ -7,7 +7,7 @@
 #include <iterator>
 #include <utility>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/study/study.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
@@ -240,6 +240,58 @@ std::string statistic(const Field& f, const std::string& outcome) {
   return s;
 }
 
+/// `motion`: the motion after each sample's capture (duration, output_step), checked against the
+/// scenario's step budget and refused when no motion follows its capture.
+void readMotion(const Field& m, Study& st) {
+  const Scenario& sc = st.scenario;
+  m.onlyKeys({"duration", "output_step"});
+  st.motion_duration = m.at("duration").number();
+  if (!(st.motion_duration > 0.0)) m.at("duration").fail("must be > 0 s, got " + number(st.motion_duration));
+  st.motion_output_step = m.has("output_step") ? m.at("output_step").number() : st.motion_duration / 100.0;
+  if (!(st.motion_output_step > 0.0)) m.at("output_step").fail("must be > 0 s, got " + number(st.motion_output_step));
+  // As `simulate`: a motion that cannot fit the step budget would spend it in every sample.
+  const StepEstimate e = fewestSteps(sc.simulation, st.motion_duration, st.motion_output_step);
+  const long budget = sc.simulation.options.max_steps;
+  if (e.steps > static_cast<double>(budget)) {
+    const std::string by = std::string(e.limited_by) == "output_step" ? "motion.output_step" : "the scenario's simulation." + std::string(e.limited_by);
+    m.at("duration").fail(number(st.motion_duration) + " s in steps of at most " + number(e.longest) + " s (" + by +
+                          ") needs " + number(e.steps) + " steps, more than the scenario's simulation.max_steps = " +
+                          std::to_string(budget) + ": give a duration of at most " +
+                          number(e.longest * static_cast<double>(budget)) + " s (or raise simulation.max_steps in " +
+                          detail::shownPath(sc.file) + ")");
+  }
+  try {
+    CaptureResult probe;
+    probe.contact_body_pose = KDL::Frame::Identity();
+    if (sc.capture.law.kind == ImpactKind::TranslationalCapture || !std::holds_alternative<RigidTarget>(sc.capture.target))
+      attachTarget(sc.capture, probe);  // refuses what no motion follows
+  } catch (const Error& e) {
+    e.rethrowWithContext(m.where() + "no motion follows this scenario's capture: ");
+  }
+}
+
+/// `heat_map`: x and y, the study's two grid inputs, and an outcome's statistic over each point.
+void readHeatMap(const Field& h, const std::vector<std::string>& columns, Study& st) {
+  h.onlyKeys({"x", "y", "outcome", "statistic"});
+  for (const char* k : {"x", "y", "outcome"}) checkColumn(h.at(k), columns, "column");
+  st.heat_map = StudyHeatMap{h.at("x").text(), h.at("y").text(), h.at("outcome").text(), "mean"};
+  if (h.at("outcome").text().rfind("exceeds.", 0) == 0) st.heat_map->statistic = "probability";
+  if (h.has("statistic")) st.heat_map->statistic = statistic(h.at("statistic"), st.heat_map->outcome);
+  // One value a cell: the cells are the grid's points, so x and y are its grid inputs, all of them.
+  std::vector<std::string> grid;
+  for (const StudyInput& in : st.inputs)
+    if (isGrid(in)) grid.push_back(in.name);
+  for (const char* k : {"x", "y"})
+    if (std::find(grid.begin(), grid.end(), h.at(k).text()) == grid.end())
+      h.at(k).fail("is no grid input of this study: a heat map's cells are the grid's points (one value a cell); "
+                   "give " + h.at(k).text() + " a grid: [from, to, count]" +
+                   (grid.empty() ? std::string() : " (its grid inputs: " + detail::listNames(grid) + ")"));
+  if (h.at("x").text() == h.at("y").text()) h.at("y").fail("is x too: give two grid inputs");
+  if (grid.size() != 2)
+    h.fail("the study has " + std::to_string(grid.size()) + " grid inputs (" + detail::listNames(grid) +
+           "): a heat map's cells are its grid points, so it needs exactly two (x and y)");
+}
+
 }  // namespace
 
 Study loadStudy(const std::string& path) {
@@ -288,33 +340,7 @@ Study loadStudy(const std::string& path) {
   } else {
     top.at("samples");  // reports it missing
   }
-  if (top.has("motion")) {
-    const Field m = top.at("motion");
-    m.onlyKeys({"duration", "output_step"});
-    st.motion_duration = m.at("duration").number();
-    if (!(st.motion_duration > 0.0)) m.at("duration").fail("must be > 0 s, got " + number(st.motion_duration));
-    st.motion_output_step = m.has("output_step") ? m.at("output_step").number() : st.motion_duration / 100.0;
-    if (!(st.motion_output_step > 0.0)) m.at("output_step").fail("must be > 0 s, got " + number(st.motion_output_step));
-    // As `simulate`: a motion that cannot fit the step budget would spend it in every sample.
-    const StepEstimate e = fewestSteps(sc.simulation, st.motion_duration, st.motion_output_step);
-    const long budget = sc.simulation.options.max_steps;
-    if (e.steps > static_cast<double>(budget)) {
-      const std::string by = std::string(e.limited_by) == "output_step" ? "motion.output_step" : "the scenario's simulation." + std::string(e.limited_by);
-      m.at("duration").fail(number(st.motion_duration) + " s in steps of at most " + number(e.longest) + " s (" + by +
-                            ") needs " + number(e.steps) + " steps, more than the scenario's simulation.max_steps = " +
-                            std::to_string(budget) + ": give a duration of at most " +
-                            number(e.longest * static_cast<double>(budget)) + " s (or raise simulation.max_steps in " +
-                            detail::shownPath(sc.file) + ")");
-    }
-    try {
-      CaptureResult probe;
-      probe.contact_body_pose = KDL::Frame::Identity();
-      if (sc.capture.law.kind == ImpactKind::TranslationalCapture || !std::holds_alternative<RigidTarget>(sc.capture.target))
-        attachTarget(sc.capture, probe);  // refuses what no motion follows
-    } catch (const Error& e) {
-      e.rethrowWithContext(m.where() + "no motion follows this scenario's capture: ");
-    }
-  }
+  if (top.has("motion")) readMotion(top.at("motion"), st);
   const FloatingModel& robot = *sc.capture.robot.model;
   if (top.has("limits")) {
     const Field l = top.at("limits");
@@ -345,27 +371,7 @@ Study loadStudy(const std::string& path) {
                "rank the samples with `objective: " + st.objective + "`");
     }
   }
-  if (top.has("heat_map")) {
-    const Field h = top.at("heat_map");
-    h.onlyKeys({"x", "y", "outcome", "statistic"});
-    for (const char* k : {"x", "y", "outcome"}) checkColumn(h.at(k), columns, "column");
-    st.heat_map = StudyHeatMap{h.at("x").text(), h.at("y").text(), h.at("outcome").text(), "mean"};
-    if (h.at("outcome").text().rfind("exceeds.", 0) == 0) st.heat_map->statistic = "probability";
-    if (h.has("statistic")) st.heat_map->statistic = statistic(h.at("statistic"), st.heat_map->outcome);
-    // One value a cell: the cells are the grid's points, so x and y are its grid inputs, all of them.
-    std::vector<std::string> grid;
-    for (const StudyInput& in : st.inputs)
-      if (isGrid(in)) grid.push_back(in.name);
-    for (const char* k : {"x", "y"})
-      if (std::find(grid.begin(), grid.end(), h.at(k).text()) == grid.end())
-        h.at(k).fail("is no grid input of this study: a heat map's cells are the grid's points (one value a cell); "
-                     "give " + h.at(k).text() + " a grid: [from, to, count]" +
-                     (grid.empty() ? std::string() : " (its grid inputs: " + detail::listNames(grid) + ")"));
-    if (h.at("x").text() == h.at("y").text()) h.at("y").fail("is x too: give two grid inputs");
-    if (grid.size() != 2)
-      h.fail("the study has " + std::to_string(grid.size()) + " grid inputs (" + detail::listNames(grid) +
-             "): a heat map's cells are its grid points, so it needs exactly two (x and y)");
-  }
+  if (top.has("heat_map")) readHeatMap(top.at("heat_map"), columns, st);
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (const std::string& file : {path, scenario_path, sc.robot_urdf, sc.target_urdf}) h = fold(h, file);
   st.fingerprint = h;

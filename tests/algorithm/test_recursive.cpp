@@ -39,7 +39,7 @@
 
 #include <kdl/rigidbodyinertia.hpp>
 
-#include "detail/symmetric6d.hpp"
+#include "spatial/symmetric6d.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/algorithm/recursive_ex_iit.hpp"

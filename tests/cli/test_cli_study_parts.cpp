@@ -566,8 +566,8 @@ TEST(StudyMemory, AStudyOfABillionSamplesRunsInBoundedMemoryUntilCtrlC) {
   // Too many chunk files: refused up front, with the chunk size to use.
   const ToolRun r = kdlSpace("study " + study + " --chunk-size 999 -o " + table);
   EXPECT_EQ(r.rc, 2);
-  EXPECT_NE(r.err.find("--chunk-size 999: 1001002 chunk files for samples 0-1000000000, more than 1000000; use --chunk-size "
-                       "1001 or more"),
+  EXPECT_NE(r.err.find("chunk size 999: 1001002 chunk files for samples 0-1000000000, more than 1000000; use a chunk size "
+                       "of 1001 or more"),
             std::string::npos)
       << r.err;
 }

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 
 namespace kdl_space::report {

@@ -11,7 +11,7 @@
 #include "kdl_space/multibody/diagnostics.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/report/scene_writer.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/operation/motion_sample.hpp"
 
 namespace kdl_space::report {

@@ -15,7 +15,7 @@
 #include <string>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 
 namespace kdl_space::report {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/multibody/kinematics.hpp"

@@ -17,7 +17,7 @@
 #include <kdl/frames.hpp>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/multibody/model.hpp"
 #include "kdl_space/multibody/overlap.hpp"

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/study/study.hpp"
 
 namespace kdl_space::report {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/multibody/kinematics.hpp"

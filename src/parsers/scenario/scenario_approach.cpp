@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "parsers/scenario/scenario_sections.hpp"
 
 namespace kdl_space::sections {

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space::fields {
 
-/// A text from the file, quoted for a message (detail/text.hpp).
+/// A text from the file, quoted for a message (spatial/message_text.hpp).
 using detail::echo;
 
 /// The largest scenario or study file (YAML or JSON) parseFile reads: 16 MiB. Such files are

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space::sections {
 namespace {

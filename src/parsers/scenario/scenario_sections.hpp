@@ -4,7 +4,7 @@
 
 #include <fnmatch.h>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
 

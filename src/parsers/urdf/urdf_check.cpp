@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"

@@ -12,7 +12,7 @@
 
 #include "kdl_space/spatial/errors.hpp"
 #include "kdl_space/parsers/input_file.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 #include "parsers/urdf/urdf_graph.hpp"
 #include "parsers/urdf/urdf_parse.hpp"

@@ -9,7 +9,7 @@
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/algorithm/recursive_ex_iit.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 
 namespace kdl_space::detail {

@@ -8,7 +8,7 @@
 #include <map>
 #include <set>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "parsers/urdf/urdf_numbers.hpp"
 #include "parsers/urdf/urdf_rules.hpp"
 

@@ -1,4 +1,4 @@
-#include "simulate.hpp"
+#include "simulate_command.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -9,7 +9,6 @@
 #include <memory>
 #include <optional>
 
-#include "capture.hpp"
 #include "cli_common.hpp"
 #include "kdl_space/report/csv_writer.hpp"
 #include "kdl_space/report/html_writer.hpp"

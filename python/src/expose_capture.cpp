@@ -4,7 +4,7 @@
 
 #include "conversions.hpp"
 #include "capture_types.hpp"
-#include "html.hpp"
+#include "expose_html.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "impact_law.hpp"
 #include "kdl_space/impact/capture.hpp"

@@ -1,10 +1,10 @@
-#include "ik.hpp"
+#include "ik_command.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 
-#include "capture.hpp"  // inScenario
+#include "cli_common.hpp"
 
 namespace kdl_space::cli {
 namespace {

@@ -1,4 +1,4 @@
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 
-namespace kdl_space::report {
+namespace kdl_space {
 namespace {
 namespace fs = std::filesystem;
 using detail::quoted;
@@ -116,4 +116,4 @@ void AtomicFile::retract() {
   if (committed_) std::remove(path_.c_str());
 }
 
-}  // namespace kdl_space::report
+}  // namespace kdl_space

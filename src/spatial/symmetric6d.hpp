@@ -1,4 +1,4 @@
-// The packed symmetric 6x6 of the O(n) recursions: a speed internal of the library, not API.
+// The packed symmetric 6x6 of the O(n) recursions (spatial, articulated inertias): an internal, not API.
 #pragma once
 
 #include "kdl_space/spatial/spatial.hpp"

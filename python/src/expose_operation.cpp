@@ -9,7 +9,7 @@
 #include "capture_types.hpp"
 #include "conversions.hpp"
 #include "json_objects.hpp"
-#include "html.hpp"
+#include "expose_html.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/report/operation_report.hpp"
 #include "simulation_types.hpp"

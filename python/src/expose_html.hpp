@@ -1,5 +1,5 @@
 // The pages of `--html` from Python (CaptureResult.to_html, OperationResult.to_html): the tool's
-// writer (tools/html_writer, in kdl_space_reports), its refusals as ValueError and OSError.
+// writer (kdl_space/report/html_writer.hpp), its refusals as ValueError and OSError.
 #pragma once
 
 #include <memory>

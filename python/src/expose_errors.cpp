@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "conversions.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space::python {
@@ -130,6 +131,8 @@ void bindErrors(py::module_& m) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     } catch (const Error& e) {
       error(e.what());
+    } catch (const UsageError& e) {  // a request to change before anything runs (an output on an input)
+      PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const py::cast_error& e) {  // a cast no argumentAs named: a TypeError all the same
       PyErr_SetString(PyExc_TypeError, (std::string("an argument has the wrong type: ") + e.what()).c_str());
     }

@@ -33,11 +33,4 @@ struct StudyOptions {
 CLI::App* addStudy(CLI::App& app, StudyOptions& options);
 void runStudyCommand(const StudyOptions& options, std::ostream& out);
 
-/// \brief The per-grid-point aggregates as CSV (`--groups`): the grid inputs, count, failed, then
-/// per outcome OUTCOME.mean, OUTCOME.q95, OUTCOME.max, then per limit P(exceeds.*); one row a point.
-void writeStudyGroups(std::ostream& out, const StudySummary& summary);
-
-/// The summary JSON (`--json`, `--summary`; the keys are a contract: see docs/studies.md).
-Json studySummaryJson(const Study& study, const StudySummary& summary, const std::string& table);
-
 }  // namespace kdl_space::cli

@@ -1,4 +1,4 @@
-#include "inspect.hpp"
+#include "inspect_command.hpp"
 
 #include <iomanip>
 #include <map>
@@ -6,9 +6,8 @@
 #include <sstream>
 #include <variant>
 
-#include "capture.hpp"  // warnOnStderr
 #include "cli_common.hpp"
-#include "detail/text.hpp"
+#include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/conditioning.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/algorithm/inspection.hpp"

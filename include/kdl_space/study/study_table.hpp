@@ -8,29 +8,28 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
-#include <ostream>
 #include <string>
 #include <vector>
 
-#include "kdl_space/report/json.hpp"
-#include "kdl_space/report/output_file.hpp"
+#include "kdl_space/export.hpp"
+#include "kdl_space/parsers/output_file.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/study/study.hpp"
 
-namespace kdl_space::report {
+namespace kdl_space {
 
 /// The study's fingerprint as the table's head line and the summary JSON write it (16 hex digits).
-std::string fingerprintText(const Study& study);
+KDL_SPACE_EXPORT std::string fingerprintText(const Study& study);
 
 /// \brief CRC-32 (IEEE 802.3, the polynomial of zlib's and Python's `zlib.crc32`) of `n` bytes
 /// continued from `crc` (0 to start). The table's checksum: any change of up to 32 bits in a row
 /// (a digit cut or changed, a line dropped) changes it.
-std::uint32_t crc32(std::uint32_t crc, const char* data, std::size_t n);
+KDL_SPACE_EXPORT std::uint32_t crc32(std::uint32_t crc, const char* data, std::size_t n);
 
 /// \brief Writes rows [begin, end) of a study to `path` as they come (under a temporary name,
 /// renamed into place by commit(), after the trailer with the rows' checksum). `option` names the
 /// file in messages. Throws InputError if it cannot be written.
-class StudyTableWriter {
+class KDL_SPACE_EXPORT StudyTableWriter {
  public:
   StudyTableWriter(const std::string& path, const std::string& option, const Study& study,
                    const std::vector<std::string>& columns, std::uint64_t begin, std::uint64_t end);
@@ -56,17 +55,17 @@ class StudyTableWriter {
 };
 
 /// Writes rows [begin, end) (row-major, columns.size() wide) to `path`, whole or not at all.
-void writeStudyPart(const std::string& path, const std::string& option, const Study& study,
+KDL_SPACE_EXPORT void writeStudyPart(const std::string& path, const std::string& option, const Study& study,
                     const std::vector<std::string>& columns, std::uint64_t begin, std::uint64_t end,
                     const double* rows);
 
-/// \brief Reads a part written by StudyTableWriter (or Python's StudyResult.to_csv) row by row and
+/// \brief Reads a part written by StudyTableWriter (or StudyTableWriter's of another run, shard or process) row by row and
 /// checks it: this study's (fingerprint, sample count, columns), each row whole (every column a
 /// number; sample and status whole numbers, the status a known code, the inputs finite, the
 /// samples begin..end-1 in order), and the last line's checksum that of the rows read. Lines may
 /// end in \r\n (a file moved through Windows reads as the same part). Throws InputError
 /// "PATH[:LINE]: what is wrong".
-class StudyPartReader {
+class KDL_SPACE_EXPORT StudyPartReader {
  public:
   StudyPartReader(const std::string& path, const Study& study, const std::vector<std::string>& columns);
   std::uint64_t begin() const { return begin_; }
@@ -99,22 +98,24 @@ class StudyPartReader {
 
 /// \brief A table's lock: `TABLE.lock`, created with O_EXCL, holding the PID, the host and the
 /// time, while a run writes the table or its parts; removed by the destructor (at the end, on an
-/// error, on Ctrl-C). A lock of a live process, or of another host, is refused (InputError, exit
-/// 3); one whose process is gone (same host) is stale: removed, with a note on `notes`.
-class TableLock {
+/// error, on Ctrl-C). A lock of a live process, or of another host, is refused (InputError); one
+/// whose process is gone (same host) is stale: removed, and note() says so.
+class KDL_SPACE_EXPORT TableLock {
  public:
-  TableLock(const std::string& table, std::ostream& notes);
+  explicit TableLock(const std::string& table);
   ~TableLock();
+  /// "PATH: removed a stale lock (PID ..., since ..., is no longer running)", or empty.
+  const std::string& note() const { return note_; }
   TableLock(const TableLock&) = delete;
   TableLock& operator=(const TableLock&) = delete;
 
  private:
-  std::string path_;
+  std::string path_, note_;
 };
 
 /// \brief Removes the temporaries (`.NAME.tmpPID`, AtomicFile's; `.NAME.probePID`,
 /// checkOutputFile's) of processes that are gone: those of `table` beside it, and any in `parts`.
 /// Call it holding the table's lock. Best effort.
-void removeStaleTemporaries(const std::string& table, const std::string& parts);
+KDL_SPACE_EXPORT void removeStaleTemporaries(const std::string& table, const std::string& parts);
 
-}  // namespace kdl_space::report
+}  // namespace kdl_space

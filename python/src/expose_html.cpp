@@ -1,6 +1,6 @@
 // CaptureResult.to_html and kdl_space.OperationResult (run_operation's dict with to_html): the
 // bindings parse the path and the samples, the tool's HtmlWriter draws the page.
-#include "html.hpp"
+#include "expose_html.hpp"
 
 #include <filesystem>
 #include <functional>
@@ -32,19 +32,19 @@ void warnInPython(const std::vector<Diagnostic>& warnings) {
 /// a path that is one of the run's inputs: ValueError), then written under a temporary name and
 /// renamed: a failed call leaves no file. Every message names the path.
 void writePage(const std::string& path, const Scenario& sc, const std::vector<std::string>& mesh_search_path,
-               const std::function<void(const report::AtomicFile&)>& draw) {
+               const std::function<void(const AtomicFile&)>& draw) {
   try {
-    if (path.empty()) throw report::UsageError("to_html: the file name is empty");
+    if (path.empty()) throw UsageError("to_html: the file name is empty");
     report::checkHtmlLibrary("to_html", path);
-    report::checkOutputFile(path, "to_html");
-    std::vector<report::InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
-                                          {"the target's URDF", sc.target_urdf}};
-    for (report::InputFile& mesh : report::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
-    report::refuseOverwritingInputs("to_html", path, inputs);
-    report::AtomicFile file(path, "to_html");
+    checkOutputFile(path, "to_html");
+    std::vector<InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
+                                     {"the target's URDF", sc.target_urdf}};
+    for (InputFile& mesh : report::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
+    refuseOverwritingInputs("to_html", path, inputs);
+    AtomicFile file(path, "to_html");
     draw(file);
     file.commit();
-  } catch (const report::UsageError& e) {
+  } catch (const UsageError& e) {
     throw py::value_error(e.what());
   } catch (const InputError& e) {
     PyErr_SetString(PyExc_OSError, e.what());
@@ -96,7 +96,7 @@ void operationToHtml(py::object self, const std::string& path, const py::object&
                           "not those run_operation returned");
   const std::string title = "kdl_space.run_operation " + std::filesystem::path(run.scenario->file).filename().string();
   const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
-  writePage(path, *run.scenario, search_path, [&](const report::AtomicFile& file) {
+  writePage(path, *run.scenario, search_path, [&](const AtomicFile& file) {
     report::HtmlWriter page(*run.scenario, search_path);
     warnInPython(page.warnings());
     MotionSample x;
@@ -119,7 +119,7 @@ void captureToHtml(const PyResult& x, const std::string& path, const py::object&
   const std::string title = "kdl_space.solve_capture " + std::filesystem::path(x.scenario->file).filename().string();
   const std::vector<std::string> search_path = meshSearchPathOf(mesh_path);
   writePage(path, *x.scenario, search_path,
-            [&](const report::AtomicFile& file) { warnInPython(report::writeCaptureHtml(file, *x.scenario, x.r, title, search_path)); });
+            [&](const AtomicFile& file) { warnInPython(report::writeCaptureHtml(file, *x.scenario, x.r, title, search_path)); });
 }
 
 py::object operationResultOf(py::dict d, std::shared_ptr<const Scenario> scenario, OperationResult result) {

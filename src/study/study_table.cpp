@@ -1,4 +1,4 @@
-#include "kdl_space/report/study_table.hpp"
+#include "kdl_space/study/study_table.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -13,7 +13,7 @@
 #include <ctime>
 #include <filesystem>
 
-namespace kdl_space::report {
+namespace kdl_space {
 namespace fs = std::filesystem;
 
 std::string fingerprintText(const Study& study) {
@@ -246,7 +246,7 @@ bool writeWhole(int fd, const std::string& text) {
 }
 }  // namespace
 
-TableLock::TableLock(const std::string& table, std::ostream& notes) : path_(table + ".lock") {
+TableLock::TableLock(const std::string& table) : path_(table + ".lock") {
   const std::string host = hostName();
   char since_now[32];
   const std::time_t now = std::time(nullptr);
@@ -275,8 +275,7 @@ TableLock::TableLock(const std::string& table, std::ostream& notes) : path_(tabl
       throw InputError(table + " has a lock " + path_ + " that names no holder (not written by this version of " +
                        "kdl_space?); remove it if no run is writing the table");
     if (attempt == 0 && holder_host == host && processGone(pid)) {
-      notes << "kdl_space: " << path_ << ": removed a stale lock (PID " << pid << ", since " << since
-            << ", is no longer running)\n";
+      note_ = path_ + ": removed a stale lock (PID " + std::to_string(pid) + ", since " + since + ", is no longer running)";
       unlink(path_.c_str());
       continue;
     }
@@ -319,4 +318,4 @@ void removeStaleTemporaries(const std::string& table, const std::string& parts) 
   }
 }
 
-}  // namespace kdl_space::report
+}  // namespace kdl_space

@@ -1,10 +1,10 @@
-#include "plan.hpp"
+#include "plan_command.hpp"
 
 #include <algorithm>
 #include <iomanip>
 #include <sstream>
 
-#include "capture.hpp"  // inScenario
+#include "cli_common.hpp"
 
 namespace kdl_space::cli {
 namespace {

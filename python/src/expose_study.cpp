@@ -5,6 +5,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <cinttypes>
 #include <cmath>
@@ -16,7 +17,12 @@
 
 #include "capture_types.hpp"
 #include "conversions.hpp"
+#include "json_objects.hpp"
+#include "kdl_space/report/capture_report.hpp"
+#include "kdl_space/report/study_report.hpp"
 #include "kdl_space/study/study.hpp"
+#include "kdl_space/study/study_table.hpp"
+#include "kdl_space/study/study_to_table.hpp"
 
 namespace kdl_space::python {
 namespace {
@@ -25,12 +31,6 @@ struct PyStudy {
   std::shared_ptr<const Study> study;
   std::vector<std::string> columns;
 };
-
-std::string hex(std::uint64_t fingerprint) {
-  char fp[17];
-  std::snprintf(fp, sizeof fp, "%016" PRIx64, fingerprint);
-  return fp;
-}
 
 const char* kindName(Distribution::Kind k) {
   switch (k) {
@@ -50,17 +50,10 @@ std::uint64_t bounded(long long value, std::uint64_t most, const char* name, con
   return static_cast<std::uint64_t>(value);
 }
 
-py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long end_arg, long long threads_arg) {
-  const Study& st = *s.study;
-  const std::uint64_t end = bounded(end_arg, st.samples, "end", "the study's samples");
-  const std::uint64_t begin = bounded(begin_arg, end, "begin", "end");
-  const unsigned threads = static_cast<unsigned>(bounded(threads_arg, 4096, "threads", "0: all cores"));
-  const std::size_t m = s.columns.size();
-  py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(end - begin), static_cast<py::ssize_t>(m)});
-  double* data = out.mutable_data();
-  // The run on threads of its own, GIL released; this thread waits in slices of 50 ms and checks
-  // for signals between them, so Ctrl-C is answered within a slice and a sample (runStudy sees the
-  // cancel between samples), not after a chunk of up to 65,536 samples.
+/// Runs `work(cancel)` on a thread of its own with the GIL released; this thread waits in slices of
+/// 50 ms and checks for signals between them, so Ctrl-C sets `cancel` within a slice (the library
+/// stops within a sample) and raises KeyboardInterrupt, not after a chunk of up to 65,536 samples.
+void runAnsweringCtrlC(const std::function<void(const std::atomic<bool>& cancel)>& work) {
   std::atomic<bool> cancel{false};
   std::mutex mutex;
   std::condition_variable finished_cv;
@@ -70,10 +63,7 @@ py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long e
     py::gil_scoped_release nogil;
     std::thread runner([&] {
       try {
-        runStudy(s.study, StudyGrid{begin, end, defaultChunkSize(st.samples)}, threads,
-                 [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
-                   std::memcpy(data + (c.begin - begin) * m, chunk_rows.data(), chunk_rows.size() * sizeof(double));
-                 }, &cancel);
+        work(cancel);
       } catch (...) {
         error = std::current_exception();
       }
@@ -95,59 +85,39 @@ py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long e
     }
     runner.join();
   }
-  if (interrupted) throw py::error_already_set();
+  if (interrupted) {
+    if (error) {  // the library's Cancelled says what it kept: the KeyboardInterrupt's message
+      try {
+        std::rethrow_exception(error);
+      } catch (const Cancelled& e) {
+        PyErr_Clear();
+        PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+      } catch (...) {
+      }
+    }
+    throw py::error_already_set();
+  }
   if (error) std::rethrow_exception(error);
+}
+
+py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long end_arg, long long threads_arg) {
+  const Study& st = *s.study;
+  const std::uint64_t end = bounded(end_arg, st.samples, "end", "the study's samples");
+  const std::uint64_t begin = bounded(begin_arg, end, "begin", "end");
+  const unsigned threads = static_cast<unsigned>(bounded(threads_arg, 4096, "threads", "0: all cores"));
+  const std::size_t m = s.columns.size();
+  py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(end - begin), static_cast<py::ssize_t>(m)});
+  double* data = out.mutable_data();
+  runAnsweringCtrlC([&](const std::atomic<bool>& cancel) {
+    runStudy(s.study, StudyGrid{begin, end, defaultChunkSize(st.samples)}, threads,
+             [&](const StudyChunk& c, const std::vector<double>& chunk_rows) {
+               std::memcpy(data + (c.begin - begin) * m, chunk_rows.data(), chunk_rows.size() * sizeof(double));
+             }, &cancel);
+  });
   return out;
 }
 
-py::dict quantiles(const OutcomeSummary& o) {
-  py::dict d;
-  d["min"] = o.min, d["q05"] = o.q05, d["q25"] = o.q25, d["median"] = o.median;
-  d["q75"] = o.q75, d["q95"] = o.q95, d["max"] = o.max, d["mean"] = o.mean;
-  return d;
-}
-
-py::list digests(const std::vector<SampleDigest>& list) {
-  py::list a;
-  for (const SampleDigest& x : list) {
-    py::dict inputs, d;
-    for (const auto& [name, value] : x.inputs) inputs[py::str(name)] = value;
-    d["sample"] = x.sample, d["objective"] = x.objective, d["inputs"] = inputs;
-    a.append(d);
-  }
-  return a;
-}
-
-py::dict named(const std::vector<std::pair<std::string, double>>& values) {
-  py::dict d;
-  for (const auto& [name, v] : values) d[py::str(name)] = v;
-  return d;
-}
-
-/// A grid point's aggregates, as in `kdl_space study --json`'s grid_points.
-py::dict gridPoint(const GridPointSummary& g) {
-  py::dict d, outcomes;
-  for (const GridPointSummary::Outcome& o : g.outcomes) {
-    py::dict x;
-    x["mean"] = o.mean, x["q95"] = o.q95, x["max"] = o.max;
-    outcomes[py::str(o.name)] = x;
-  }
-  d["grid_point"] = g.index, d["inputs"] = named(g.inputs), d["count"] = g.count, d["failed"] = g.failed;
-  d["outcomes"] = outcomes, d["probabilities"] = named(g.probabilities);
-  return d;
-}
-
-py::list gridDigests(const std::vector<GridPointDigest>& list) {
-  py::list a;
-  for (const GridPointDigest& x : list) {
-    py::dict d;
-    d["grid_point"] = x.index, d["count"] = x.count, d["objective"] = x.objective, d["inputs"] = named(x.inputs);
-    a.append(d);
-  }
-  return a;
-}
-
-/// The summary as `kdl_space study --json` writes it (tools/study.cpp), without "table" (no file).
+/// The summary as `kdl_space study --json` writes it (report::studySummaryJson), without "table" (no file).
 py::dict summary(const PyStudy& s, py::handle given) {
   const Study& st = *s.study;
   const long m = static_cast<long>(s.columns.size());
@@ -167,28 +137,66 @@ py::dict summary(const PyStudy& s, py::handle given) {
     summarizer.add(a.data(), static_cast<std::size_t>(a.shape(0)));
     sum = summarizer.finish();
   }
-  py::dict outcomes, probabilities, d;
-  for (const OutcomeSummary& o : sum.outcomes) outcomes[py::str(o.name)] = quantiles(o);
-  for (const auto& [name, p] : sum.probabilities) probabilities[py::str(name)] = p;
-  d["study"] = st.file, d["fingerprint"] = hex(st.fingerprint), d["samples"] = sum.samples, d["failed"] = sum.failed;
-  d["seed"] = st.seed, d["outcomes"] = outcomes, d["probabilities"] = probabilities, d["objective"] = st.objective;
-  d["best"] = digests(sum.best), d["worst"] = digests(sum.worst);
-  d["quantile_rank_error"] = sum.quantile_rank_error;
-  py::list failures;
-  for (const StudyFailure& f : sum.failures) {
-    py::dict x;
-    x["status"] = f.status, x["count"] = f.count, x["first_sample"] = f.first_sample, x["message"] = f.message;
-    failures.append(x);
+  report::Json j = report::studySummaryJson(st, sum, "");
+  j.erase("table");
+  return toPython(j);
+}
+
+/// `table` as a study's table file at `path` (the tool's format, byte for byte), whole or not at all.
+void writeTable(const PyStudy& s, py::handle given, const std::string& path) {
+  const Study& st = *s.study;
+  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  Array a = Array::ensure(given);
+  const long m = static_cast<long>(s.columns.size());
+  if (!a || a.ndim() != 2 || a.shape(1) != m || static_cast<std::uint64_t>(a.shape(0)) > st.samples) {
+    PyErr_Clear();
+    throw py::value_error("table: expected an array of shape (n, " + std::to_string(m) + "), n <= " +
+                          std::to_string(st.samples) + " (rows 0..n-1 of the study)");
   }
-  d["failures"] = failures;
-  py::list grid_inputs, points;
-  for (const StudyInput& in : st.inputs)
-    if (in.distribution.kind == Distribution::Kind::Grid) grid_inputs.append(in.name);
-  for (const GridPointSummary& g : sum.grid_points) points.append(gridPoint(g));
-  d["grid_inputs"] = grid_inputs, d["grid_points"] = points;
-  if (!st.objective_statistic.empty()) {
-    d["objective_statistic"] = st.objective_statistic;
-    d["best_grid_points"] = gridDigests(sum.best_grid_points), d["worst_grid_points"] = gridDigests(sum.worst_grid_points);
+  checkOutputFile(path, "to_csv");
+  std::vector<InputFile> inputs = report::scenarioInputs(st.scenario);  // no output replaces an input
+  inputs.push_back({"the study file", st.file});
+  refuseOverwritingInputs("to_csv", path, inputs);
+  py::gil_scoped_release nogil;
+  writeStudyPart(path, "to_csv", st, s.columns, 0, static_cast<std::uint64_t>(a.shape(0)), a.data());
+}
+
+/// runStudyToTable: the summary (none for a shard) and what was done, as a dict.
+py::dict toTable(const PyStudy& s, const std::string& table, long long threads, py::object shard, std::vector<std::string> merge,
+                 long long chunk_size) {
+  TableOptions o;
+  o.table = table;
+  o.option = "table";
+  o.threads = static_cast<unsigned>(bounded(threads, 4096, "threads", "0: all cores"));
+  o.chunk_size = bounded(chunk_size, 100000000, "chunk_size", "0: the study's");
+  o.merge = std::move(merge);
+  if (!shard.is_none()) {
+    const auto pair = argumentAs<std::pair<long long, long long>>(shard, "shard", "a pair (i, n) of whole numbers");
+    o.shard = bounded(pair.first, 1u << 30, "shard[0]", "1 <= i <= n");
+    o.shards = bounded(pair.second, 1u << 30, "shard[1]", "n <= the study's samples");
+  }
+  tableRows(*s.study, o);  // UsageError (ValueError) before any work
+  std::vector<InputFile> inputs = report::scenarioInputs(s.study->scenario);
+  inputs.push_back({"the study file", s.study->file});
+  for (const std::string& part : o.merge) inputs.push_back({"one of the parts merged", part});
+  checkOutputFile(o.table, "table");
+  refuseOverwritingInputs("table", o.table, inputs);
+  std::vector<std::string> notes;
+  o.note = [&](const std::string& note) { notes.push_back(note); };
+  TableRun run;
+  runAnsweringCtrlC([&](const std::atomic<bool>& cancel) {
+    o.cancel = &cancel;
+    run = runStudyToTable(s.study, o);
+  });
+  for (const std::string& note : notes) PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1);
+  py::dict d;
+  d["table"] = run.table, d["begin"] = run.begin, d["end"] = run.end, d["computed"] = run.computed;
+  d["resumed"] = run.resumed, d["threads"] = run.threads, d["seconds"] = run.seconds, d["how"] = run.how;
+  if (run.summary) {
+    report::Json j = report::studySummaryJson(*s.study, *run.summary, run.table);
+    d["summary"] = toPython(j);
+  } else {
+    d["summary"] = py::none();
   }
   return d;
 }
@@ -272,6 +280,14 @@ void bindStudy(py::module_& m) {
            "fraction of the samples computed), probabilities {exceeds.*: p}, objective, best and worst [{sample, objective, inputs}], failures "
            "[{status, count, first_sample, message}] (one per distinct status; the message from evaluating "
            "first_sample again, GIL released).")
+      .def("write_table", &writeTable, py::arg("table"), py::arg("path"),
+           "Writes rows 0..n-1 of this study's table (an array (n, len(columns))) to `path` as `kdl_space study -o` "
+           "does, byte for byte (the tool merges, resumes from and plots it), whole or not at all. ValueError for a "
+           "path that is one of the study's inputs; OSError-like InputError for one that cannot be written.")
+      .def("to_table", &toTable, py::arg("table"), py::arg("threads") = 0, py::arg("shard") = py::none(),
+           py::arg("merge") = std::vector<std::string>{}, py::arg("chunk_size") = 0,
+           "runStudyToTable (kdl_space.study_to_table): the study's table written to `table` as `kdl_space study "
+           "-o` writes it.")
       .def("__repr__", [](const PyStudy& s) {
         std::ostringstream r;
         r << "<kdl_space.Study '" << s.study->file << "' " << s.study->samples << " samples, inputs [";

@@ -1,4 +1,5 @@
-// The rules of every output file the reports write: it is checked before any work, it never
+// The rules of every output file the library, the reports and the tool write (the counterpart of
+// input_file.hpp): it is checked before any work, it never
 // replaces an input, and it appears whole or not at all (written under a fresh temporary name in
 // its folder and renamed into place).
 #pragma once
@@ -7,24 +8,25 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/export.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
-namespace kdl_space::report {
+namespace kdl_space {
 
 /// A request the caller must change before anything runs (an output that would replace an input,
 /// an empty file name): the tool's exit 2, Python's ValueError.
-struct UsageError : std::runtime_error {
+struct KDL_SPACE_EXPORT UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 /// \brief Why the last write failed, for a message: the system's reason (strerror(errno): "No
 /// space left on device"), or "disk full?" when the stream kept none.
-std::string writeFailure();
+KDL_SPACE_EXPORT std::string writeFailure();
 
 /// \brief Refuses, before any work, an output file that could not be written: its folder is
 /// missing, not a folder or not writable, or the path is a folder. Throws InputError naming the
 /// option (e.g. "--csv run.csv: the folder 'out' does not exist"); UsageError for an empty name.
-void checkOutputFile(const std::string& path, const std::string& option);
+KDL_SPACE_EXPORT void checkOutputFile(const std::string& path, const std::string& option);
 
 /// A file a run reads, with what it is for messages ("the scenario file", "the robot's URDF").
 struct InputFile {
@@ -35,7 +37,7 @@ struct InputFile {
 /// `path` of `option` is one of `inputs`, by canonical path or as the same file (device and inode:
 /// a hard or symbolic link to it), naming both ("--csv a.urdf: is the robot's URDF
 /// robots/a.urdf; it would be overwritten").
-void refuseOverwritingInputs(const std::string& option, const std::string& path,
+KDL_SPACE_EXPORT void refuseOverwritingInputs(const std::string& option, const std::string& path,
                                               const std::vector<InputFile>& inputs);
 
 /// \brief Creates a new empty file `folder`/`stem`PID-XXXXXX (six random characters), exclusively
@@ -44,14 +46,14 @@ void refuseOverwritingInputs(const std::string& option, const std::string& path,
 /// its path; `fd`, if given, receives the open descriptor (else it is closed). The PID in the name
 /// lets a later run remove the temporaries of runs that are gone. Throws InputError `where` +
 /// "cannot create a file in the folder ...: REASON".
-std::string createFreshFile(const std::string& folder, const std::string& stem,
+KDL_SPACE_EXPORT std::string createFreshFile(const std::string& folder, const std::string& stem,
                                              const std::string& where, int* fd = nullptr);
 
 /// \brief A file written under a fresh temporary name in the same folder (createFreshFile: created
 /// at construction, unpredictable, never through a link someone planted) and renamed into place by
 /// commit(), so that a failed run never leaves a partial file that looks complete; the temporary
 /// is removed if the object is destroyed without a commit.
-class AtomicFile {
+class KDL_SPACE_EXPORT AtomicFile {
  public:
   /// `option` names the file in messages (e.g. "--csv"). Creates the temporary `.NAME.tmpPID-XXXXXX`
   /// beside `path`; throws InputError if it cannot.
@@ -72,4 +74,4 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-}  // namespace kdl_space::report
+}  // namespace kdl_space
