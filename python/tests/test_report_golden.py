@@ -56,3 +56,28 @@ def test_python_dicts_are_the_tools_json(cli):
     plan = kdl_space.plan_capture(scenario)
     tool_plan = tool_json(cli, "plan", "tumbling_box_capture.yaml", "--json")
     assert plan.optimum == tool_plan["optimum"] and plan.nominal == tool_plan["nominal"]
+
+
+def test_the_study_table_is_what_the_tool_wrote_before(cli, tmp_path):
+    """The first of 8 shards of the shipped study (its table's format moved into the library's
+    study/ layer): the same head line (fingerprint, rows), columns and statuses, the numbers within
+    1e-9; and Python's study_to_table writes the tool's bytes."""
+    import math
+    import kdl_space
+    before = (GOLDEN / "study_grasp_configuration.part-1-of-8.csv").read_text().splitlines()
+    out = subprocess.run([cli, "study", "study_grasp_configuration.yaml", "--shard", "1/8", "-o", tmp_path / "now.csv"],
+                         capture_output=True, text=True, timeout=600, cwd=SCENARIOS)
+    assert out.returncode == 0, out.stderr
+    now = (tmp_path / "now.csv").read_text().splitlines()
+    assert now[:2] == before[:2] and len(now) == len(before) == 53
+    assert now[-1].startswith("# end; rows 0-50; crc32 ")
+    for a, b in zip(before[2:-1], now[2:-1]):
+        x, y = [float(v) for v in a.split(",")], [float(v) for v in b.split(",")]
+        assert x[:2] == y[:2]  # sample, status
+        for u, v in zip(x, y):
+            assert (math.isnan(u) and math.isnan(v)) or abs(u - v) <= 1e-9 * max(1.0, abs(u)), (a, b)
+    done = kdl_space.study_to_table(SCENARIOS / "study_grasp_configuration.yaml", tmp_path / "py.csv", shard=(1, 8))
+    assert done["summary"] is None
+    # the fingerprint folds the study's path as given: the same path, the same bytes
+    py = (tmp_path / "py.csv").read_text().splitlines()
+    assert py[1:] == now[1:]
