@@ -85,7 +85,7 @@ std::unique_ptr<AtomicFile> nominalSamplePage(const Study& st, const std::string
   return file;
 }
 
-/// "i/N" -> (i, N): whole numbers (runStudyToTable checks 1 <= i <= N <= samples).
+/// "i/N" -> (i, N), whole numbers with 1 <= i <= N (runStudyToTable checks N <= samples).
 std::pair<std::uint64_t, std::uint64_t> parseShard(const std::string& text, std::uint64_t samples) {
   // Whole numbers in full (from_chars: no sign, no saturation of one too large to hold).
   const std::size_t slash = text.find('/');

@@ -1,6 +1,6 @@
 // `kdl_space study STUDY [-o TABLE.csv] [--threads N] [--shard i/N] [--merge PART...] [--plot FILE]
 // [--heat-map FILE] [--summary FILE] [--html FILE [--mesh-path DIR]...] [--json]`: a capture study (the library's loadStudy and
-// runStudy) on this machine's cores, or one shard of it, or its shards merged; the table, its
+// runStudyToTable) on this machine's cores, or one shard of it, or its shards merged; the table, its
 // summary and plots. A run keeps each finished chunk in TABLE.csv.parts/ until the table is
 // whole, so an interrupted run resumes where it stopped.
 #pragma once
