@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "ik_command.hpp"
 #include "inspect_command.hpp"
+#include "mount_command.hpp"
 #include "plan_command.hpp"
 #include "simulate_command.hpp"
 #include "study_command.hpp"
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   CLI::App* ik = addIk(app, ik_options);
   PlanCliOptions plan_options;
   CLI::App* plan = addPlan(app, plan_options);
+  MountOptions mount_options;
+  CLI::App* mount = addMount(app, mount_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
     if (study->parsed()) runStudyCommand(study_options, std::cout);
     if (ik->parsed()) runIk(ik_options, std::cout);
     if (plan->parsed()) runPlan(plan_options, std::cout);
+    if (mount->parsed()) runMount(mount_options, std::cout);
     const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
     if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
       std::cerr << "kdl_space: cannot write the output to stdout\n";

@@ -45,7 +45,8 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
             : r.target_motion    ? std::string("the target separates; both move on")
                                  : std::string("the target separates; the robot alone"));
   } else {
-    out << "Plain motion of " << sc.robot_urdf << " from its initial state (no impact)";
+    out << "Plain motion of " << (sc.robot_urdf.empty() ? "the mounted robot" : sc.robot_urdf)
+        << " from its initial state (no impact)";
   }
   out << ", " << r.duration << " s with " << toString(record.options.integrator) << " ("
       << record.stats.accepted_steps << " steps, " << record.stats.rejected_steps << " rejected)"

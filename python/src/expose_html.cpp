@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "kdl_space/report/capture_report.hpp"
 #include "kdl_space/report/html_writer.hpp"
 
 namespace kdl_space::python {
@@ -37,8 +38,7 @@ void writePage(const std::string& path, const Scenario& sc, const std::vector<st
     if (path.empty()) throw UsageError("to_html: the file name is empty");
     report::checkHtmlLibrary("to_html", path);
     checkOutputFile(path, "to_html");
-    std::vector<InputFile> inputs = {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf},
-                                     {"the target's URDF", sc.target_urdf}};
+    std::vector<InputFile> inputs = report::scenarioInputs(sc);
     for (InputFile& mesh : report::meshInputs(sc, mesh_search_path)) inputs.push_back(std::move(mesh));  // the page's meshes
     refuseOverwritingInputs("to_html", path, inputs);
     AtomicFile file(path, "to_html");

@@ -8,6 +8,7 @@ import json
 import math
 import re
 import shutil
+import functools
 import subprocess
 import xml.etree.ElementTree as ET
 
@@ -69,7 +70,10 @@ def browser(page, fragment, *extra):
                           capture_output=True, text=True, timeout=120)
 
 
+@functools.lru_cache(maxsize=None)
 def selftest(page, k):
+    """The page's self-test at frame k (one Chromium run; the same page and frame asked again, the
+    same answer: a page is a file the module's run wrote once)."""
     done = browser(page, f"selftest={k}", "--dump-dom")
     m = re.search(r'<pre id="selftest">(.*?)</pre>', done.stdout, re.S)
     assert m and m.group(1), f"no selftest output; chromium said: {done.stderr[-2000:]}"

@@ -431,24 +431,24 @@ def test_study_to_table_takes_a_stale_lock_with_a_warning_and_refuses_a_live_one
 
 
 def test_study_to_table_answers_ctrl_c_and_the_same_call_resumes(tmp_path):
-    # 2,000 samples of a capture and 0.5 s of motion (about 6 ms each) in chunks of 50 on two
-    # threads: about 6 s. SIGINT after 1 s: KeyboardInterrupt saying what is kept; the chunks stay;
-    # the same call computes only the rest, and the table is the uninterrupted run's.
+    # 600 samples of a capture and 0.5 s of motion (about 6 ms each) in chunks of 20 on two
+    # threads: about 2 s. SIGINT after 0.5 s: KeyboardInterrupt saying what is kept; the chunks
+    # stay; the same call computes only the rest, and the table is the uninterrupted run's.
     path = tmp_path / "long_study.yaml"
-    path.write_text(SMALL_STUDY.replace("samples: 60", "samples: 2000") + "motion: {duration: 0.5}\n")
+    path.write_text(SMALL_STUDY.replace("samples: 60", "samples: 600") + "motion: {duration: 0.5}\n")
     table = tmp_path / "t.csv"
-    timer = threading.Timer(1.0, lambda: signal.pthread_kill(threading.main_thread().ident, signal.SIGINT))
+    timer = threading.Timer(0.5, lambda: signal.pthread_kill(threading.main_thread().ident, signal.SIGINT))
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt, match="chunks kept in"):
-            kdl_space.study_to_table(path, table, threads=2, chunk_size=50)
+            kdl_space.study_to_table(path, table, threads=2, chunk_size=20)
     finally:
         timer.cancel()
         timer.join()
     kept = sorted(os.listdir(str(table) + ".parts"))
     assert kept and not table.exists() and not (tmp_path / "t.csv.lock").exists()
-    done = kdl_space.study_to_table(path, table, threads=2, chunk_size=50)
-    assert done["resumed"] == 50 * len(kept) and done["computed"] == 2000 - done["resumed"]
+    done = kdl_space.study_to_table(path, table, threads=2, chunk_size=20)
+    assert done["resumed"] == 20 * len(kept) and done["computed"] == 600 - done["resumed"]
     whole = kdl_space.study(path, threads=2)
     whole.to_csv(tmp_path / "whole.csv")
     assert table.read_bytes() == (tmp_path / "whole.csv").read_bytes()

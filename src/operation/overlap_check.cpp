@@ -124,7 +124,7 @@ std::vector<Diagnostic> overlapWarnings(const CaptureProblem& problem, const std
 
 std::vector<Diagnostic> overlapWarnings(const Scenario& scenario, const CaptureProblem& at, const std::string& moment) {
   if (!scenario.impact) return {};
-  return overlapWarnings(at, scenario.robot_urdf, moment);
+  return overlapWarnings(at, linkGeometry(*at.robot.model, robotVisuals(scenario)), moment);
 }
 
 }  // namespace kdl_space

@@ -113,7 +113,10 @@ SceneSnapshot impactSnapshot(const Scenario& sc) {
 }
 
 std::vector<InputFile> scenarioInputs(const Scenario& sc) {
-  return {{"the scenario file", sc.file}, {"the robot's URDF", sc.robot_urdf}, {"the target's URDF", sc.target_urdf}};
+  std::vector<InputFile> inputs{{"the scenario file", sc.file}};
+  for (const std::string& f : sc.robot_files) inputs.push_back({"the robot's URDF", f});  // a mounted robot's bus and arms
+  inputs.push_back({"the target's URDF", sc.target_urdf});
+  return inputs;
 }
 
 /// The compliant contact beside the impulsive capture (`law: {type: compliant}`): what the

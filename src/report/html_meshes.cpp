@@ -77,7 +77,7 @@ void HtmlWriter::readMesh(const std::string& link, LinkVisual& v) {
 // --- The meshes a page reads, as inputs no output may replace (issue 25's rule) ----------------
 PageVisuals readPageVisuals(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
   PageVisuals visuals;
-  if (!sc.robot_urdf.empty()) visuals.robot = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  visuals.robot = robotVisuals(sc, mesh_search_path);
   if (!sc.target_urdf.empty()) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
   return visuals;
 }

@@ -58,7 +58,7 @@ namespace {
 /// page draws them (HtmlWriter::drawsTargetVisuals).
 PageVisuals visualsToDraw(const Scenario& sc, const std::vector<std::string>& mesh_search_path, bool target) {
   PageVisuals visuals;
-  if (!sc.robot_urdf.empty()) visuals.robot = readUrdfVisuals(sc.robot_urdf, mesh_search_path);
+  visuals.robot = robotVisuals(sc, mesh_search_path);
   if (target) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
   return visuals;
 }

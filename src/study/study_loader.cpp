@@ -373,7 +373,10 @@ Study loadStudy(const std::string& path) {
   }
   if (top.has("heat_map")) readHeatMap(top.at("heat_map"), columns, st);
   std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (const std::string& file : {path, scenario_path, sc.robot_urdf, sc.target_urdf}) h = fold(h, file);
+  std::vector<std::string> files{path, scenario_path};  // a mounted robot: its bus's and arms' files
+  files.insert(files.end(), sc.robot_files.begin(), sc.robot_files.end());
+  files.push_back(sc.target_urdf);
+  for (const std::string& file : files) h = fold(h, file);
   st.fingerprint = h;
   return st;
 }

@@ -518,6 +518,45 @@ TEST_P(CliFamilies, AStudyComputesEverySample) {
 }
 
 // check: no error in any family's file, and the joints it counts are the family's.
+// kdl_space mount: the family's robot as an arm on a bus given as mass and box (robot.mount),
+// written as one URDF: the bus's mass and box inertia added, the robot's joints kept, and inspect
+// on the written file gives the G* of the library's model of the same scenario; the arm's file is
+// never overwritten.
+TEST_P(CliFamilies, MountPutsTheRobotOnABusAsOneUrdf) {
+  const ModelFamily& f = GetParam();
+  const FloatingModel alone = loadUrdfFile(familyUrdf(f.name));
+  const std::string scenario = scratchIn("cli_families_" + f.name, "mount.yaml");
+  spit(scenario, "robot:\n  urdf: " + familyUrdf(f.name) + "\n  mount: {bus: {name: servicer, mass: 800, box: [1.5, 1.2, 1.0]}, " +
+                     "pose: {position: [0.8, 0, 0.6], rpy: {deg: [0, 20, 0]}}}\n  contact: {link: " + f.contact + "}\n" +
+                     "simulation: {duration: 1}\n");
+  const std::string out = scratchIn("cli_families_" + f.name, "mounted.urdf");
+  const ToolRun run = kdlSpace("mount " + scenario + " -o " + out + " --json");
+  ASSERT_TRUE(noSignal(run, f.name + " mount"));
+  ASSERT_EQ(run.rc, 0) << f.name << ": " << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_NEAR(j.at("mass").get<double>(), 800 + alone.totalMass(), 1e-12 * (800 + alone.totalMass())) << f.name;
+  std::vector<std::string> joints = j.at("joints").get<std::vector<std::string>>(), expected = alone.jointNames();
+  std::sort(joints.begin(), joints.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(joints, expected) << f.name;
+  const auto written = std::make_shared<const FloatingModel>(loadUrdfFile(out));
+  EXPECT_EQ(written->bodies()[0].name, "servicer");
+  const ToolRun inspect = kdlSpace("inspect --urdf " + out + " --tip " + f.contact + " --json");
+  ASSERT_EQ(inspect.rc, 0) << f.name << ": " << inspect.err;
+  FreeFloatingSolver solver(written);
+  ASSERT_EQ(solver.compute(State(*written)), 0);
+  Matrix6d G;
+  ASSERT_EQ(solver.G_star(written->contact(f.contact), G), 0);
+  const Eigen::MatrixXd G_tool = matrixOf(json::parse(inspect.out).at("contacts")[0].at("G_star"));
+  EXPECT_TRUE(near(G_tool, G, 1e-12, 1e-15 * G.norm(), f.name + " inspect of the mounted robot"));
+  // the robot's own file is an input: never the output
+  const std::string before = slurp(familyUrdf(f.name));
+  const ToolRun over = kdlSpace("mount " + scenario + " -o " + familyUrdf(f.name));
+  EXPECT_EQ(over.rc, 2) << over.err;
+  EXPECT_NE(over.err.find("it would be overwritten"), std::string::npos) << over.err;
+  EXPECT_EQ(slurp(familyUrdf(f.name)), before);
+}
+
 TEST_P(CliFamilies, CheckFindsNoError) {
   const ModelFamily& f = GetParam();
   const ToolRun run = kdlSpace("check " + familyUrdf(f.name) + " --json");

@@ -189,6 +189,82 @@ TEST(LoadScenario, RefusesABrokenFileNamingTheLineAndField) {
   EXPECT_EQ(refusal("/nonexistent/scenario.yaml"), "/nonexistent/scenario.yaml: no such file");
 }
 
+// --- Angles in degrees where a person writes them ------------------------------------------------
+
+/// A scenario (a plain motion) of a base, a hinge and a slide, with `robot` (YAML after "robot:"
+/// and the URDF) in a scratch folder.
+std::string degreesScenario(const std::string& name, const std::string& robot) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "kdl_space_degrees";
+  fs::create_directories(dir);
+  std::ofstream(dir / "hinge_slide.urdf") << R"(<robot name="hs">
+  <link name="base"><inertial><mass value="50"/><inertia ixx="2" iyy="3" izz="4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="5"/><inertia ixx="0.2" iyy="0.3" izz="0.4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+  <joint name="slide" type="prismatic"><parent link="arm"/><child link="tip"/><origin xyz="1 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+)";
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << "simulation: {duration: 1}\nrobot:\n  urdf: hinge_slide.urdf\n" << robot;
+  return path;
+}
+
+// `{deg: x}` for an angle, `{deg: [r, p, y]}` for a pose's rpy, `{deg_per_s: x}` for a revolute
+// joint's rate: converted once at load, the same state as the radians written out; a prismatic
+// joint's value or rate in degrees, and any other key, refused naming the field.
+TEST(LoadScenario, AnglesInDegreesAreConvertedOnceAtLoad) {
+  const Scenario d = loadScenario(degreesScenario(
+      "deg.yaml", "  base: {position: [1, 2, 3], rpy: {deg: [10, -20, 30]}}\n"
+                  "  q: {hinge: {deg: 30}, slide: 0.2}\n  qdot: {hinge: {deg_per_s: -5}, slide: 0.01}\n"));
+  char rad[256];
+  const double k = 3.14159265358979323846 / 180.0;
+  std::snprintf(rad, sizeof rad,
+                "  base: {position: [1, 2, 3], rpy: [%.17g, %.17g, %.17g]}\n  q: {hinge: %.17g, slide: 0.2}\n"
+                "  qdot: {hinge: %.17g, slide: 0.01}\n",
+                10 * k, -20 * k, 30 * k, 30 * k, -5 * k);
+  const Scenario r = loadScenario(degreesScenario("rad.yaml", rad));
+  const State& a = d.capture.robot.state;
+  const State& b = r.capture.robot.state;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(a.world_T_base.p(i), b.world_T_base.p(i));
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(a.world_T_base.M(i, j), b.world_T_base.M(i, j), 1e-15);
+  }
+  double roll = 0, pitch = 0, yaw = 0;
+  a.world_T_base.M.GetRPY(roll, pitch, yaw);
+  EXPECT_NEAR(roll, 3.14159265358979323846 / 18, 1e-15);  // 10 degrees, independently
+  EXPECT_NEAR(pitch, -3.14159265358979323846 / 9, 1e-15);
+  EXPECT_NEAR(yaw, 3.14159265358979323846 / 6, 1e-15);
+  const FloatingModel& m = *d.capture.robot.model;
+  EXPECT_NEAR(a.q(m.jointIndex("hinge")), 3.14159265358979323846 / 6, 1e-15);
+  EXPECT_EQ(a.q(m.jointIndex("slide")), 0.2);
+  EXPECT_NEAR(d.capture.robot.velocity.qdot(m.jointIndex("hinge")), -3.14159265358979323846 / 36, 1e-16);
+  EXPECT_EQ(d.capture.robot.velocity.qdot(m.jointIndex("slide")), 0.01);
+  EXPECT_EQ(a.q.data, b.q.data);
+  EXPECT_DOUBLE_EQ(d.capture.robot.velocity.qdot(m.jointIndex("hinge")), r.capture.robot.velocity.qdot(m.jointIndex("hinge")));
+
+  const auto refused = [](const std::string& name, const std::string& robot) {
+    const std::string path = degreesScenario(name, robot);
+    const std::string why = refusal(path);
+    return why.substr(0, path.size()) == path ? why.substr(path.size()) : why;
+  };
+  EXPECT_EQ(refused("slide_deg.yaml", "  q: {slide: {deg: 3}}\n"),
+            ":4: robot.q.slide: joint 'slide' is prismatic: its value is a length in m, not an angle");
+  EXPECT_EQ(refused("slide_rate.yaml", "  qdot: {slide: {deg_per_s: 3}}\n"),
+            ":4: robot.qdot.slide: joint 'slide' is prismatic: its rate is a speed in m/s, not an angle");
+  EXPECT_NE(refused("rate_as_angle.yaml", "  q: {hinge: {deg_per_s: 3}}\n").find("robot.q.hinge"), std::string::npos);
+  EXPECT_NE(refused("rate_as_angle.yaml", "  q: {hinge: {deg_per_s: 3}}\n").find("deg_per_s"), std::string::npos);
+  EXPECT_NE(refused("rad_key.yaml", "  base: {rpy: {rad: [0, 0, 0]}}\n").find("robot.base.rpy"), std::string::npos);
+  EXPECT_EQ(refused("two.yaml", "  base: {rpy: {deg: [1, 2]}}\n"),
+            ":4: robot.base.rpy.deg: expected a list of 3 numbers, got a list of 2");
+  EXPECT_EQ(refused("list.yaml", "  q: {hinge: [30]}\n"),
+            ":4: robot.q.hinge: expected an angle [rad], or {deg: VALUE}, got a list of 1");
+  EXPECT_EQ(refused("not_map.yaml", "  q: [1, 2]\n"), ":4: robot.q: expected a mapping NAME: VALUE, got a list of 2");
+  EXPECT_EQ(refused("unknown.yaml", "  q: {elbow: {deg: 3}}\n"),
+            ":4: robot.q.elbow: the model has no movable joint 'elbow' (its movable joints: hinge, slide)");
+}
+
 // --- The compliant law -------------------------------------------------------------------------
 
 /// robot_to_robot_capture.yaml (a free-floating target) with `law` (YAML after "law:"), in a

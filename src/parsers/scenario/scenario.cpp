@@ -11,6 +11,7 @@
 #include "multibody/model_rules.hpp"
 #include "parsers/scenario/scenario_approach.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
+#include "parsers/scenario/scenario_mount.hpp"
 #include "parsers/scenario/scenario_sections.hpp"
 
 namespace kdl_space {
@@ -20,6 +21,7 @@ using detail::listNames;
 using detail::number;
 using fields::echo;
 using fields::Field;
+using fields::pose;
 
 std::vector<std::string> linkNames(const FloatingModel& model) {
   std::vector<std::string> names;
@@ -27,20 +29,24 @@ std::vector<std::string> linkNames(const FloatingModel& model) {
   return names;
 }
 
-/// A pose from optional `position` and `rpy` fields of f (URDF convention).
-KDL::Frame pose(const Field& f) {
-  const Eigen::VectorXd p = f.has("position") ? f.at("position").vector(3) : Eigen::VectorXd::Zero(3);
-  const Eigen::VectorXd r = f.has("rpy") ? f.at("rpy").vector(3) : Eigen::VectorXd::Zero(3);
-  return basePose(KDL::Vector(p(0), p(1), p(2)), r(0), r(1), r(2));
-}
-
-/// Joint values by name; an unknown name is reported at its field.
-KDL::JntArray joints(const Field& f, const FloatingModel& model) {
-  const std::map<std::string, double> values = f.namedNumbers();
-  for (const auto& [name, value] : values)
-    if (model.jointIndex(name) < 0)
-      f.at(name).fail("the model has no movable joint " + echo(name) + " (its movable joints: " +
-                      listNames(model.jointNames()) + ")");
+/// Joint values (`rate`: rates) by name; an unknown name is reported at its field. A revolute
+/// joint's value may be given in degrees ({deg: 30}; a rate {deg_per_s: 5}); a prismatic one's is a length.
+KDL::JntArray joints(const Field& f, const FloatingModel& model, bool rate = false) {
+  if (!f.isMap()) f.failKind("a mapping NAME: VALUE");
+  std::map<std::string, double> values;
+  for (const Field::Entry& e : f.entries()) {
+    const int j = model.jointIndex(e.name);
+    if (j < 0)
+      e.key.fail("the model has no movable joint " + echo(e.name) + " (its movable joints: " +
+                 listNames(model.jointNames()) + ")");
+    const Field& v = e.required();
+    const KDL::Joint::JointType type = model.bodies()[model.jointBody()[j]].segment.getJoint().getType();
+    const bool prismatic = type >= KDL::Joint::TransAxis && type <= KDL::Joint::TransZ;
+    if (prismatic && v.isMap())
+      v.fail("joint " + echo(e.name) + " is prismatic: its " + (rate ? "rate is a speed in m/s" : "value is a length in m") +
+             ", not an angle");
+    values[e.name] = v.angle(rate);
+  }
   return jointsByName(model, values);
 }
 
@@ -80,19 +86,27 @@ double rotorInertia(const Field& f) {
 }
 
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
-FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp"});
+/// `mount` (the robot's: its arms on a bus, robot.mount) gets the joined document; null: refused.
+FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path, MountedRobot* mount = nullptr) {
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp", "mount"});
   FloatingSystem s;
-  const Field urdf = f.at("urdf");
-  urdf_path = urdf.text();
-  if (urdf_path.empty()) urdf.fail("the file name is empty");
-  if (std::filesystem::path(urdf_path).is_relative())
-    urdf_path = (std::filesystem::path(folder) / urdf_path).lexically_normal().string();
-  try {
-    checkInputFile(urdf_path, "URDF file");
-    s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
-  } catch (const Error& e) {  // the file unreadable (InputError) or its model broken (ModelError)
-    e.rethrowWithContext(urdf.where());
+  if (f.has("mount")) {
+    if (!mount) f.at("mount").fail("only the robot is mounted (its arms on a bus): give the target's urdf");
+    *mount = sections::mounted(f, folder);
+    try {
+      s.model = std::make_shared<const FloatingModel>(loadUrdfString(mount->urdf, "the mounted robot"));
+    } catch (const Error& e) {  // the joined model broken (a bus's inertia, an arm's rule)
+      e.rethrowWithContext(f.at("mount").where());
+    }
+  } else {
+    const Field urdf = f.at("urdf");
+    urdf_path = sections::filePath(urdf, folder);
+    try {
+      checkInputFile(urdf_path, "URDF file");
+      s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
+    } catch (const Error& e) {  // the file unreadable (InputError) or its model broken (ModelError)
+      e.rethrowWithContext(urdf.where());
+    }
   }
   if (f.has("armature")) {  // rotor inertias, reflected: a number, or n^2 I_rotor
     std::vector<double> armature = s.model->armature();
@@ -108,7 +122,7 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
     if (base.has("twist")) s.velocity.base_twist = toTwist(Vector6d(base.at("twist").vector(6)));
   }
   if (f.has("q")) s.state.q = joints(f.at("q"), *s.model);
-  if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model);
+  if (f.has("qdot")) s.velocity.qdot = joints(f.at("qdot"), *s.model, true);
   if (f.has("locked"))
     s.locked = lockedJoints(f.at("locked"), *s.model, s.velocity.qdot, (f.path().empty() ? "" : f.path() + ".") + "qdot");
   if (f.has("contact")) {  // required for an impact (loadScenario); a plain motion has none: the base
@@ -351,7 +365,11 @@ Scenario loadScenario(const std::string& path) {
     top.fail("a scenario is a mapping with robot, target and law (or robot and simulation), not " + fields::kindOf(root));
   top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
-  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf);
+  MountedRobot mount;
+  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf, &mount);
+  s.robot_document = std::move(mount.urdf);
+  s.robot_files = s.robot_urdf.empty() ? std::move(mount.files) : std::vector<std::string>{s.robot_urdf};
+  s.robot_notes = std::move(mount.notes);
   const Field robot = top.at("robot");
   if (robot.has("grasp") && !robot.has("place"))
     robot.at("grasp").fail("is the grasp frame that robot.place: grasp solves the arm for: add robot.place: grasp");

@@ -24,7 +24,7 @@ ApproachSpec approach(const Field& f, const FloatingModel& robot, const KDL::Vec
   grasp.onlyKeys({"position", "rpy"});
   const Eigen::VectorXd p = grasp_position && !grasp.has("position") ? Eigen::VectorXd(toEigen(*grasp_position))
                                                                       : grasp.at("position").vector(3);
-  const Eigen::VectorXd r = grasp.has("rpy") ? grasp.at("rpy").vector(3) : Eigen::VectorXd::Zero(3);
+  const Eigen::VectorXd r = grasp.has("rpy") ? grasp.at("rpy").angles(3) : Eigen::VectorXd::Zero(3);
   a.grasp = KDL::Frame(KDL::Rotation::RPY(r(0), r(1), r(2)), KDL::Vector(p(0), p(1), p(2)));
   if (f.has("track")) {
     const std::string track = f.at("track").text();

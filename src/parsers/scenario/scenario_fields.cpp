@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "kdl_space/spatial/errors.hpp"
+#include "kdl_space/multibody/state.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 
 namespace kdl_space::fields {
@@ -164,18 +165,33 @@ Eigen::VectorXd Field::vector(int size) const {
   return v;
 }
 
+namespace {
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+}  // namespace
+
+double Field::angle(bool rate) const {
+  const char* unit = rate ? "deg_per_s" : "deg";
+  if (!node_.IsMap()) {
+    if (!node_.IsScalar())
+      fail("expected " + std::string(rate ? "an angular rate [rad/s]" : "an angle [rad]") + ", or {" + unit +
+           ": VALUE}, got " + kindOf(node_));
+    return number();
+  }
+  onlyKeys({unit});
+  return at(unit).number() * kRadPerDeg;
+}
+
+Eigen::VectorXd Field::angles(int size) const {
+  if (!node_.IsMap()) return vector(size);
+  onlyKeys({"deg"});
+  return at("deg").vector(size) * kRadPerDeg;
+}
+
 Eigen::Matrix3d Field::matrix3() const {
   if (!node_.IsSequence() || node_.size() != 3) fail("expected 3 rows of 3 numbers, got " + kindOf(node_));
   Eigen::Matrix3d m;
   for (int i = 0; i < 3; ++i) m.row(i) = child(node_[i], path_ + "[" + std::to_string(i) + "]").vector(3);
   return m;
-}
-
-std::map<std::string, double> Field::namedNumbers() const {
-  if (!node_.IsMap()) fail("expected a mapping NAME: VALUE, got " + kindOf(node_));
-  std::map<std::string, double> values;
-  for (const Entry& e : entries()) values[e.name] = e.required().number();
-  return values;
 }
 
 std::vector<Field> Field::items(const std::string& what) const {
@@ -195,6 +211,12 @@ bool Field::flag() const {
 Eigen::Vector3d Field::perAxis() const {
   if (node_.IsSequence()) return vector(3);
   return Eigen::Vector3d::Constant(number());
+}
+
+KDL::Frame pose(const Field& f) {
+  const Eigen::VectorXd p = f.has("position") ? f.at("position").vector(3) : Eigen::VectorXd::Zero(3);
+  const Eigen::VectorXd r = f.has("rpy") ? f.at("rpy").angles(3) : Eigen::VectorXd::Zero(3);
+  return basePose(KDL::Vector(p(0), p(1), p(2)), r(0), r(1), r(2));
 }
 
 }  // namespace kdl_space::fields

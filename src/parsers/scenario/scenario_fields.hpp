@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <kdl/frames.hpp>
 #include <cstdint>
 #include <initializer_list>
 #include <map>
@@ -61,10 +62,13 @@ class Field {
   double number() const;
   /// A list of `size` finite numbers.
   Eigen::VectorXd vector(int size) const;
+  /// \brief An angle [rad], or an angular rate [rad/s] when `rate`: a number in SI, or the same
+  /// in degrees as `{deg: 30}` (`{deg_per_s: 5}` for a rate), converted here (outputs stay SI).
+  double angle(bool rate = false) const;
+  /// `size` angles [rad] (roll, pitch, yaw): a list of numbers, or `{deg: [r, p, y]}`.
+  Eigen::VectorXd angles(int size) const;
   /// 3 rows of 3 finite numbers.
   Eigen::Matrix3d matrix3() const;
-  /// A mapping NAME: finite number.
-  std::map<std::string, double> namedNumbers() const;
   /// The items of a list, each with its path PATH[i] ("expected a list of `what`, got ..." else).
   std::vector<Field> items(const std::string& what) const;
   /// true or false.
@@ -75,6 +79,9 @@ class Field {
   const std::string& path() const { return path_; }
   bool isScalar() const { return node_.IsScalar(); }
   bool isSequence() const { return node_.IsSequence(); }
+  bool isMap() const { return node_.IsMap(); }
+  /// Throws "PATH: expected `expected`, got WHAT IT IS".
+  [[noreturn]] void failKind(const std::string& expected) const { fail("expected " + expected + ", got " + kindOf(node_)); }
 
  private:
   /// path.key, the key cut to a readable length (detail::cut).
@@ -84,6 +91,9 @@ class Field {
   std::string path_;
   const std::string* file_;
 };
+
+/// A pose from optional `position` and `rpy` fields of f (URDF convention; rpy in rad or {deg: [...]}).
+KDL::Frame pose(const Field& f);
 
 /// A key of a mapping and its value (Field::entries).
 struct Field::Entry {

@@ -84,7 +84,7 @@ BaseControl baseControl(const Field& f) {
       sp.onlyKeys({"rpy", "quaternion"});
       if (sp.has("rpy") == sp.has("quaternion")) sp.fail("give one of rpy, quaternion");
       if (sp.has("rpy")) {
-        const Eigen::VectorXd r = sp.at("rpy").vector(3);
+        const Eigen::VectorXd r = sp.at("rpy").angles(3);
         att.set_point = KDL::Rotation::RPY(r(0), r(1), r(2));
       } else {
         const Eigen::VectorXd q = sp.at("quaternion").vector(4);

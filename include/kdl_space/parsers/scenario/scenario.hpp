@@ -3,6 +3,7 @@
 // `kdl_space capture` and `simulate` read; a library user can build the same types in code.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,6 +13,8 @@
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/simulation/approach.hpp"
 #include "kdl_space/impact/capture.hpp"
+#include "kdl_space/multibody/diagnostics.hpp"
+#include "kdl_space/parsers/urdf/urdf_visuals.hpp"
 #include "kdl_space/export.hpp"
 #include "kdl_space/simulation/simulation.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
@@ -40,7 +43,12 @@ struct SimulationSpec {
 /// A scenario file, read and checked.
 struct Scenario {
   std::string file;         ///< the path it was read from
-  std::string robot_urdf;   ///< the robot's URDF (resolved path)
+  std::string robot_urdf;   ///< the robot's URDF (resolved path); empty for a mounted robot (robot.mount)
+  /// A mounted robot's URDF document (robot.mount: its arms on a bus, mountArms), what robot_urdf
+  /// holds otherwise; empty when robot_urdf is the robot's.
+  std::string robot_document;
+  std::vector<std::string> robot_files;  ///< the files the robot is read from: robot_urdf, or the bus's and arms'
+  std::vector<Diagnostic> robot_notes;   ///< what mounting assumed (names prefixed, mesh paths made absolute)
   /// The target's URDF (resolved path): a free-floating target, or a rigid one read from a file
   /// (one without movable joints, or the links from `target.link` down); empty for a rigid target
   /// given by numbers.
@@ -83,6 +91,11 @@ struct Scenario {
 /// \throws InputError "FILE[:LINE]: FIELD: what is wrong" (e.g. "s.yaml:10: target.mass: must
 /// be > 0 kg, got -3") for every problem of the file, its own (missing, empty, not YAML)
 /// included; a URDF it names that loads no model is the loader's ModelError with the same
+/// \brief The robot's visuals (readUrdfVisuals) from its URDF, or from its document when it is
+/// mounted (robot.mount); none for neither (a robot built in code).
+KDL_SPACE_EXPORT std::map<std::string, std::vector<LinkVisual>> robotVisuals(const Scenario& scenario,
+                                                                           const std::vector<std::string>& package_path = {});
+
 /// "FILE:LINE: robot.urdf: " in front (catch Error for both).
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);
 
