@@ -1,4 +1,4 @@
-// The library calls behind `inspect`, `capture`, `ik` and `plan` on one scenario file: what
+// The library calls behind `inspect`, `capture`, `ik`, `plan` and `export` on one scenario file: what
 // fuzz_commands drives, and what test_fuzz_regressions.cpp replays on the inputs it found.
 // Returns normally for every outcome a caller can handle (a result, a code, a kdl_space::Error);
 // anything else escapes (another exception) or crashes: a finding.
@@ -14,6 +14,9 @@
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/multibody/poses.hpp"
+#include "kdl_space/parsers/formats/mjcf.hpp"
+#include "kdl_space/parsers/formats/spacedyn_lp.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 
@@ -40,7 +43,21 @@ inline void driveInspect(const FloatingSystem& robot) {
   contactFrame(*model, robot.state, robot.contact);
 }
 
-/// Loads the scenario and runs inspect, capture, ik and plan on it.
+/// export's writers on the scenario (SpaceDyn's LP and SV, the MJCF scene) and the MJCF read back.
+inline void driveExport(const Scenario& sc) {
+  try {
+    writeSpaceDyn(sc.capture.robot, "fuzz");
+  } catch (const Error&) {
+  }
+  try {
+    std::vector<Diagnostic> notes;
+    const std::string xml = writeMjcf(MjcfScene{sc.capture.robot, sc.impact ? std::optional<CaptureTarget>(sc.capture.target) : std::nullopt});
+    loadUrdfString(mjcfToUrdf(xml, "fuzz.xml", notes), "fuzz.xml");
+  } catch (const Error&) {
+  }
+}
+
+/// Loads the scenario and runs inspect, capture, ik, plan and export on it.
 inline void driveCommands(const std::string& scenario_path) {
   Scenario sc;
   try {
@@ -53,6 +70,7 @@ inline void driveCommands(const std::string& scenario_path) {
     driveInspect(robot);
   } catch (const Error&) {
   }
+  driveExport(sc);
   if (sc.impact) {
     try {
       solveCapture(sc.capture);

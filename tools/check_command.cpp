@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "kdl_space/parsers/formats/robot_file.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 
 namespace kdl_space::cli {
@@ -137,7 +138,7 @@ CLI::App* addCheck(CLI::App& app, CheckOptions& o) {
 }
 
 int runCheck(const CheckOptions& o, std::ostream& out) {
-  const UrdfReport report = checkUrdfFile(o.urdf, o.tips);
+  const UrdfReport report = checkRobotFile(o.urdf, o.tips);
   stopIfInterrupted("check " + o.urdf + ": after the checks");
   const bool failed = !report.errors.empty() || (o.strict && !report.warnings.empty());
   if (o.json) {

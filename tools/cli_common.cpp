@@ -22,6 +22,16 @@
 
 namespace kdl_space::cli {
 
+void writeTextFile(const std::string& path, const std::string& option, const std::string& text) {
+  AtomicFile file(path, option);
+  errno = 0;
+  std::ofstream f(file.tmp(), std::ios::binary);
+  f << text;
+  f.close();
+  if (!f) throw InputError(option + " " + path + ": cannot write the file: " + writeFailure());
+  file.commit();
+}
+
 std::size_t outputWidth() {
   const char* columns = std::getenv("COLUMNS");
   if (columns == nullptr || *columns == '\0') return kDefaultOutputWidth;

@@ -26,6 +26,10 @@ class Validator;
 
 namespace kdl_space::cli {
 
+/// \brief Writes `text` to `path` whole or not at all (AtomicFile); InputError naming `option` when
+/// it cannot. The caller has refused an input as `path` (refuseOverwritingInputs).
+void writeTextFile(const std::string& path, const std::string& option, const std::string& text);
+
 /// Exit codes of every subcommand (kInterrupted: 128 + SIGINT, as a shell reports Ctrl-C).
 enum Exit : int { kOk = 0, kUsage = 2, kUnusable = 3, kInterrupted = 130 };
 

@@ -9,6 +9,8 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libexpat1-dev
   libeigen3-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libyaml-cpp-dev
   libnlopt-cxx-dev                                                           # capture planning (kdl_space plan)
+  libsdformat-dev                                                            # Gazebo SDF model files (the library reads them)
+  libmujoco-dev                                                              # MuJoCo: an independent engine in the tests (MJCF export)
   gnuplot-nox
   libjs-three                                                                # three.js, inlined into simulate --html's page
   chromium                                                                   # headless browser: the --html page's tests

@@ -12,6 +12,7 @@
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/algorithm/inspection.hpp"
 #include "kdl_space/multibody/poses.hpp"
+#include "kdl_space/parsers/formats/robot_file.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
@@ -205,12 +206,12 @@ Inspected inspected(const InspectOptions& o, const std::vector<ContactRequest>& 
   for (double v : o.base_rpy) if (!std::isfinite(v)) throw UsageError("--base-rpy: not a finite number");
 
   std::shared_ptr<const FloatingModel>& model = in.model;
-  checkInputFile(o.urdf, "URDF file");
+  checkInputFile(o.urdf, robotFileKind(o.urdf));
   try {
-    model = std::make_shared<const FloatingModel>(loadUrdfFile(o.urdf));
+    model = std::make_shared<const FloatingModel>(loadRobotFile(o.urdf));
   } catch (const ModelError& e) {
     // In check's words (one set of rules): every error of the file, not only the loader's first.
-    const UrdfReport report = checkUrdfFile(o.urdf);
+    const UrdfReport report = checkRobotFile(o.urdf);
     std::string all;
     for (const Finding& f : report.errors) all += (all.empty() ? "" : "\n") + report.source + ": error: " + describe(f);
     if (all.empty()) throw;

@@ -7,6 +7,8 @@
 #include "check_command.hpp"
 #include "cli_common.hpp"
 #include "ik_command.hpp"
+#include "export_command.hpp"
+#include "import_command.hpp"
 #include "inspect_command.hpp"
 #include "mount_command.hpp"
 #include "plan_command.hpp"
@@ -35,6 +37,10 @@ int main(int argc, char** argv) {
   CLI::App* plan = addPlan(app, plan_options);
   MountOptions mount_options;
   CLI::App* mount = addMount(app, mount_options);
+  ExportOptions export_options;
+  CLI::App* export_cmd = addExport(app, export_options);
+  ImportOptions import_options;
+  CLI::App* import_cmd = addImport(app, import_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -62,6 +68,8 @@ int main(int argc, char** argv) {
     if (ik->parsed()) runIk(ik_options, std::cout);
     if (plan->parsed()) runPlan(plan_options, std::cout);
     if (mount->parsed()) runMount(mount_options, std::cout);
+    if (export_cmd->parsed()) runExport(export_options, std::cout);
+    if (import_cmd->parsed()) runImport(import_options, std::cout);
     const int rc = check->parsed() ? runCheck(check_options, std::cout) : kOk;
     if (!std::cout.flush()) {  // e.g. a full disk: the output is not complete
       std::cerr << "kdl_space: cannot write the output to stdout\n";

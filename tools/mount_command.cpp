@@ -26,13 +26,7 @@ void runMount(const MountOptions& o, std::ostream& out) {
     throw UsageError(o.scenario + ": its robot is one URDF file (" + sc.robot_urdf +
                      "), not mounted: give robot.mount {bus, link, pose} to join an arm to a bus");
   refuseOverwritingInputs("-o", o.output, scenarioInputs(sc));
-  AtomicFile file(o.output, "-o");
-  errno = 0;
-  std::ofstream f(file.tmp());
-  f << sc.robot_document;
-  f.close();
-  if (!f) throw InputError("-o " + o.output + ": cannot write the file: " + writeFailure());
-  file.commit();
+  writeTextFile(o.output, "-o", sc.robot_document);
   const FloatingModel& m = *sc.capture.robot.model;
   if (o.json) {
     Json j{{"urdf", o.output}, {"files", sc.robot_files}, {"links", m.bodies().size()}, {"joints", m.jointNames()},

@@ -122,5 +122,6 @@ void bindOperation(py::module_& m);
 void bindPoses(py::module_& m);
 void bindInverseKinematics(py::module_& m);
 void bindPlanning(py::module_& m);
+void bindFormats(py::module_& m);
 
 }  // namespace kdl_space::python

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "conversions.hpp"
+#include "kdl_space/parsers/formats/robot_file.hpp"
 #include "kdl_space/parsers/urdf/urdf_check.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
@@ -147,10 +148,10 @@ void bindModel(py::module_& m) {
         return "<kdl_space.State of " + std::to_string(s.model->nj()) + " joints>";
       });
 
-  m.def("load_urdf", [](const std::string& path) { return Model{std::make_shared<const FloatingModel>(loadUrdfFile(path)), path}; },
-        py::arg("path"), "Loads a URDF file as a free-floating Model (root link = base); ModelError naming the problem.");
+  m.def("load_urdf", [](const std::string& path) { return Model{std::make_shared<const FloatingModel>(loadRobotFile(path)), path}; },
+        py::arg("path"), "Loads a robot description as a free-floating Model (root link = base): URDF, or SDF, MJCF, SpaceDyn LP (.m) read as their URDF document (urdf_document); ModelError or InputError naming the problem.");
   m.def("check_urdf", [](const std::string& path, const std::vector<std::string>& tips) {
-    const UrdfReport r = checkUrdfFile(path, tips);
+    const UrdfReport r = checkRobotFile(path, tips);
     std::vector<Finding> all = r.errors;
     all.insert(all.end(), r.warnings.begin(), r.warnings.end());
     all.insert(all.end(), r.notes.begin(), r.notes.end());

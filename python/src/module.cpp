@@ -22,4 +22,5 @@ PYBIND11_MODULE(_kdl_space, m) {
   bindHtml(m);
   bindInverseKinematics(m);
   bindPlanning(m);
+  bindFormats(m);
 }

@@ -78,7 +78,7 @@ void HtmlWriter::readMesh(const std::string& link, LinkVisual& v) {
 PageVisuals readPageVisuals(const Scenario& sc, const std::vector<std::string>& mesh_search_path) {
   PageVisuals visuals;
   visuals.robot = robotVisuals(sc, mesh_search_path);
-  if (!sc.target_urdf.empty()) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
+  visuals.target = targetVisuals(sc, mesh_search_path);
   return visuals;
 }
 

@@ -59,7 +59,7 @@ namespace {
 PageVisuals visualsToDraw(const Scenario& sc, const std::vector<std::string>& mesh_search_path, bool target) {
   PageVisuals visuals;
   visuals.robot = robotVisuals(sc, mesh_search_path);
-  if (target) visuals.target = readUrdfVisuals(sc.target_urdf, mesh_search_path);
+  if (target) visuals.target = targetVisuals(sc, mesh_search_path);
   return visuals;
 }
 }  // namespace

@@ -141,10 +141,38 @@ void checkDomain(const Field& f, const StudyInput& in) {
          number(low) + ": " + positiveAdvice(d, mass));
 }
 
+/// A distribution given in degrees ({deg: DIST} for an angle, {deg_per_s: DIST} for a rate) in radians.
+void toRadians(Distribution& d) {
+  const double k = M_PI / 180.0;
+  if (d.kind == Distribution::Kind::LogNormal) {
+    d.a *= k;  // the median; the factor is a ratio
+    return;
+  }
+  d.a *= k, d.b *= k;  // the ends of a range or a grid; a normal's mean and std
+  d.min *= k, d.max *= k;
+}
+
+/// Whether `in` takes an angle ("deg") or an angular rate ("deg_per_s"): a revolute joint's
+/// position or rate, the target's angular velocity components and its tumble rate, the self-motion.
+const char* angularUnit(const StudyInput& in, const FloatingModel& robot) {
+  using F = StudyInput::Field;
+  const bool revolute = (in.field == F::JointPosition || in.field == F::JointRate) &&
+                        robot.bodies()[robot.jointBody()[in.index]].joint_twist.tail<3>().norm() > 0.0;
+  if ((in.field == F::JointPosition && revolute) || in.field == F::SelfMotion) return "deg";
+  if ((in.field == F::JointRate && revolute) || in.field == F::TargetTumble || (in.field == F::TargetTwist && in.index >= 3))
+    return "deg_per_s";
+  return "";
+}
+
 /// The input a field name sets, checked against the scenario.
-StudyInput input(const Field& f, const std::string& name, const Scenario& sc) {
+StudyInput input(const Field& given, const std::string& name, const Scenario& sc) {
   StudyInput in;
   in.name = name;
+  // {deg: DIST} / {deg_per_s: DIST}: the distribution in degrees, converted once here
+  std::string unit;
+  const bool in_degrees = given.isMap() && given.keys().size() == 1 && (given.has("deg") || given.has("deg_per_s"));
+  if (in_degrees) unit = given.has("deg") ? "deg" : "deg_per_s";
+  const Field f = in_degrees ? given.at(unit) : given;
   in.distribution = distribution(f);
   const FloatingModel& robot = *sc.capture.robot.model;
   const bool rigid = std::holds_alternative<RigidTarget>(sc.capture.target);
@@ -198,6 +226,14 @@ StudyInput input(const Field& f, const std::string& name, const Scenario& sc) {
     f.fail("is no input of a study (target.twist.{vx,vy,vz,wx,wy,wz}, target.tumble, target.mass, "
            "target.grasp.{x,y,z}, timing, robot.q.JOINT, robot.qdot.JOINT, robot.self_motion, "
            "robot.contact.offset.{x,y,z})");
+  }
+  if (in_degrees) {
+    const std::string expected = angularUnit(in, robot);
+    if (expected != unit)
+      given.fail(expected.empty() ? "is not an angle or an angular rate: give its distribution in SI units, without " + unit
+                                  : "is " + std::string(expected == "deg" ? "an angle: {deg: ...}" : "an angular rate: {deg_per_s: ...}") +
+                                        ", not {" + unit + ": ...}");
+    toRadians(in.distribution);
   }
   checkDomain(f, in);
   return in;

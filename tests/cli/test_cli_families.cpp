@@ -557,6 +557,52 @@ TEST_P(CliFamilies, MountPutsTheRobotOnABusAsOneUrdf) {
   EXPECT_EQ(slurp(familyUrdf(f.name)), before);
 }
 
+// export and import over every family: SpaceDyn's LP and MuJoCo's MJCF written from a scenario, read
+// back (import, and inspect on the files themselves), the same G* at the contact (the LP's contact end
+// point, the MJCF's link); mimic families refused by name (exit 3); no input is overwritten.
+TEST_P(CliFamilies, ExportAndImportKeepTheSystem) {
+  const ModelFamily& f = GetParam();
+  const std::string dir = scratchIn("cli_families_" + f.name, "export");
+  const std::string scenario = dir + ".yaml";
+  spit(scenario, "robot:\n  urdf: " + familyUrdf(f.name) + "\n  contact: {link: " + f.contact + "}\nsimulation: {duration: 1}\n");
+  const auto original = std::make_shared<const FloatingModel>(loadUrdfFile(familyUrdf(f.name)));
+  FreeFloatingSolver ours(original);
+  ASSERT_EQ(ours.compute(State(*original)), 0);
+  Matrix6d G;
+  ASSERT_EQ(ours.G_star(original->contact(f.contact), G), 0);
+  const ToolRun sd = kdlSpace("export " + scenario + " --spacedyn " + dir + " --name fam --json");
+  const ToolRun mj = kdlSpace("export " + scenario + " --mjcf " + dir + "/scene.xml");
+  ASSERT_TRUE(noSignal(sd, f.name + " export --spacedyn") && noSignal(mj, f.name + " export --mjcf"));
+  if (f.mimic) {
+    EXPECT_EQ(sd.rc, 3) << sd.err;
+    EXPECT_NE(sd.err.find("(mimic)"), std::string::npos) << sd.err;
+    EXPECT_EQ(mj.rc, 3) << mj.err;
+    EXPECT_NE(mj.err.find("mimic"), std::string::npos) << mj.err;
+    return;
+  }
+  ASSERT_EQ(sd.rc, 0) << f.name << ": " << sd.err;
+  ASSERT_EQ(mj.rc, 0) << f.name << ": " << mj.err;
+  const std::string lp = dir + "/fam_LP.m", xml = dir + "/scene.xml";
+  for (const std::string& file : {lp, xml}) {
+    const ToolRun back = kdlSpace("import " + std::string(file == lp ? "--spacedyn " : "--mjcf ") + file + " -o " + file + ".urdf --json");
+    ASSERT_EQ(back.rc, 0) << f.name << " " << file << ": " << back.err;
+    EXPECT_NEAR(json::parse(back.out).at("mass").get<double>(), original->totalMass(), 1e-12 * original->totalMass()) << file;
+    // the contact: MJCF keeps the link and its frame; the LP has it as its end point "contact" (not on the base)
+    const std::string tip = file == xml ? f.contact : "contact";
+    const bool on_base = original->contact(f.contact).body == 0;
+    if (file == lp && (on_base || original->nj() == 0)) continue;
+    const std::string offset = file == xml ? " --offset 0 0 0" : "";
+    const ToolRun inspect = kdlSpace("inspect --urdf " + file + " --tip " + tip + offset + " --json");  // the file itself, not its URDF
+    ASSERT_EQ(inspect.rc, 0) << f.name << " " << file << ": " << inspect.err;
+    const Eigen::MatrixXd G_tool = matrixOf(json::parse(inspect.out).at("contacts")[0].at("G_star"));
+    EXPECT_TRUE(near(G_tool, G, 1e-12, 1e-12 * G.norm(), f.name + " inspect of " + file));
+  }
+  const std::string before = slurp(familyUrdf(f.name));
+  const ToolRun over = kdlSpace("export " + scenario + " --urdf " + familyUrdf(f.name));
+  EXPECT_EQ(over.rc, 2) << over.err;
+  EXPECT_EQ(slurp(familyUrdf(f.name)), before);
+}
+
 TEST_P(CliFamilies, CheckFindsNoError) {
   const ModelFamily& f = GetParam();
   const ToolRun run = kdlSpace("check " + familyUrdf(f.name) + " --json");

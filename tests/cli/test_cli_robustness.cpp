@@ -416,7 +416,7 @@ void expectAll(const std::vector<CommandLine>& cases) {
 TEST(CommandLines, UsageErrorsExitWith2) {
   expectAll({
       {"", 2, "kdl_space: A subcommand is required\n" + kHint},
-      {"frobnicate", 2, "kdl_space: unknown command 'frobnicate' (commands: inspect, capture, simulate, check, study, ik, plan, mount)\n" + kHint},
+      {"frobnicate", 2, "kdl_space: unknown command 'frobnicate' (commands: inspect, capture, simulate, check, study, ik, plan, mount, export, import)\n" + kHint},
       {"capture", 2, "kdl_space: SCENARIO is required\n" + kHint},
       {"capture " + kValid + " " + kValid, 2, "kdl_space: The following argument was not expected: " + kValid + "\n" + kHint},
       {"capture " + kValid + " --bogus", 2, "kdl_space: The following argument was not expected: --bogus\n" + kHint},

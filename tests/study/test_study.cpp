@@ -447,3 +447,32 @@ TEST(Study, TheLoaderNamesTheFieldThatIsWrong) {
 
 }  // namespace
 }  // namespace kdl_space
+
+namespace kdl_space {
+namespace {
+// Angles in degrees where a person writes them: {deg: DIST} for an angle, {deg_per_s: DIST} for a
+// rate, converted once at load into the same distribution in radians (bit for bit: x * pi / 180);
+// a unit that does not fit the input is refused by name.
+TEST(Study, DistributionsInDegreesAreTheRadiansOnes) {
+  const std::string head = "scenario: " + kScenarios + "tumbling_box_capture.yaml\nsamples: 8\nseed: 4\ninputs:\n";
+  const Study deg = loadStudy(studyFile("deg.yaml", head + "  robot.q.joint2: {deg: {uniform: [20, 50]}}\n"
+                                                           "  target.twist.wz: {deg_per_s: {normal: {mean: 1, std: 2, min: -3, max: 5}}}\n"
+                                                           "  target.tumble: {deg_per_s: {grid: [0, 4, 3]}}\n"));
+  const double k = M_PI / 180.0;
+  const Distribution& q = deg.inputs[0].distribution;
+  EXPECT_EQ(q.a, 20 * k);
+  EXPECT_EQ(q.b, 50 * k);
+  const Distribution& w = deg.inputs[1].distribution;
+  EXPECT_EQ(w.a, 1 * k);
+  EXPECT_EQ(w.b, 2 * k);
+  EXPECT_EQ(w.min, -3 * k);
+  EXPECT_EQ(w.max, 5 * k);
+  EXPECT_EQ(deg.inputs[2].distribution.b, 4 * k);
+  EXPECT_EQ(deg.inputs[2].distribution.count, 3);
+  EXPECT_NE(refusal("deg_mass.yaml", head + "  target.mass: {deg: {uniform: [20, 50]}}\n").find("is not an angle or an angular rate"),
+            std::string::npos);
+  EXPECT_NE(refusal("deg_rate.yaml", head + "  robot.q.joint2: {deg_per_s: {uniform: [20, 50]}}\n").find("is an angle: {deg: ...}"),
+            std::string::npos);
+}
+}  // namespace
+}  // namespace kdl_space

@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
 #include <Eigen/Core>
 #include <random>
 #include <string>
@@ -39,6 +44,16 @@ inline ::testing::AssertionResult near(const Eigen::MatrixXd& a, const Eigen::Ma
 /// Directory of the test data and of the bundled models (set by CMake).
 inline std::string dataDir() { return KDL_SPACE_TEST_DATA_DIR; }
 inline std::string urdfDir() { return KDL_SPACE_URDF_DIR; }
+
+/// Every bundled robot, sorted: urdf/*.urdf, tests/data/models/*.urdf, tests/data/families/*.urdf.
+inline std::vector<std::string> bundledRobots() {
+  std::vector<std::string> files;
+  for (const std::string& folder : {dataDir() + "/models", dataDir() + "/families", urdfDir()})
+    for (const auto& e : std::filesystem::directory_iterator(folder))
+      if (e.path().extension() == ".urdf") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
 
 /// A random configuration: joints in [-pi, pi] (prismatic in [-0.2, 0.4] m), random base pose.
 inline State randomState(const FloatingModel& model, std::mt19937& rng) {

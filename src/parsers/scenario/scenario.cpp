@@ -7,6 +7,7 @@
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
+#include "kdl_space/parsers/formats/robot_file.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "multibody/model_rules.hpp"
 #include "parsers/scenario/scenario_approach.hpp"
@@ -87,7 +88,10 @@ double rotorInertia(const Field& f) {
 
 /// A free-floating system (the robot, or a target with a URDF); `urdf_path` gets the resolved path.
 /// `mount` (the robot's: its arms on a bus, robot.mount) gets the joined document; null: refused.
-FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path, MountedRobot* mount = nullptr) {
+/// `document` gets the URDF document of a description in another format (SDF, MJCF, SpaceDyn's LP:
+/// readRobotDocument), its notes and its file; untouched for a URDF file.
+FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path, MountedRobot& document,
+                      MountedRobot* mount = nullptr) {
   f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp", "mount"});
   FloatingSystem s;
   if (f.has("mount")) {
@@ -102,8 +106,14 @@ FloatingSystem system(const Field& f, const std::string& folder, std::string& ur
     const Field urdf = f.at("urdf");
     urdf_path = sections::filePath(urdf, folder);
     try {
-      checkInputFile(urdf_path, "URDF file");
-      s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
+      checkInputFile(urdf_path, robotFileKind(urdf_path));
+      RobotDocument d = readRobotDocument(urdf_path);
+      if (d.format == RobotFormat::Urdf) {
+        s.model = std::make_shared<const FloatingModel>(loadUrdfFile(urdf_path));
+      } else {
+        s.model = std::make_shared<const FloatingModel>(loadUrdfString(d.urdf, urdf_path));
+        document = MountedRobot{std::move(d.urdf), std::move(d.notes), {urdf_path}};
+      }
     } catch (const Error& e) {  // the file unreadable (InputError) or its model broken (ModelError)
       e.rethrowWithContext(urdf.where());
     }
@@ -366,7 +376,9 @@ Scenario loadScenario(const std::string& path) {
   top.onlyKeys({"robot", "target", "law", "approach", "simulation"});
   const std::string folder = std::filesystem::path(path).parent_path().string();
   MountedRobot mount;
-  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf, &mount);
+  MountedRobot converted;  // a robot file in another format, as a URDF document
+  s.capture.robot = system(top.at("robot"), folder, s.robot_urdf, converted, &mount);
+  if (!converted.urdf.empty()) mount = std::move(converted);
   s.robot_document = std::move(mount.urdf);
   s.robot_files = s.robot_urdf.empty() ? std::move(mount.files) : std::vector<std::string>{s.robot_urdf};
   s.robot_notes = std::move(mount.notes);
@@ -385,7 +397,9 @@ Scenario loadScenario(const std::string& path) {
     top.at("robot").at("contact");  // reports it missing: an impact needs the robot's contact point
     const Field target = top.at("target");
     if (target.has("urdf")) {
-      FloatingSystem t = system(target, folder, s.target_urdf);
+      MountedRobot converted;
+      FloatingSystem t = system(target, folder, s.target_urdf, converted);
+      s.target_document = std::move(converted.urdf);
       if (target.has("link") || t.model->nj() == 0) {
         s.capture.target = rigidUrdfTarget(target, t);  // one rigid body: the robot's contact point is hit
         s.rigid_target_body = target.has("link") ? t.model->bodyIndex(target.at("link").text()) : 0;

@@ -90,8 +90,14 @@ MountedRobot mounted(const Field& f, const std::string& folder) {
 namespace kdl_space {
 
 std::map<std::string, std::vector<LinkVisual>> robotVisuals(const Scenario& sc, const std::vector<std::string>& package_path) {
-  if (!sc.robot_urdf.empty()) return readUrdfVisuals(sc.robot_urdf, package_path);
   if (!sc.robot_document.empty()) return readUrdfVisualsString(sc.robot_document, sc.file, package_path);
+  if (!sc.robot_urdf.empty()) return readUrdfVisuals(sc.robot_urdf, package_path);
+  return {};
+}
+
+std::map<std::string, std::vector<LinkVisual>> targetVisuals(const Scenario& sc, const std::vector<std::string>& package_path) {
+  if (!sc.target_document.empty()) return readUrdfVisualsString(sc.target_document, sc.target_urdf, package_path);
+  if (!sc.target_urdf.empty()) return readUrdfVisuals(sc.target_urdf, package_path);
   return {};
 }
 

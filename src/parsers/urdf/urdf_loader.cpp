@@ -109,7 +109,7 @@ std::map<std::string, JointProperties> properties(const urdf::ModelInterface& mo
 
 }  // namespace
 
-FloatingModel loadUrdfString(const std::string& bytes, const std::string& source) {
+FloatingModel loadUrdfString(const std::string& bytes, const std::string& source, std::vector<Diagnostic> notes) {
   // Its names in UTF-8, without control characters, whatever writer they reach.
   const detail::UrdfText utf8 = detail::urdfText(bytes);
   if (!utf8.problem.empty()) throw ModelError(source + ": " + utf8.problem);
@@ -200,8 +200,9 @@ FloatingModel loadUrdfString(const std::string& bytes, const std::string& source
       fail("link " + detail::quoted(graph.link(l)) + " is not connected to the base " + detail::quoted(base->name) +
            ": its joints form a loop (a URDF describes a tree)");
 
+  notes.insert(notes.end(), diagnostics.begin(), diagnostics.end());  // a conversion's notes first
   try {
-    return FloatingModel(tree, baseInertia(*base), {}, std::move(diagnostics), std::move(mimic))
+    return FloatingModel(tree, baseInertia(*base), {}, std::move(notes), std::move(mimic))
         .withJointProperties(properties(*model));
   } catch (const Error& e) {
     e.rethrowWithContext(source + ": ");

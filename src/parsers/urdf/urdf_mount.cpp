@@ -13,6 +13,7 @@
 
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/spatial/errors.hpp"
+#include "parsers/formats/urdf_builder.hpp"
 #include "spatial/message_text.hpp"
 
 namespace kdl_space {
@@ -20,11 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.17g", v);  // reads back exactly
-  return b;
-}
+std::string num(double v) { return formats::exactNumber(v); }  // reads back exactly
 
 std::string triple(double a, double b, double c) { return num(a) + " " + num(b) + " " + num(c); }
 
@@ -235,10 +232,9 @@ MountedRobot mountArms(const BusBody& bus, const std::vector<ArmMount>& arms) {
     TiXmlElement joint("joint"), origin("origin"), parent("parent"), child("child");
     joint.SetAttribute("name", unique(root + "_mount", joints));
     joint.SetAttribute("type", "fixed");
-    double roll = 0, pitch = 0, yaw = 0;
-    arm.pose.M.GetRPY(roll, pitch, yaw);
+    const KDL::Vector rpy = formats::urdfRpy(arm.pose.M);  // exact near pitch = +-pi/2
     origin.SetAttribute("xyz", triple(arm.pose.p.x(), arm.pose.p.y(), arm.pose.p.z()));
-    origin.SetAttribute("rpy", triple(roll, pitch, yaw));
+    origin.SetAttribute("rpy", triple(rpy.x(), rpy.y(), rpy.z()));
     parent.SetAttribute("link", hook);
     child.SetAttribute("link", root);
     joint.InsertEndChild(origin);
@@ -246,13 +242,7 @@ MountedRobot mountArms(const BusBody& bus, const std::vector<ArmMount>& arms) {
     joint.InsertEndChild(child);
     out.InsertEndChild(joint);
   }
-  TiXmlDocument doc;
-  doc.InsertEndChild(TiXmlDeclaration("1.0", "utf-8", ""));
-  doc.InsertEndChild(out);
-  TiXmlPrinter printer;
-  printer.SetIndent("  ");
-  doc.Accept(&printer);
-  result.urdf = printer.CStr();
+  result.urdf = formats::xmlText(out);
   return result;
 }
 

@@ -53,6 +53,9 @@ struct Scenario {
   /// (one without movable joints, or the links from `target.link` down); empty for a rigid target
   /// given by numbers.
   std::string target_urdf;
+  /// The target's description as a URDF document when target_urdf is in another format (SDF, MJCF,
+  /// SpaceDyn's LP: readRobotDocument); empty for a URDF file. robot_document is the robot's.
+  std::string target_document;
   /// A rigid target read from target_urdf: the file's system at the scenario's state (its joints
   /// held where target.q puts them, its base at target.base) and the body whose frame is the
   /// target's frame (target.link's, or the root's), whose subtree it is. What a viewer poses the
@@ -92,9 +95,12 @@ struct Scenario {
 /// be > 0 kg, got -3") for every problem of the file, its own (missing, empty, not YAML)
 /// included; a URDF it names that loads no model is the loader's ModelError with the same
 /// \brief The robot's visuals (readUrdfVisuals) from its URDF, or from its document when it is
-/// mounted (robot.mount); none for neither (a robot built in code).
+/// mounted (robot.mount) or in another format; none for neither (a robot built in code).
 KDL_SPACE_EXPORT std::map<std::string, std::vector<LinkVisual>> robotVisuals(const Scenario& scenario,
                                                                            const std::vector<std::string>& package_path = {});
+/// The target's visuals as robotVisuals' (none for a target given by numbers).
+KDL_SPACE_EXPORT std::map<std::string, std::vector<LinkVisual>> targetVisuals(const Scenario& scenario,
+                                                                            const std::vector<std::string>& package_path = {});
 
 /// "FILE:LINE: robot.urdf: " in front (catch Error for both).
 KDL_SPACE_EXPORT Scenario loadScenario(const std::string& path);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/multibody/model.hpp"
@@ -19,7 +20,9 @@ namespace kdl_space {
 /// \throws ModelError whose message starts with the file name and names the link or joint.
 KDL_SPACE_EXPORT FloatingModel loadUrdfFile(const std::string& path);
 
-/// Same as loadUrdfFile for a URDF document in memory; `source` names it in messages.
-KDL_SPACE_EXPORT FloatingModel loadUrdfString(const std::string& xml, const std::string& source = "<urdf string>");
+/// Same as loadUrdfFile for a URDF document in memory; `source` names it in messages; `notes` (what
+/// a conversion to URDF assumed: readRobotDocument) come first among the model's diagnostics.
+KDL_SPACE_EXPORT FloatingModel loadUrdfString(const std::string& xml, const std::string& source = "<urdf string>",
+                                              std::vector<Diagnostic> notes = {});
 
 }  // namespace kdl_space
