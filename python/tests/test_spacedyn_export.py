@@ -1,6 +1,7 @@
 """SpaceDyn's LP and SV as kdl_space writes them, checked by an evaluation written from SpaceDyn's
 own definitions (spacedyn_numpy: its calc_aa/calc_pos kinematics, the system inertia from the link
-Jacobians; no kdl_space): the generalized inertia H*, the generalized Jacobian J* of the contact's
+Jacobians; no kdl_space): the system inertia HH (6 + n, SpaceDyn's coordinates), the generalized
+inertia H*, the generalized Jacobian J* of the contact's
 end point, the mass and the contact point; then the LP read back (import) gives the same J*, H*, G*.
 Every bundled robot, at random states."""
 import glob
@@ -55,6 +56,31 @@ def in_spacedyn_order(model, LP):
     return [model.joint_names.index(n) for n in names]
 
 
+def skew(a):
+    return np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+
+
+def system_inertia_at(solver, SV, order):
+    """Our system inertia in SpaceDyn's coordinates (v0 of the base centroid R0, w0, qd): momentum (P; L
+    about R0) per unit velocity, from our centroid terms: the mass w, the CoM r_g, I_g, A_m (momentum
+    about r_g per joint rate, base still) and the fixed-base H. With d = r_g - R0:
+    P = w v0 - w [d]x w0 + A_m,P qd, L_R0 = L_rg + d x P."""
+    w, d = solver.w, np.asarray(solver.r_g) - np.asarray(SV["R0"]).reshape(3)
+    A_m = np.asarray(solver.A_m)[:, order] if order else np.zeros((6, 0))
+    n = A_m.shape[1]
+    HH = np.zeros((6 + n, 6 + n))
+    HH[0:3, 0:3] = w * np.eye(3)
+    HH[0:3, 3:6] = -w * skew(d)
+    HH[3:6, 0:3] = w * skew(d)
+    HH[3:6, 3:6] = np.asarray(solver.I_g) - w * skew(d) @ skew(d)
+    HH[0:3, 6:] = A_m[0:3]
+    HH[3:6, 6:] = A_m[3:6] + skew(d) @ A_m[0:3]
+    HH[6:, :6] = HH[:6, 6:].T
+    if n:
+        HH[6:, 6:] = np.asarray(solver.H)[np.ix_(order, order)]
+    return HH
+
+
 @pytest.mark.parametrize("urdf", ROBOTS, ids=os.path.basename)
 def test_the_written_lp_has_our_dynamics_by_spacedyn_definitions(urdf, tmp_path):
     model = kdl_space.load_urdf(urdf)
@@ -69,6 +95,7 @@ def test_the_written_lp_has_our_dynamics_by_spacedyn_definitions(urdf, tmp_path)
         assert sd.total_mass(LP) == pytest.approx(model.total_mass, rel=1e-13)
         H_star = np.asarray(solver.H_star)[np.ix_(order, order)]
         close(sd.generalized_inertia(LP, SV), H_star)
+        close(sd.system_inertia(LP, SV), system_inertia_at(solver, SV, order))
         if model.nj == 0:
             # one body: SpaceDyn's system inertia at the base centroid is the centroid inertia M_a
             close(sd.system_inertia(LP, SV), solver.M_a)
