@@ -55,6 +55,12 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
         << sc.grasp_solution->position_residual << " m, " << sc.grasp_solution->orientation_residual << " rad ("
         << sc.grasp_solution->iterations << " iterations, " << sc.grasp_solution->attempts
         << (sc.grasp_solution->attempts == 1 ? " start)\n" : " starts)\n");
+  if (sc.grasp_solution) {  // the angles it solved, which robot.q did not give
+    out << "  at";
+    for (int j : sc.grasp_solution->chain_joints)
+      out << " " << p.robot.model->jointNames()[j] << " = " << sc.grasp_solution->q(j);
+    out << " [rad or m]\n";
+  }
   const std::vector<std::string> braked = lockedNames(p.robot);
   if (!braked.empty()) {
     out << "Braked joints (locked at the impact, rates stay 0):";

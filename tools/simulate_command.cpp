@@ -209,7 +209,16 @@ void runSimulate(const SimulateOptions& o, std::ostream& out) {
   } catch (const OperationError& e) {
     // Ctrl-C: the temporaries go with `streams`; nothing partial is left.
     if (e.code() == E_CANCELLED) throw Interrupted(std::string(e.what()) + "; no output written");
-    if (e.partial() && e.partial()->approach && !e.partial()->approach->record.reached) writeApproachOutputs(o, sc, *e.partial(), streams, e.what());
+    const bool approach_failed = e.partial() && e.partial()->approach && !e.partial()->approach->record.reached;
+    if (approach_failed) writeApproachOutputs(o, sc, *e.partial(), streams, e.what());
+    if (o.json && e.partial()) {  // the JSON too: the failure and what was recorded up to it (exit 3 all the same)
+      OperationResult so_far = *e.partial();
+      if (!so_far.model) so_far.model = sc.capture.robot.model;
+      const OperationFiles written = approach_failed ? OperationFiles{o.csv, o.plot, o.html} : OperationFiles{};
+      Json j = operationJson(sc, so_far, written);
+      j["failure"] = Json{{"message", e.what()}, {"code", e.code()}, {"phase", approach_failed ? "approach" : "motion"}};
+      out << jsonText(j, 2) << "\n";
+    }
     throw;  // the temporaries are removed: no file is left
   }
   writeOutputs(o, sc, r, streams);

@@ -1,5 +1,7 @@
 #include "kdl_space/report/capture_report.hpp"
 
+#include <algorithm>
+
 #include <optional>
 
 #include "kdl_space/algorithm/conditioning.hpp"
@@ -31,10 +33,14 @@ std::optional<Vector3d> pointInTargetFrame(const CaptureProblem& p, const Vector
 Json graspJson(const Scenario& sc) {
   if (!sc.grasp_solution) return nullptr;
   const IkResult& g = *sc.grasp_solution;
+  const FloatingModel& m = *sc.capture.robot.model;
+  Json q = Json::object();  // the angles the solve put the arm at, by joint name (the chain's joints)
+  for (int j : g.chain_joints) q[m.jointNames()[j]] = g.q(j);
   return Json{{"residual_position", g.position_residual},
               {"residual_rotation", g.orientation_residual},
               {"iterations", g.iterations},
-              {"attempts", g.attempts}};
+              {"attempts", g.attempts},
+              {"q", q}};
 }
 
 Json captureJson(const Scenario& sc, const CaptureResult& r) {
@@ -83,11 +89,31 @@ Json captureJson(const Scenario& sc, const CaptureResult& r) {
   return j;
 }
 
+namespace {
+/// A joint outside its limits at the capture: what put it there, where the scenario says (the
+/// library's hint is robot.q's rule, which holds for a configuration the user gave).
+void sayWhatPutTheJointThere(const Scenario& sc, const FloatingModel& model, std::vector<Diagnostic>& warnings) {
+  const std::string given = " (a joint left out of q is at 0): give its position inside the limits";
+  for (Diagnostic& d : warnings) {
+    const auto at = d.message.find(given);
+    if (d.kind != "joint_outside_limits" || at == std::string::npos) continue;
+    const int j = model.jointIndex(d.element);
+    const bool solved = sc.grasp_solution && std::find(sc.grasp_solution->chain_joints.begin(),
+                                                        sc.grasp_solution->chain_joints.end(), j) != sc.grasp_solution->chain_joints.end();
+    if (sc.approach)
+      d.message.replace(at, given.size(), ": the approach's controller drove it there (it does not keep joints inside their limits)");
+    else if (solved)
+      d.message.replace(at, given.size(), ": robot.place: grasp's inverse kinematics put it there (no solution inside the limits was found)");
+  }
+}
+}  // namespace
+
 std::vector<Diagnostic> captureWarnings(const Scenario& sc, const CaptureProblem& p) {
   Conditioning c;
   std::vector<Diagnostic> warnings;
   // A state the solver refuses has failed the capture already; the limit warnings stand alone then.
   checkConfiguration(p.robot.model, p.robot.state, p.robot.contact, c, warnings);
+  sayWhatPutTheJointThere(sc, *p.robot.model, warnings);
   for (Diagnostic& d : overlapWarnings(sc, p, "capture")) warnings.push_back(std::move(d));
   return warnings;
 }

@@ -10,6 +10,10 @@
 #include <string>
 
 #include "cli_runner.hpp"
+#include "kdl_space/multibody/poses.hpp"
+#include "kdl_space/parsers/scenario/scenario.hpp"
+#include "kdl_space/parsers/urdf/urdf_loader.hpp"
+#include "kdl_space/report/capture_report.hpp"
 
 namespace kdl_space::test {
 namespace {
@@ -130,6 +134,15 @@ TEST(GraspResidual, CaptureReportsTheGraspSolveAndTheGraspPointInTheTargetsFrame
   EXPECT_LE(j.at("grasp").at("residual_position").get<double>(), 1e-9);
   EXPECT_LE(j.at("grasp").at("residual_rotation").get<double>(), 1e-9);
   EXPECT_GE(j.at("grasp").at("iterations").get<int>(), 1);
+  // The angles it solved, by name: at them the contact point is where the capture happened
+  const nlohmann::json& solved = j.at("grasp").at("q");
+  ASSERT_EQ(solved.size(), 7u) << solved.dump();
+  const kdl_space::FloatingModel arm = kdl_space::loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf");
+  kdl_space::State at(arm);
+  for (auto it = solved.begin(); it != solved.end(); ++it) at.q(arm.jointIndex(it.key())) = it.value().get<double>();
+  const KDL::Frame hand = kdl_space::contactFrame(arm, at, arm.contact("end_effector", KDL::Vector(0, 0, 0.05)));
+  const std::vector<double> point = j.at("contact_point").get<std::vector<double>>();
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(hand.p(k), point[k], 1e-12);
   // The hand holds the grasp frame: the contact point is the frame's origin in the target's
   // (base) frame, as the scenario wrote it.
   const std::vector<double> p = j.at("contact_point_in_target").get<std::vector<double>>();
@@ -141,6 +154,7 @@ TEST(GraspResidual, CaptureReportsTheGraspSolveAndTheGraspPointInTheTargetsFrame
   ASSERT_EQ(text.rc, 0) << text.err;
   EXPECT_NE(text.out.find("Grasp (robot.place: grasp): the contact frame holds robot.grasp.target_frame to "),
             std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  at joint1 = "), std::string::npos) << text.out;  // the solved angles
   EXPECT_NE(text.out.find("m in the target's frame"), std::string::npos) << text.out;
   // Without robot.place: grasp there is no solve to report.
   const ToolRun plain = kdlSpace("capture " + kScenarios + "robot_to_robot_capture.yaml --json");
@@ -182,3 +196,20 @@ TEST(IkPreference, ReactionNoWorseThanPostureAndRefusesAPosture) {
 
 }  // namespace
 }  // namespace kdl_space::test
+
+// A joint outside its limits at a capture says what put it there: after an approach, its controller
+// (not robot.q's rule that an omitted joint is at 0, a guess there).
+TEST(ConfigurationWarnings, AfterAnApproachTheHintNamesTheApproach) {
+  const kdl_space::Scenario sc = kdl_space::loadScenario(KDL_SPACE_SOURCE_DIR "/scenarios/approach_tumbling_box.yaml");
+  kdl_space::CaptureProblem p = sc.capture;
+  const int j = p.robot.model->jointIndex("joint2");
+  ASSERT_GE(j, 0);
+  p.robot.state.q(j) = p.robot.model->jointProperties()[j].upper + 0.3;  // where a controller might leave it
+  bool said = false;
+  for (const kdl_space::Diagnostic& d : kdl_space::report::captureWarnings(sc, p)) {
+    if (d.kind != "joint_outside_limits") continue;
+    EXPECT_EQ(d.message.find("left out of q"), std::string::npos) << d.message;
+    said |= d.message.find("the approach's controller drove it there") != std::string::npos;
+  }
+  EXPECT_TRUE(said);
+}

@@ -373,6 +373,16 @@ TEST(Operation, AnUnreachableGraspPointIsReportedWithTheClosestDistanceAndTheApp
   const std::vector<std::string> p = phases(csv);
   ASSERT_EQ(p.size(), 61u);  // 0, 0.05, ..., 3 s
   for (const std::string& phase : p) EXPECT_EQ(phase, "approach");
+  // --json: the failure and the record up to it are printed all the same (exit 3)
+  const ToolRun rj = kdlSpace("simulate " + path + " --json");
+  EXPECT_EQ(rj.rc, 3) << rj.err;
+  const json j = json::parse(rj.out);
+  EXPECT_EQ(j.at("failure").at("phase"), "approach");
+  EXPECT_NE(j.at("failure").at("message").get<std::string>().find("never reached the grasp point"), std::string::npos);
+  EXPECT_TRUE(j.at("capture").is_null()) << j.at("capture").dump();
+  EXPECT_FALSE(j.at("approach").at("reached").get<bool>()) << j.at("approach").dump();
+  EXPECT_NEAR(j.at("approach").at("closest_distance").get<double>(),
+              std::stod(rj.err.substr(rj.err.find("closest ") + 8)), 1e-4);  // the message's 6 digits
 }
 
 TEST(Operation, ACapturedFreeFloatingRobotMovesOnAsOneTree) {

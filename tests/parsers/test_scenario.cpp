@@ -433,3 +433,34 @@ TEST(LoadScenario, ALinkSubtreeOfAUrdfIsOneRigidBodyAtItsJointAngles) {
 
 }  // namespace
 }  // namespace kdl_space::test
+
+namespace kdl_space::test {
+namespace {
+// `simulation.base: grounded` means grounded in the capture too: the robot's response is the grounded
+// one (its G, not G*), and a base twist, which a held base cannot have, is refused naming the field.
+TEST(LoadScenario, AGroundedSimulationGroundsTheCaptureToo) {
+  const std::string target = "target: {mass: 20, inertia: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], pose: {position: [1.5, 0, 0]}, "
+                             "twist: [-0.1, 0, 0, 0, 0, 0]}\nlaw: {type: capture}\n";
+  const auto write = [&](const std::string& name, const std::string& robot_extra) {
+    const std::string path = degreesScenario(name, "  contact: {link: tip}\n" + robot_extra);
+    std::string text;
+    {
+      std::ifstream in(path);
+      text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    text.replace(text.find("simulation: {duration: 1}"), 25, "simulation: {duration: 1, base: grounded}");
+    std::ofstream(path) << text << target;
+    return path;
+  };
+  const Scenario sc = loadScenario(write("grounded.yaml", ""));
+  EXPECT_EQ(sc.capture.robot.response, Response::Grounded);
+  try {
+    loadScenario(write("grounded_moving.yaml", "  base: {twist: [0, 0, 0, 0, 0, 0.1]}\n"));
+    ADD_FAILURE() << "a grounded base with a twist loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation.base: grounded holds the base still, in the capture too"), std::string::npos)
+        << e.what();
+  }
+}
+}  // namespace
+}  // namespace kdl_space::test

@@ -441,6 +441,8 @@ Scenario loadScenario(const std::string& path) {
     const auto* floating = std::get_if<FloatingSystem>(&s.capture.target);
     s.simulation = sections::simulation(top.at("simulation"), *s.capture.robot.model,
                                         s.impact && floating ? floating->model.get() : nullptr);
+    if (s.impact && s.simulation.grounded.value_or(false) && s.capture.robot.response == Response::FreeFloating)
+      sections::groundForTheCapture(top.at("simulation").at("base"), s.capture.robot);
   }
   return s;
 }

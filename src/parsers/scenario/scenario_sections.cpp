@@ -213,4 +213,11 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot, const Floa
   return s;
 }
 
+void groundForTheCapture(const Field& base, FloatingSystem& robot) {
+  if (toEigen(robot.velocity.base_twist) != Vector6d::Zero())
+    base.fail("grounded holds the base still, in the capture too, but robot.base.twist is not zero: give it zero, "
+              "or simulation.base: free");
+  robot.response = Response::Grounded;  // the capture's base held as the motion's (not free, then refused)
+}
+
 }  // namespace kdl_space::sections

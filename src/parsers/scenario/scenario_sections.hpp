@@ -45,4 +45,8 @@ std::vector<std::pair<unsigned int, T>> byJoint(const fields::Field& f, const Fl
 /// `target`: a free-floating target's model (its joints' controls: target_joints), or null.
 SimulationSpec simulation(const fields::Field& f, const FloatingModel& robot, const FloatingModel* target = nullptr);
 
+/// `simulation.base: grounded` (the field `base`) for a free robot of an impact: grounded in the
+/// capture too (Response::Grounded), its base at rest, or InputError naming the field.
+void groundForTheCapture(const fields::Field& base, FloatingSystem& robot);
+
 }  // namespace kdl_space::sections
