@@ -91,6 +91,7 @@ void runExport(const ExportOptions& o, std::ostream& out) {
   if (!o.mjcf.empty()) checkOutputFile(o.mjcf, "--mjcf");
   if (!o.urdf.empty()) checkOutputFile(o.urdf, "--urdf");
   const Source s = read(o.input);
+  std::vector<Diagnostic> notes = s.notes;  // the input's, then what each export assumed
   Json files = Json::array();
   if (!o.spacedyn.empty()) {
     const SpaceDynFiles f = writeSpaceDyn(s.robot, name);
@@ -100,6 +101,7 @@ void runExport(const ExportOptions& o, std::ostream& out) {
     writeTextFile(lp, "--spacedyn", f.lp);
     writeTextFile(sv, "--spacedyn", f.sv);
     files = Json::array({lp, sv});
+    notes.insert(notes.end(), f.notes.begin(), f.notes.end());
     if (!o.json) {
       out << "Wrote " << lp << " and " << sv << ": SpaceDyn's LP (" << s.robot.model->nj() << " joints) and SV\n";
       for (const Diagnostic& d : f.notes) out << "Note: " << d.message << (d.element.empty() ? "" : " (" + d.element + ")") << "\n";
@@ -117,8 +119,10 @@ void runExport(const ExportOptions& o, std::ostream& out) {
     files.push_back(o.urdf);
     if (!o.json) out << "Wrote " << o.urdf << ": the robot as one URDF document\n";
   }
+  if (!o.json)  // what reading the input assumed (a mounted robot's names, a converted file's frames)
+    for (const Diagnostic& d : s.notes) out << "Note: " << d.message << (d.element.empty() ? "" : " (" + d.element + ")") << "\n";
   if (o.json) out << jsonText(Json{{"input", o.input}, {"files", files}, {"joints", s.robot.model->jointNames()},
-                                   {"notes", warningsJson(s.notes)}}, 2) << "\n";
+                                   {"notes", warningsJson(notes)}}, 2) << "\n";
 }
 
 }  // namespace kdl_space::cli

@@ -155,3 +155,20 @@ def test_an_lp_statement_that_is_not_read_is_refused_with_its_line(tmp_path):
     lp.write_text("function LP = bad_LP()\nLP.num_q = 2;\nLP.BB = [0 1 2];\nend\n")
     with pytest.raises(kdl_space.InputError, match=r"bad_LP\.m:3: LP\.BB: is 1x3, expected 1x2"):
         kdl_space.load_urdf(str(lp))
+
+
+@pytest.mark.parametrize("line, message", [
+    ("LP.BB = [1-2];", r"an operator"),
+    ("LP.BB = ;", r"no value after '='"),
+    ("LP.BB = zeros(1e20, 3);", r"not a whole number in \[0, 100000\]"),
+    ("LP.BB = zeros(   , 3);", r"a size or index is missing"),
+    ("LP.BB = zeros(3000, 3000, 3000);", r"more than 3 dimensions or 1e7 numbers"),
+    ("LP.BB(:,1e300) = [1];", r"assigned before LP\.BB has a size"),
+    ("LP.BB = zeros(1, 2);\nLP.BB(:,1e300) = [1];", r"not a whole number in \[1, 100000\]"),
+    ("LP.BB = zeros(1, 2);\nLP.BB(:,1 = [1];", r"only a column"),
+])
+def test_hostile_lp_lines_are_refused_with_their_line_never_a_crash(tmp_path, line, message):
+    lp = tmp_path / "h_LP.m"
+    lp.write_text("function LP = h_LP()\nLP.num_q = 2;\n" + line + "\nend\n")
+    with pytest.raises(kdl_space.InputError, match=r"h_LP\.m:\d+: .*" + message):
+        kdl_space.load_urdf(str(lp))

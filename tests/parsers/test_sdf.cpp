@@ -122,10 +122,12 @@ TEST(Sdf, RefusalsNameTheFileAndWhatIsWrong) {
     }
     return std::string("(no error)");
   };
-  EXPECT_NE(refusal("ball_joint.sdf").find("joint 'wrist': only revolute, continuous, prismatic and fixed"), std::string::npos)
+  EXPECT_NE(refusal("ball_joint.sdf").find("ball_joint.sdf:6: SDF: joint 'wrist': only revolute, continuous, prismatic and fixed"),
+            std::string::npos)
       << refusal("ball_joint.sdf");
   EXPECT_NE(refusal("world.sdf").find("expected one <model>"), std::string::npos) << refusal("world.sdf");
-  EXPECT_NE(refusal("disconnected.sdf").find("link 'b': no joint joins it"), std::string::npos) << refusal("disconnected.sdf");
+  EXPECT_NE(refusal("disconnected.sdf").find("disconnected.sdf:5: SDF: link 'b': no joint joins it"), std::string::npos)
+      << refusal("disconnected.sdf");
   const std::string bad = refusal("bad_xml.sdf");
   EXPECT_NE(bad.find("bad_xml.sdf"), std::string::npos) << bad;
   EXPECT_NE(refusal("missing.sdf").find("missing.sdf"), std::string::npos);

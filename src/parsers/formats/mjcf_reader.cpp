@@ -209,17 +209,11 @@ TiXmlElement Reader::link(const TiXmlElement* b, const std::string& name, const 
     fail(in, "has neither diaginertia nor fullinertia");
   }
   if (mass == 0.0 && I.isZero(0.0)) return link;
-  TiXmlElement inertial("inertial"), origin("origin"), m("mass"), inertia("inertia");
-  origin.SetAttribute("xyz", triple(vector(in, "pos") - joint_pos));  // the CoM in the link frame
-  origin.SetAttribute("rpy", "0 0 0");
-  m.SetAttribute("value", num(mass));
-  const char* keys[6] = {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
-  const double values[6] = {I(0, 0), I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2)};
-  for (int k = 0; k < 6; ++k) inertia.SetAttribute(keys[k], num(values[k]));
-  inertial.InsertEndChild(origin);
-  inertial.InsertEndChild(m);
-  inertial.InsertEndChild(inertia);
-  link.InsertEndChild(inertial);
+  formats::UrdfInertial inertial;
+  inertial.mass = mass;
+  inertial.origin = KDL::Frame(vector(in, "pos") - joint_pos);  // the CoM in the link frame
+  inertial.inertia = I;
+  formats::appendInertial(link, inertial);
   return link;
 }
 

@@ -2,6 +2,7 @@
 
 #include <sdf/Box.hh>
 #include <sdf/Console.hh>
+#include <sdf/Element.hh>
 #include <sdf/Cylinder.hh>
 #include <sdf/Geometry.hh>
 #include <sdf/Joint.hh>
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/spatial/errors.hpp"
@@ -45,6 +47,12 @@ KDL::Frame frame(const ignition::math::Pose3d& p) {
   if (e.LineNumber()) where += ":" + std::to_string(*e.LineNumber());
   std::string more = errors.size() > 1 ? " (and " + std::to_string(errors.size() - 1) + " more)" : "";
   throw InputError(where + ": SDF: " + e.Message() + more);
+}
+
+/// "FILE:LINE" of an element SDFormat read (its line when it kept one).
+std::string where(const std::string& path, const sdf::ElementPtr& e) {
+  const std::optional<int> line = e ? e->LineNumber() : std::nullopt;
+  return line ? path + ":" + std::to_string(*line) : path;
 }
 
 /// A pose resolved in the model frame, or the error naming what.
@@ -135,16 +143,16 @@ void Reader::joints() {
     const std::string what = "joint " + detail::quoted(j.Name());
     const sdf::JointType t = j.Type();
     if (t != sdf::JointType::REVOLUTE && t != sdf::JointType::CONTINUOUS && t != sdf::JointType::PRISMATIC && t != sdf::JointType::FIXED)
-      throw InputError(path + ": SDF: " + what + ": only revolute, continuous, prismatic and fixed joints are read (a ball, universal, "
+      throw InputError(where(path, j.Element()) + ": SDF: " + what + ": only revolute, continuous, prismatic and fixed joints are read (a ball, universal, "
                        "screw or gearbox joint has no KDL counterpart)");
     std::string parent, child;
     if (!j.ResolveParentLink(parent).empty() || !j.ResolveChildLink(child).empty())
-      throw InputError(path + ": SDF: " + what + ": its parent or child does not resolve to a link of the model");
+      throw InputError(where(path, j.Element()) + ": SDF: " + what + ": its parent or child does not resolve to a link of the model");
     if (parent == "world") {
       notes.push_back({j.Name(), "a joint to the world: dropped, the base floats", "", Severity::Note});
       continue;
     }
-    if (joint_of.count(child)) throw InputError(path + ": SDF: " + what + ": link " + detail::quoted(child) + " already has a parent joint");
+    if (joint_of.count(child)) throw InputError(where(path, j.Element()) + ": SDF: " + what + ": link " + detail::quoted(child) + " already has a parent joint");
     joint_of[child] = &j;
     order.push_back(&j);
     model_T_urdf[child] = inModel(j.SemanticPose(), path, what);  // the URDF link frame is its joint's frame
@@ -162,10 +170,10 @@ UrdfJoint Reader::joint(const sdf::Joint& j) const {
            : t == sdf::JointType::PRISMATIC ? "prismatic" : "fixed";
   if (t == sdf::JointType::FIXED) return u;
   const sdf::JointAxis* a = j.Axis(0);
-  if (!a) throw InputError(path + ": SDF: joint " + detail::quoted(j.Name()) + ": no <axis>");
+  if (!a) throw InputError(where(path, j.Element()) + ": SDF: joint " + detail::quoted(j.Name()) + ": no <axis>");
   ignition::math::Vector3d xyz;
   if (!a->ResolveXyz(xyz, "__model__").empty())
-    throw InputError(path + ": SDF: joint " + detail::quoted(j.Name()) + ": its axis does not resolve");
+    throw InputError(where(path, j.Element()) + ": SDF: joint " + detail::quoted(j.Name()) + ": its axis does not resolve");
   const KDL::Vector axis = model_T_urdf.at(u.child).M.Inverse() * KDL::Vector(xyz.X(), xyz.Y(), xyz.Z());
   u.axis = Eigen::Vector3d(axis.x(), axis.y(), axis.z()).normalized();
   u.properties = properties(*a, t != sdf::JointType::CONTINUOUS);
@@ -211,7 +219,7 @@ std::string sdfToUrdf(const std::string& path, std::vector<Diagnostic>& notes) {
   for (uint64_t i = 0; i < r.model->LinkCount(); ++i) {
     const sdf::Link& l = *r.model->LinkByIndex(i);
     if (!r.model_T_urdf.count(l.Name()))
-      throw InputError(path + ": SDF: link " + detail::quoted(l.Name()) + ": no joint joins it to the model (a tree rooted at the canonical link " +
+      throw InputError(where(path, l.Element()) + ": SDF: link " + detail::quoted(l.Name()) + ": no joint joins it to the model (a tree rooted at the canonical link " +
                        detail::quoted(canonical->Name()) + " is read)");
     links.push_back(r.link(l));
   }

@@ -71,6 +71,7 @@ std::vector<Statement> statements(const std::string& src) {
     }
     if (c == '\n') ++line;
   }
+  if (cur.text.find_first_not_of(" \t\r;") != std::string::npos) out.push_back(cur);  // a bracket never closed: read, refused
   return out;
 }
 
@@ -102,13 +103,13 @@ struct Parser {
     };
     for (std::size_t i = 0; i < body.size(); ++i) {
       const char c = body[i];
-      const bool sign_starts = (c == '-' || c == '+') && !token.empty() && std::tolower(token.back()) != 'e';
+      if ((c == '-' || c == '+') && !token.empty() && std::tolower(static_cast<unsigned char>(token.back())) != 'e')
+        fail(field + ": " + detail::quoted(token + c) + "...: an operator (MATLAB reads [1-2] as -1): an LP is read as numbers");
       if (c == ' ' || c == '\t' || c == ',' || c == '\r') flush();
       else if (c == ';') {
         flush();
         if (!rows.back().empty()) rows.emplace_back();  // ";" then a line break: one row's end
       }
-      else if (sign_starts) flush(), token += c;
       else token += c;
     }
     flush();
@@ -123,9 +124,19 @@ struct Parser {
     return v;
   }
 
+  /// A whole number in [lo, hi] (an index or a size), checked before it is cast.
+  int whole(const std::string& token, const std::string& field, double lo, double hi) const {
+    const auto b = token.find_first_not_of(' '), e = token.find_last_not_of(' ');
+    if (b == std::string::npos) fail(field + ": a size or index is missing");
+    const double v = number(token.substr(b, e - b + 1), field);
+    if (v < lo || v > hi || v != std::floor(v)) fail(field + ": " + detail::number(v) + " is not a whole number in [" + detail::number(lo) + ", " + detail::number(hi) + "]");
+    return int(v);
+  }
+
   Value value(std::string e, const std::string& field) const {
     bool transpose = false;
     while (!e.empty() && (e.back() == ' ')) e.pop_back();
+    if (e.empty()) fail(field + ": no value after '='");
     if (e.size() > 1 && e.back() == '\'' && e[e.size() - 2] != '\'' && e.front() != '\'') transpose = true, e.pop_back();
     Value v;
     if (e.size() >= 2 && e.front() == '\'' && e.back() == '\'') {
@@ -145,10 +156,10 @@ struct Parser {
       std::stringstream in(e.substr(6, e.size() - 7));
       std::string d;
       v.dims.clear();
-      while (std::getline(in, d, ',')) v.dims.push_back(int(number(d.substr(d.find_first_not_of(' ')), field)));
-      if (v.dims.size() == 1) v.dims.push_back(v.dims[0]);
-      for (int d2 : v.dims)
-        if (d2 < 0 || d2 > 100000) fail(field + ": zeros(...) of a size out of range");
+      double total = 1.0;
+      while (std::getline(in, d, ',')) total *= v.dims.emplace_back(whole(d, field + ": zeros(...)", 0, 100000));
+      if (v.dims.size() == 1) total *= v.dims.emplace_back(v.dims[0]);
+      if (v.dims.size() > 3 || total > 1e7) fail(field + ": zeros(...) of more than 3 dimensions or 1e7 numbers");
       v.data.assign(std::size_t(v.count()), 0.0);
       return v;
     }
@@ -197,11 +208,13 @@ std::map<std::string, Value> readFields(const std::string& path) {
     // LP.F(:,i[,j]) = a column of 3
     if (!fields.count(field)) p.fail("LP." + target + ": assigned before LP." + field + " has a size (zeros(...) first)");
     std::vector<int> index;
+    if (target.size() < field.size() + 2 || target[field.size()] != '(' || target.back() != ')')
+      p.fail("LP." + target + ": only a column LP.F(:,i) or LP.F(:,i,j) is read");
     std::stringstream in(target.substr(field.size() + 1, target.size() - field.size() - 2));
     std::string part;
     std::getline(in, part, ',');
     if (part != ":") p.fail("LP." + target + ": only a column LP.F(:,i) or LP.F(:,i,j) is read");
-    while (std::getline(in, part, ',')) index.push_back(int(p.number(part, "LP." + target)));
+    while (std::getline(in, part, ',')) index.push_back(p.whole(part, "LP." + target, 1, 100000));
     Value& f = fields[field];
     const Value col = p.value(expr, "LP." + target);
     if (index.size() + 1 != f.dims.size() || col.count() != f.dims[0]) p.fail("LP." + target + ": index or size does not match LP." + field);

@@ -18,20 +18,6 @@ TiXmlElement origin(const KDL::Frame& f) {
   return e;
 }
 
-TiXmlElement inertial(const UrdfInertial& in) {
-  TiXmlElement e("inertial");
-  e.InsertEndChild(origin(in.origin));
-  TiXmlElement mass("mass");
-  mass.SetAttribute("value", exactNumber(in.mass));
-  e.InsertEndChild(mass);
-  TiXmlElement I("inertia");
-  const char* names[3][3] = {{"ixx", "ixy", "ixz"}, {"", "iyy", "iyz"}, {"", "", "izz"}};
-  for (int r = 0; r < 3; ++r)
-    for (int c = r; c < 3; ++c) I.SetAttribute(names[r][c], exactNumber(0.5 * (in.inertia(r, c) + in.inertia(c, r))));
-  e.InsertEndChild(I);
-  return e;
-}
-
 TiXmlElement visual(const UrdfVisual& v) {
   TiXmlElement e("visual");
   e.InsertEndChild(origin(v.origin));
@@ -112,12 +98,26 @@ std::string urdfText(const std::string& robot, const std::vector<UrdfLink>& link
   for (const UrdfLink& l : links) {
     TiXmlElement e("link");
     e.SetAttribute("name", l.name);
-    if (l.inertial) e.InsertEndChild(inertial(*l.inertial));
+    if (l.inertial) appendInertial(e, *l.inertial);
     for (const UrdfVisual& v : l.visuals) e.InsertEndChild(visual(v));
     root.InsertEndChild(e);
   }
   for (const UrdfJoint& j : joints) root.InsertEndChild(joint(j));
   return xmlText(root);
+}
+
+void appendInertial(TiXmlElement& link, const UrdfInertial& in) {
+  TiXmlElement e("inertial");
+  e.InsertEndChild(origin(in.origin));
+  TiXmlElement mass("mass");
+  mass.SetAttribute("value", exactNumber(in.mass));
+  e.InsertEndChild(mass);
+  TiXmlElement I("inertia");
+  const char* names[3][3] = {{"ixx", "ixy", "ixz"}, {"", "iyy", "iyz"}, {"", "", "izz"}};
+  for (int r = 0; r < 3; ++r)
+    for (int c = r; c < 3; ++c) I.SetAttribute(names[r][c], exactNumber(in.inertia(r, c)));  // the upper triangle
+  e.InsertEndChild(I);
+  link.InsertEndChild(e);
 }
 
 std::string xmlText(const TiXmlElement& root) {

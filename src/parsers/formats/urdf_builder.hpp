@@ -47,6 +47,9 @@ struct UrdfJoint {
 /// The document: <robot name>, the links, then the joints, numbers to 17 digits (read back exactly).
 std::string urdfText(const std::string& robot, const std::vector<UrdfLink>& links, const std::vector<UrdfJoint>& joints);
 
+/// Appends `in` to the URDF <link> element `link` as its <inertial> (origin, mass, the inertia's upper triangle).
+void appendInertial(TiXmlElement& link, const UrdfInertial& in);
+
 /// An XML document of `root` (declaration, two-space indent): what the URDF writers return.
 std::string xmlText(const TiXmlElement& root);
 

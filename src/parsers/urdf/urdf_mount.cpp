@@ -139,21 +139,12 @@ TiXmlElement busLink(const BusBody& bus) {
     throw InputError("bus: its inertia, com and box must be finite (a box's edges >= 0)");
   TiXmlElement link("link");
   link.SetAttribute("name", bus.name);
-  TiXmlElement inertial("inertial"), origin("origin"), mass("mass"), inertia("inertia");
-  origin.SetAttribute("xyz", triple(bus.com.x(), bus.com.y(), bus.com.z()));
-  origin.SetAttribute("rpy", "0 0 0");
-  mass.SetAttribute("value", num(bus.mass));
-  const Eigen::Matrix3d& I = bus.inertia;
-  const char* keys[6] = {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"};
-  const double values[6] = {I(0, 0), I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2)};
-  for (int k = 0; k < 6; ++k) inertia.SetAttribute(keys[k], num(values[k]));
-  inertial.InsertEndChild(origin);
-  inertial.InsertEndChild(mass);
-  inertial.InsertEndChild(inertia);
-  link.InsertEndChild(inertial);
+  formats::appendInertial(link, {bus.mass, KDL::Frame(KDL::Vector(bus.com.x(), bus.com.y(), bus.com.z())), bus.inertia});
   if ((bus.box.array() > 0.0).all()) {
     for (const char* part : {"visual", "collision"}) {
-      TiXmlElement v(part), geometry("geometry"), box("box");
+      TiXmlElement v(part), geometry("geometry"), box("box"), origin("origin");  // the box at the CoM
+      origin.SetAttribute("xyz", triple(bus.com.x(), bus.com.y(), bus.com.z()));
+      origin.SetAttribute("rpy", "0 0 0");
       box.SetAttribute("size", triple(bus.box.x(), bus.box.y(), bus.box.z()));
       geometry.InsertEndChild(box);
       v.InsertEndChild(origin);
