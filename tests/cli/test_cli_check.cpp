@@ -354,6 +354,22 @@ TEST(CheckTool, BundledModelsPass) {
   }
 }
 
+// The tool reads an SDF through the library's SDF module (libkdl_space_sdf.so, loaded on the first
+// SDF file): the hand-written pair of tests/data/sdf/ gives the same model summary.
+TEST(CheckTool, AnSdfIsTheModelOfItsUrdf) {
+  const std::string dir = dataDir() + "/sdf/offset_joint_arm";
+  const ToolRun sdf = kdlSpace("check " + dir + ".sdf --json");
+  const ToolRun urdf = kdlSpace("check " + dir + ".urdf --json");
+  ASSERT_EQ(sdf.rc, 0) << sdf.out << sdf.err;
+  ASSERT_EQ(urdf.rc, 0) << urdf.out << urdf.err;
+  const nlohmann::json s = nlohmann::json::parse(sdf.out).at("model"), u = nlohmann::json::parse(urdf.out).at("model");
+  EXPECT_EQ(s.at("joint_names"), u.at("joint_names"));
+  EXPECT_EQ(s.at("links"), u.at("links"));
+  EXPECT_NEAR(s.at("total_mass").get<double>(), u.at("total_mass").get<double>(), 1e-12 * u.at("total_mass").get<double>());
+  EXPECT_NEAR(s.at("condition_H_star").get<double>(), u.at("condition_H_star").get<double>(),
+              1e-9 * u.at("condition_H_star").get<double>());
+}
+
 TEST(CheckTool, UsageErrorsExitWith2) {
   for (const std::string& args : {std::string("check"), "check " + kBroken + "valid.urdf --bogus",
                                   "check " + kBroken + "valid.urdf --tip", std::string("check a.urdf b.urdf")}) {

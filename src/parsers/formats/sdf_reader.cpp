@@ -1,5 +1,4 @@
-#include "kdl_space/parsers/formats/sdf_reader.hpp"
-
+// The module libkdl_space_sdf.so (sdf_module.hpp): Gazebo's model files through Debian's SDFormat.
 #include <sdf/Box.hh>
 #include <sdf/Console.hh>
 #include <sdf/Element.hh>
@@ -23,6 +22,7 @@
 
 #include "kdl_space/parsers/input_file.hpp"
 #include "kdl_space/spatial/errors.hpp"
+#include "parsers/formats/sdf_module.hpp"
 #include "parsers/formats/urdf_builder.hpp"
 #include "spatial/message_text.hpp"
 
@@ -198,7 +198,9 @@ UrdfLink Reader::link(const sdf::Link& l) {
 
 }  // namespace
 
-std::string sdfToUrdf(const std::string& path, std::vector<Diagnostic>& notes) {
+/// sdfToUrdf's reading (kdl_space/parsers/formats/sdf_reader.hpp has the rules): one model's links
+/// and joints.
+void readSdf(const std::string& path, std::vector<Diagnostic>& notes, formats::SdfModel& model) {
   checkInputFile(path, "SDF file", max_input_file_bytes);
   sdf::Console::Instance()->SetQuiet(true);  // the library prints nothing: the errors come back as data
   sdf::Root root;
@@ -215,17 +217,21 @@ std::string sdfToUrdf(const std::string& path, std::vector<Diagnostic>& notes) {
   if (r.joint_of.count(canonical->Name()))
     throw InputError(path + ": SDF: the canonical link " + detail::quoted(canonical->Name()) + " has a parent joint: the base must be the tree's root");
   r.model_T_urdf[canonical->Name()] = inModel(canonical->SemanticPose(), path, "link " + detail::quoted(canonical->Name()));
-  std::vector<UrdfLink> links;
+  model.name = r.model->Name();
   for (uint64_t i = 0; i < r.model->LinkCount(); ++i) {
     const sdf::Link& l = *r.model->LinkByIndex(i);
     if (!r.model_T_urdf.count(l.Name()))
       throw InputError(where(path, l.Element()) + ": SDF: link " + detail::quoted(l.Name()) + ": no joint joins it to the model (a tree rooted at the canonical link " +
                        detail::quoted(canonical->Name()) + " is read)");
-    links.push_back(r.link(l));
+    model.links.push_back(r.link(l));
   }
-  std::vector<UrdfJoint> joints;
-  for (const sdf::Joint* j : r.order) joints.push_back(r.joint(*j));
-  return formats::urdfText(r.model->Name(), links, joints);
+  for (const sdf::Joint* j : r.order) model.joints.push_back(r.joint(*j));
 }
 
 }  // namespace kdl_space
+
+// The module's one export (the rest of it is hidden): formats::ReadSdf, found by sdf_entry_name.
+extern "C" __attribute__((visibility("default"))) void kdl_space_read_sdf(const std::string& path,
+    std::vector<kdl_space::Diagnostic>& notes, kdl_space::formats::SdfModel& model) {
+  kdl_space::readSdf(path, notes, model);
+}
