@@ -171,7 +171,34 @@ def _run_dask(s, client, scheduler, threads, chunk_size, timeout):
     return np.concatenate(parts, axis=0)
 
 
-def study(study, *, engine="threads", threads=0, client=None, scheduler=None, chunk_size=None, timeout=10.0):
+def _sampled(s, sampler):
+    """The study's rows with sample i's inputs from ``sampler(rng, i)`` (a dict {input column: value}
+    replacing the study's draws of those columns; the rest drawn as the file says), ``rng`` numpy's
+    Generator seeded by (the study's seed, i): the same seed, the same table, in any order."""
+    columns = s.input_columns
+    where = {c: k for k, c in enumerate(columns)}
+    draws = np.empty((s.samples, len(columns)))
+    for i in range(s.samples):
+        draws[i] = s.draws(i)
+        given = sampler(np.random.default_rng([s.seed, i]), i)
+        if not isinstance(given, dict):
+            raise TypeError(f"sampler: expected a dict {{input column: value}} for sample {i}, got {type(given).__name__}")
+        for name, value in given.items():
+            if name not in where:
+                raise ValueError(f"sampler: {name!r} (sample {i}) is no input column of this study "
+                                 f"(its input columns: {', '.join(columns)})")
+            if not (isinstance(value, (int, float, np.floating, np.integer)) and math.isfinite(value)):
+                raise ValueError(f"sampler: {name} = {value!r} (sample {i}) is no finite number")
+            draws[i, where[name]] = float(value)
+        for k, c in enumerate(columns):  # an axis (target.tumble, .tilt, .tumble_cone) must stay a unit vector
+            if c.endswith(".axis_x") and abs(np.linalg.norm(draws[i, k:k + 3]) - 1.0) > 1e-9:
+                raise ValueError(f"sampler: {c[:-7]}'s axis (sample {i}) is no unit vector: |axis| = "
+                                 f"{np.linalg.norm(draws[i, k:k + 3])!r}; give all three components")
+    return s.rows_drawn(draws)
+
+
+def study(study, *, engine="threads", threads=0, client=None, scheduler=None, chunk_size=None, timeout=10.0,
+          sampler=None):
     """Runs a capture study and returns its :class:`StudyResult` (all samples, in order).
 
     study: a study file's path, or a :class:`Study` (``load_study``).
@@ -186,6 +213,11 @@ def study(study, *, engine="threads", threads=0, client=None, scheduler=None, ch
       they need the same files at the same path (a shared file system).
     chunk_size: samples per Dask task (default: the study's ``default_chunk_size``, the command-line
       tool's chunks); the rows do not depend on it.
+    sampler: a callable ``sampler(rng, i)`` that draws sample i's inputs as you state them (correlated
+      inputs, a distribution the file cannot write): it returns a dict {input column: value} (the
+      study's ``input_columns``, e.g. ``"target.inertia.I1"``, ``"target.tumble.axis_x"``), which
+      replaces those columns' draws; ``rng`` is ``numpy.random.default_rng([seed, i])``, so the same
+      study and sampler give the same table. Evaluated in this process (engine threads).
     """
     if engine not in _ENGINES:
         raise ValueError(f"engine: expected 'threads' or 'dask', got {engine!r}")
@@ -199,6 +231,11 @@ def study(study, *, engine="threads", threads=0, client=None, scheduler=None, ch
     if client is not None and scheduler is not None:
         raise ValueError("client, scheduler: give one (a Client, or the address of a scheduler to connect to)")
     s = _resolve(study)
+    if sampler is not None:
+        if engine != "threads" or not callable(sampler):
+            raise ValueError("sampler: a callable, with engine='threads'")
+        table, failures = _sampled(s, sampler)
+        return StudyResult(s, table, failures)
     if engine == "threads":
         table = s.rows(0, s.samples, threads=threads)
     else:
@@ -238,7 +275,7 @@ class StudyResult:
     """The rows of a study: ``table`` (samples, len(columns)) float64, one row per sample in order,
     column 0 ``sample``, column 1 ``status`` (0: computed; else an error code, outcomes NaN)."""
 
-    def __init__(self, study, table):
+    def __init__(self, study, table, failures=None):
         table = np.asarray(table, dtype=np.float64)
         if table.ndim != 2 or table.shape[1] != len(study.columns):
             raise ValueError(f"table: expected shape (n, {len(study.columns)}), got {table.shape}")
@@ -246,6 +283,7 @@ class StudyResult:
         self.columns = list(study.columns)
         self.table = table
         self._summary = None
+        self._failures = failures  # {sample: why}: a sampler's rows (the study's draws would say otherwise)
 
     def __len__(self):
         return self.table.shape[0]
@@ -262,6 +300,8 @@ class StudyResult:
         """The summary as ``kdl_space study --json`` prints it (without its "table" file name)."""
         if self._summary is None:
             self._summary = self.study.summary(self.table)
+            for f in self._summary.get("failures", []) if self._failures is not None else []:
+                f["message"] = self._failures.get(f["first_sample"], f["message"])
         return self._summary
 
     @property

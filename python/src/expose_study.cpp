@@ -117,6 +117,36 @@ py::array_t<double> studyRows(const PyStudy& s, long long begin_arg, long long e
   return out;
 }
 
+/// Rows 0..n-1 of the table from the inputs `given` ((n, studyInputCount) values: a caller's own
+/// draws), on one evaluator, GIL released; with the failures' messages by sample.
+py::tuple studyRowsDrawn(const PyStudy& s, py::handle given) {
+  const Study& st = *s.study;
+  const long k = static_cast<long>(studyInputCount(st));
+  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  Array a = Array::ensure(given);
+  if (!a) {
+    PyErr_Clear();
+    throw py::value_error("draws: expected an array of numbers of shape (n, " + std::to_string(k) + ")");
+  }
+  if (a.ndim() != 2 || a.shape(1) != k || static_cast<std::uint64_t>(a.shape(0)) > st.samples)
+    throw py::value_error("draws: expected shape (n, " + std::to_string(k) + ") (the study's input columns), n <= samples");
+  const std::size_t n = static_cast<std::size_t>(a.shape(0)), m = s.columns.size();
+  py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(m)});
+  double* data = out.mutable_data();
+  std::vector<std::pair<std::uint64_t, std::string>> failures;
+  {
+    py::gil_scoped_release nogil;
+    StudyEvaluator evaluator(s.study);
+    for (std::size_t i = 0; i < n; ++i) {
+      evaluator.evaluate(i, a.data() + i * static_cast<std::size_t>(k), data + i * m);
+      if (!evaluator.failure().empty()) failures.emplace_back(i, evaluator.failure());
+    }
+  }
+  py::dict messages;
+  for (const auto& [i, why] : failures) messages[py::int_(i)] = why;
+  return py::make_tuple(out, messages);
+}
+
 /// The summary as `kdl_space study --json` writes it (report::studySummaryJson), without "table" (no file).
 py::dict summary(const PyStudy& s, py::handle given) {
   const Study& st = *s.study;
@@ -201,13 +231,30 @@ py::dict toTable(const PyStudy& s, const std::string& table, long long threads, 
   return d;
 }
 
+/// A caller's own draws (kdl_space.study's sampler=): the study's, and rows from given ones.
+void bindStudyDraws(py::class_<PyStudy>& study) {
+  study
+      .def("draws", [](const PyStudy& s, long long i) {
+        const std::vector<double> v = studyDraws(*s.study, bounded(i, s.study->samples - 1, "i", "samples - 1"));
+        return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+      }, py::arg("i"),
+           "Sample i's inputs as the study draws them: the values of its table's input columns (input_columns).")
+      .def_property_readonly("input_columns", [](const PyStudy& s) {
+        return std::vector<std::string>(s.columns.begin() + 2, s.columns.begin() + 2 + static_cast<long>(studyInputCount(*s.study)));
+      }, "The table's input columns, in order (after sample and status): what draws() and rows_drawn() hold.")
+      .def("rows_drawn", &studyRowsDrawn, py::arg("draws"),
+           "(rows, failures): rows 0..n-1 of the table computed from the inputs `draws` ((n, len(input_columns)): "
+           "a caller's own draws, kdl_space.study's sampler=) instead of the study's, and {sample: why} for "
+           "those that failed. GIL released.");
+}
+
 }  // namespace
 
 void bindStudy(py::module_& m) {
-  py::class_<PyStudy>(m, "Study",
+  py::class_<PyStudy> study(m, "Study",
                       "A capture study (load_study): a scenario plus distributions over its inputs; sample i depends "
-                      "only on (seed, i), so its rows are the same whatever computes them.")
-      .def_property_readonly("file", [](const PyStudy& s) { return s.study->file; }, "The path it was read from.")
+                      "only on (seed, i), so its rows are the same whatever computes them.");
+  study.def_property_readonly("file", [](const PyStudy& s) { return s.study->file; }, "The path it was read from.")
       .def_property_readonly("fingerprint", [](const PyStudy& s) { return s.study->fingerprint; },
                              "Of the study's, scenario's and URDFs' bytes (tables' parts must agree).")
       .def_property_readonly("samples", [](const PyStudy& s) { return s.study->samples; }, "Rows in the whole table.")
@@ -295,6 +342,7 @@ void bindStudy(py::module_& m) {
         r << "], columns (" << s.columns.size() << ",)>";
         return r.str();
       });
+  bindStudyDraws(study);
 
   m.def("self_motion", [](const ScenarioArg& scenario, double s) {
     std::vector<double> q;

@@ -426,6 +426,25 @@ def test_a_study_computes_every_sample(tmp_path, family):
 
 
 @pytest.mark.parametrize("family", FAMILIES, ids=IDS)
+def test_a_study_of_the_targets_shape_with_a_sampler_computes_every_sample(tmp_path, family):
+    """The target's principal moments and tumble cone, and a sampler's correlated factors: every status 0,
+    the sampler's values in the rows."""
+    scenario = write_scenario(tmp_path, family)
+    study = tmp_path / "shape.yaml"
+    study.write_text(f"scenario: {scenario}\nsamples: 4\nseed: 35\ninputs:\n  target.inertia.I1: {{uniform: [0.9, 1.1]}}\n"
+                     "  target.inertia.I2: {uniform: [0.9, 1.1]}\n  target.inertia.tilt: {deg: {uniform: [0, 10]}}\n"
+                     "  target.tumble_cone: {deg: {uniform: [0, 10]}}\n")
+
+    def sampler(rng, i):
+        f = rng.uniform(0.95, 1.05)
+        return {"target.inertia.I1": f, "target.inertia.I2": f}
+
+    r = kdl_space.study(str(study), sampler=sampler)
+    assert list(r["status"]) == [0, 0, 0, 0], r.summary
+    assert np.array_equal(r["target.inertia.I1"], r["target.inertia.I2"])
+
+
+@pytest.mark.parametrize("family", FAMILIES, ids=IDS)
 def test_check_finds_no_error(family):
     findings = kdl_space.check_urdf(str(urdf_path(family)))
     assert [f.describe() for f in findings if f.severity == kdl_space.Severity.Error] == []

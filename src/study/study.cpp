@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "spatial/message_text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -12,6 +13,7 @@
 #include "kdl_space/simulation/rigid_motion.hpp"
 #include "study/study_sampling.hpp"
 #include "kdl_space/algorithm/self_motion.hpp"
+#include "study/target_shape.hpp"
 
 namespace kdl_space {
 
@@ -19,7 +21,7 @@ std::vector<std::string> studyColumns(const Study& study) {
   std::vector<std::string> c{"sample", "status"};
   for (const StudyInput& in : study.inputs) {
     c.push_back(in.name);
-    if (in.field == StudyInput::Field::TargetTumble)
+    if (sampling::valuesOf(in) == 4)  // the value and its axis (target.tumble, target.inertia.tilt, target.tumble_cone)
       for (const char* a : {".axis_x", ".axis_y", ".axis_z"}) c.push_back(in.name + a);
   }
   for (const char* f : {"impulse.fx", "impulse.fy", "impulse.fz", "impulse.nx", "impulse.ny", "impulse.nz",
@@ -59,6 +61,8 @@ struct StudyEvaluator::Work {
   KDL::Frame hand_nominal;          ///< the contact frame (body axes, at the contact point) at the scenario's state
   Vector3d grasp = Vector3d::Zero();  ///< the nominal grasp point in the target's frame
   bool moves_hand = false, places_target = false;
+  std::optional<TargetShape> shape;  ///< the target's principal frame and tumble, with shape or cone inputs
+  bool reshapes = false;             ///< a principal moment's factor or the axes' tilt is an input
 };
 
 namespace {
@@ -112,6 +116,9 @@ StudyEvaluator::StudyEvaluator(std::shared_ptr<const Study> study)
   for (const StudyInput& in : study_->inputs) {
     w.moves_hand |= in.field == F::JointPosition || in.field == F::SelfMotion || in.field == F::ContactOffset;
     w.places_target |= in.field == F::TargetGrasp || in.field == F::Timing;
+    w.reshapes |= in.field == F::TargetPrincipalInertia || in.field == F::TargetInertiaTilt;
+    if ((w.reshapes || in.field == F::TargetTumbleCone) && !w.shape)
+      w.shape.emplace(std::get<RigidTarget>(sc.capture.target));
     if (in.field == F::SelfMotion && !w.self_motion)
       w.self_motion = std::make_unique<SelfMotion>(sc.capture.robot.model, sc.capture.robot.contact, sc.capture.robot.state);
     w.drawn.resize(w.drawn.size() + static_cast<std::size_t>(sampling::valuesOf(in)));
@@ -128,23 +135,40 @@ StudyEvaluator::StudyEvaluator(std::shared_ptr<const Study> study)
 
 StudyEvaluator::~StudyEvaluator() = default;
 
-void StudyEvaluator::evaluate(std::uint64_t i, double* row) {
+std::size_t studyInputCount(const Study& study) {
+  std::size_t n = 0;
+  for (const StudyInput& in : study.inputs) n += static_cast<std::size_t>(sampling::valuesOf(in));
+  return n;
+}
+
+std::vector<double> studyDraws(const Study& study, std::uint64_t i) {
+  std::vector<double> v(studyInputCount(study));
+  sampling::draw(study, i, v.data());
+  return v;
+}
+
+void StudyEvaluator::evaluate(std::uint64_t i, double* row) { evaluate(i, nullptr, row); }
+
+void StudyEvaluator::evaluate(std::uint64_t i, const double* drawn, double* row) {
   failure_.clear();
   try {
-    sample(i, row);
+    sample(i, drawn, row);
   } catch (const std::exception& e) {  // a set-up the library refused (an Error): its status, its words
     row[1] = E_BAD_ARGUMENT;
     failure_ = e.what();
   }
 }
 
-void StudyEvaluator::sample(std::uint64_t i, double* row) {
+void StudyEvaluator::sample(std::uint64_t i, const double* drawn, double* row) {
   const Study& st = *study_;
   const Scenario& sc = st.scenario;
   Work& w = *work_;
   std::fill(row, row + columns_, std::numeric_limits<double>::quiet_NaN());
   row[0] = static_cast<double>(i);
-  sampling::draw(st, i, w.drawn.data());
+  if (drawn)
+    std::copy(drawn, drawn + w.drawn.size(), w.drawn.begin());
+  else
+    sampling::draw(st, i, w.drawn.data());
   std::copy(w.drawn.begin(), w.drawn.end(), row + 2);
   double* out = row + 2 + w.drawn.size();
   // A compute call's code: the status, and what could not be computed for the summary.
@@ -160,15 +184,16 @@ void StudyEvaluator::sample(std::uint64_t i, double* row) {
   robot.contact = sc.capture.robot.contact;
   const auto* target0 = std::get_if<RigidTarget>(&sc.capture.target);
   RigidTarget target = target0 ? *target0 : RigidTarget{};
-  double self_motion = 0.0, timing = 0.0;
-  Vector3d grasp_shift = Vector3d::Zero();
+  double self_motion = 0.0, timing = 0.0, tilt = 0.0;
+  Vector3d grasp_shift = Vector3d::Zero(), factor = Vector3d::Ones(), tilt_axis = Vector3d::UnitZ();
+  bool tumble = false;
   const double* v = w.drawn.data();
   using F = StudyInput::Field;
   for (const StudyInput& in : st.inputs) {
     const double x = *v;
     switch (in.field) {
       case F::TargetTwist: target.twist(in.index) = x; break;
-      case F::TargetTumble: target.twist.tail<3>() = x * Vector3d(v[1], v[2], v[3]); break;
+      case F::TargetTumble: target.twist.tail<3>() = x * Vector3d(v[1], v[2], v[3]), tumble = true; break;
       case F::TargetMass: target.inertia *= x / target.mass, target.mass = x; break;
       case F::TargetGrasp: grasp_shift(in.index) = x; break;
       case F::Timing: timing = x; break;
@@ -176,9 +201,15 @@ void StudyEvaluator::sample(std::uint64_t i, double* row) {
       case F::JointRate: robot.velocity.qdot(in.index) = x; break;
       case F::SelfMotion: self_motion = x; break;
       case F::ContactOffset: robot.contact.offset.data[in.index] = x; break;
+      case F::TargetPrincipalInertia: factor(in.index) = x; break;
+      case F::TargetInertiaTilt: tilt = x, tilt_axis = Vector3d(v[1], v[2], v[3]); break;
+      case F::TargetTumbleCone:  // the scenario's rate about the cone's axis (with target.tumble: its rate, draw())
+        if (!tumble) target.twist.tail<3>() = w.shape->w.norm() * Vector3d(v[1], v[2], v[3]);
+        break;
     }
     v += sampling::valuesOf(in);
   }
+  if (w.reshapes) target.inertia = w.shape->inertia(factor, tilt, tilt_axis, target.mass);
   if (w.self_motion && self_motion != 0.0)
     if (const int rc = w.self_motion->move(robot.state, self_motion))
       return fail(rc, "robot.self_motion: the arm cannot move " + detail::number(self_motion) + " rad along its self-motion");

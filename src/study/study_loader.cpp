@@ -12,6 +12,7 @@
 #include "kdl_space/study/study.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
 #include "study/study_sampling.hpp"
+#include "study/target_shape.hpp"
 #include "kdl_space/algorithm/self_motion.hpp"
 
 namespace kdl_space {
@@ -102,14 +103,6 @@ Distribution distribution(const Field& f) {
   return d;
 }
 
-/// The least and greatest values a distribution draws: a range's (uniform, grid) ends, infinite if
-/// high - low overflows (a + (b - a) u would be); a normal's or log-normal's extreme draws.
-std::pair<double, double> drawnRange(const Distribution& d) {
-  if (d.kind == Distribution::Kind::Grid || d.kind == Distribution::Kind::Uniform)
-    return {std::min(d.a, d.b), std::isfinite(d.b - d.a) ? std::max(d.a, d.b) : HUGE_VAL};
-  return {sampling::quantile(d, sampling::lowest_unit), sampling::quantile(d, sampling::highest_unit)};
-}
-
 /// What to draw instead of `d` for an input that takes values > 0 (`positive`: a mass) or >= 0.
 std::string positiveAdvice(const Distribution& d, bool positive) {
   if (d.kind == Distribution::Kind::LogNormal) return "give a smaller factor";
@@ -120,22 +113,23 @@ std::string positiveAdvice(const Distribution& d, bool positive) {
 }
 
 /// Refuses a distribution that can draw outside its input's domain, before any sample: values
-/// that are not finite, and for target.mass (> 0), target.tumble and timing (>= 0) values below.
+/// that are not finite, and for target.mass and a principal moment's factor (> 0), target.tumble
+/// and timing (>= 0) values below.
 void checkDomain(const Field& f, const StudyInput& in) {
   using F = StudyInput::Field;
   const Distribution& d = in.distribution;
-  const auto [low, high] = drawnRange(d);
+  const auto [low, high] = sampling::drawnRange(d);
   const std::string how = d.kind == Distribution::Kind::Normal ? "this normal" : d.kind == Distribution::Kind::LogNormal
                                                                                      ? "this log-normal" : "this range";
   if (!std::isfinite(low) || !std::isfinite(high))
     f.fail(how + " draws values that are not finite numbers (from " + number(low) + " to " + number(high) +
            "): give bounds whose difference is finite, e.g. within +-1e307");
-  const bool mass = in.field == F::TargetMass;
+  const bool mass = in.field == F::TargetMass || in.field == F::TargetPrincipalInertia;
   if (!mass && in.field != F::TargetTumble && in.field != F::Timing) return;
   if (mass ? low > 0.0 : low >= 0.0) return;
-  const std::string what = mass ? "a mass" : in.field == F::Timing ? "a delay" : "a rate";
+  const std::string what = in.field == F::TargetPrincipalInertia ? "a factor" : mass ? "a mass" : in.field == F::Timing ? "a delay" : "a rate";
   if (d.kind == Distribution::Kind::Uniform || d.kind == Distribution::Kind::Grid)
-    f.fail(mass && low == 0.0 ? "a mass must be > 0 kg, but the range reaches 0"
+    f.fail(mass && low == 0.0 ? what + " must be > 0" + (in.field == F::TargetMass ? " kg" : "") + ", but the range reaches 0"
                               : "takes values >= 0 (" + what + "), but the range reaches " + number(low));
   f.fail("takes values " + std::string(mass ? "> 0" : ">= 0") + " (" + what + "), but " + how + " draws down to " +
          number(low) + ": " + positiveAdvice(d, mass));
@@ -158,7 +152,9 @@ const char* angularUnit(const StudyInput& in, const FloatingModel& robot) {
   using F = StudyInput::Field;
   const bool revolute = (in.field == F::JointPosition || in.field == F::JointRate) &&
                         robot.bodies()[robot.jointBody()[in.index]].joint_twist.tail<3>().norm() > 0.0;
-  if ((in.field == F::JointPosition && revolute) || in.field == F::SelfMotion) return "deg";
+  if ((in.field == F::JointPosition && revolute) || in.field == F::SelfMotion || in.field == F::TargetInertiaTilt ||
+      in.field == F::TargetTumbleCone)
+    return "deg";
   if ((in.field == F::JointRate && revolute) || in.field == F::TargetTumble || (in.field == F::TargetTwist && in.index >= 3))
     return "deg_per_s";
   return "";
@@ -205,6 +201,12 @@ StudyInput input(const Field& given, const std::string& name, const Scenario& sc
     in.field = F::TargetTumble;
   } else if (name == "target.mass") {
     in.field = F::TargetMass;
+  } else if (name.rfind("target.inertia.", 0) == 0 && name != "target.inertia.tilt") {
+    in.field = F::TargetPrincipalInertia, in.index = component("target.inertia.", {"I1", "I2", "I3"});
+  } else if (name == "target.inertia.tilt") {
+    in.field = F::TargetInertiaTilt;
+  } else if (name == "target.tumble_cone") {
+    in.field = F::TargetTumbleCone;
   } else if (name.rfind("target.grasp.", 0) == 0) {
     in.field = F::TargetGrasp, in.index = component("target.grasp.", {"x", "y", "z"});
   } else if (name == "timing") {
@@ -223,7 +225,8 @@ StudyInput input(const Field& given, const std::string& name, const Scenario& sc
   } else if (name.rfind("robot.contact.offset.", 0) == 0) {
     in.field = F::ContactOffset, in.index = component("robot.contact.offset.", {"x", "y", "z"});
   } else {
-    f.fail("is no input of a study (target.twist.{vx,vy,vz,wx,wy,wz}, target.tumble, target.mass, "
+    f.fail("is no input of a study (target.twist.{vx,vy,vz,wx,wy,wz}, target.tumble, target.tumble_cone, target.mass, "
+           "target.inertia.{I1,I2,I3}, target.inertia.tilt, "
            "target.grasp.{x,y,z}, timing, robot.q.JOINT, robot.qdot.JOINT, robot.self_motion, "
            "robot.contact.offset.{x,y,z})");
   }
@@ -363,6 +366,7 @@ Study loadStudy(const std::string& path) {
   const Field inputs = top.at("inputs");
   for (const Field::Entry& e : inputs.entries()) st.inputs.push_back(input(e.required(), e.name, sc));
   if (st.inputs.empty()) inputs.fail("a study varies at least one input");
+  checkTargetShape(inputs, st);
   const std::uint64_t grid = sampling::gridSize(st);
   if (grid > Study::max_samples) inputs.fail("its grid has " + std::to_string(grid) + " points, more than a study's 1e9 samples");
   if (top.has("samples")) {

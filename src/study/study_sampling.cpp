@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <variant>
+
+#include "study/target_shape.hpp"
 
 namespace kdl_space::sampling {
 
@@ -101,6 +104,12 @@ double quantile(const Distribution& d, double u) {
   return d.a + d.b * (mirror ? -z : z);
 }
 
+std::pair<double, double> drawnRange(const Distribution& d) {
+  if (d.kind == Distribution::Kind::Grid || d.kind == Distribution::Kind::Uniform)
+    return {std::min(d.a, d.b), std::isfinite(d.b - d.a) ? std::max(d.a, d.b) : HUGE_VAL};
+  return {quantile(d, lowest_unit), quantile(d, highest_unit)};
+}
+
 std::uint64_t gridSize(const Study& study) {
   std::uint64_t g = 1;
   for (const StudyInput& in : study.inputs)
@@ -108,10 +117,14 @@ std::uint64_t gridSize(const Study& study) {
   return g;
 }
 
-int valuesOf(const StudyInput& input) { return input.field == StudyInput::Field::TargetTumble ? 4 : 1; }
+int valuesOf(const StudyInput& input) {
+  using F = StudyInput::Field;
+  return input.field == F::TargetTumble || input.field == F::TargetInertiaTilt || input.field == F::TargetTumbleCone ? 4 : 1;
+}
 
 void draw(const Study& study, std::uint64_t i, double* values) {
   const std::uint64_t grid_index = i % gridSize(study);
+  double *tumble = nullptr, *cone = nullptr;  // target.tumble's axis, target.tumble_cone's
   for (std::size_t k = 0; k < study.inputs.size(); ++k) {
     const StudyInput& in = study.inputs[k];
     const Distribution& d = in.distribution;
@@ -132,15 +145,23 @@ void draw(const Study& study, std::uint64_t i, double* values) {
       value = quantile(d, std::min(u, highest_unit));  // the top stratum's u can round to 1: Phi^-1(1) = inf
     }
     *values++ = value;
-    if (in.field == StudyInput::Field::TargetTumble) {  // an axis uniform on the sphere
+    using F = StudyInput::Field;
+    if (in.field == F::TargetTumble || in.field == F::TargetInertiaTilt) {  // an axis uniform on the sphere
       const double z = 2.0 * unit(study.seed, i, stream + 1) - 1.0;
       const double phi = 2.0 * M_PI * unit(study.seed, i, stream + 2);
       const double r = std::sqrt(1.0 - z * z);
       *values++ = r * std::cos(phi);
       *values++ = r * std::sin(phi);
       *values++ = z;
+    } else if (in.field == F::TargetTumbleCone) {  // at `value` from the scenario's tumble axis, azimuth uniform
+      const Vector3d w = std::get<RigidTarget>(study.scenario.capture.target).twist.tail<3>();
+      const Vector3d axis = coneAxis(w.normalized(), value, 2.0 * M_PI * unit(study.seed, i, stream + 1));
+      for (int c = 0; c < 3; ++c) *values++ = axis(c);
+      cone = values - 3;
     }
+    if (in.field == F::TargetTumble) tumble = values - 3;
   }
+  if (tumble && cone) std::copy(cone, cone + 3, tumble);  // target.tumble's rate about the cone's axis
 }
 
 }  // namespace kdl_space::sampling

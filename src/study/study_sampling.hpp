@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "kdl_space/study/study.hpp"
@@ -39,10 +40,15 @@ constexpr double lowest_unit = 0x1p-54 / 1e9, highest_unit = 1.0 - 0x1p-53;
 /// deviations (mirrored into the lower tail, where Phi resolves them); a b^Phi^-1(u).
 double quantile(const Distribution& d, double u);
 
+/// The least and greatest values a distribution draws: a range's (uniform, grid) ends, infinite
+/// if high - low overflows (a + (b - a) u would be); a normal's or log-normal's extreme draws.
+std::pair<double, double> drawnRange(const Distribution& d);
+
 /// The number of points of the study's grid (the product of its grid inputs' counts; 1 without).
 std::uint64_t gridSize(const Study& study);
 
-/// The number of values a study input puts in the table (target.tumble: its rate and axis, 4).
+/// The number of values a study input puts in the table (target.tumble, target.inertia.tilt,
+/// target.tumble_cone: the value and an axis, 4).
 int valuesOf(const StudyInput& input);
 
 /// \brief Sample i's inputs, in the order of study.inputs (valuesOf() each): a grid input takes

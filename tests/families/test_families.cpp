@@ -377,6 +377,26 @@ TEST_P(Families, AStudyComputesEverySample) {
   }
 }
 
+// study: the target's shape and tumble as engineers state their uncertainty (principal moments by
+// their own factors, the axes tilted, the tumble's axis in a cone) compute on every robot (each row
+// against its target built by hand: tests/study/test_study_target_shape.cpp).
+TEST_P(Families, AStudyOfTheTargetsShapeComputesEverySample) {
+  const ModelFamily& f = GetParam();
+  const std::string scenario = writeScenario(f, "{type: capture}");
+  const std::string study_path = scenario + ".shape.yaml";
+  std::ofstream(study_path) << "scenario: " << scenario << "\nsamples: 6\nseed: 35\ninputs:\n"
+                            << "  target.inertia.I1: {uniform: [0.9, 1.1]}\n  target.inertia.I3: {uniform: [0.9, 1.1]}\n"
+                            << "  target.inertia.tilt: {deg: {uniform: [0, 10]}}\n"
+                            << "  target.tumble: {uniform: [0.01, 0.05]}\n  target.tumble_cone: {deg: {uniform: [0, 10]}}\n";
+  const auto study = std::make_shared<const Study>(loadStudy(study_path));
+  StudyEvaluator eval(study);
+  std::vector<double> row(eval.columns());
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    eval.evaluate(i, row.data());
+    EXPECT_EQ(row[1], 0.0) << f.name << " sample " << i << ": " << eval.failure();
+  }
+}
+
 // check: the loader's and the checker's verdicts agree, and every family loads.
 TEST_P(Families, CheckFindsNoError) {
   const ModelFamily& f = GetParam();

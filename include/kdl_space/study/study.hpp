@@ -46,6 +46,10 @@ struct StudyInput {
     JointRate,     ///< robot.qdot.JOINT [rad/s or m/s]
     SelfMotion,    ///< robot.self_motion: this far [rad] along the redundant arm's self-motion
     ContactOffset, ///< robot.contact.offset.{x,y,z}: the hand's contact point, contact link frame [m]
+    /// target.inertia.{I1,I2,I3}: a factor on one principal moment (ascending order) about the CoM
+    TargetPrincipalInertia,
+    TargetInertiaTilt,  ///< target.inertia.tilt: the principal axes turned this far [rad] about a random axis
+    TargetTumbleCone,   ///< target.tumble_cone: the tumble's axis this far [rad] from the scenario's, random azimuth
   };
   std::string name;  ///< as in the study file ("robot.q.joint3")
   Field field = Field::TargetTwist;
@@ -119,6 +123,11 @@ class KDL_SPACE_EXPORT StudyEvaluator {
   /// that cannot be computed has its status (an error code, or E_BAD_ARGUMENT for a set-up the
   /// library refused) and NaN outcomes, and failure() says why; its inputs are always filled.
   void evaluate(std::uint64_t i, double* row);
+  /// \brief evaluate(), with the sample's inputs `drawn` (studyInputCount() values, in the order
+  /// of the table's input columns) instead of the study's draws: a caller's own sampler (Python's
+  /// `sampler=`). Its row holds them. A value outside an input's domain (a mass <= 0) fails the
+  /// sample as a refused set-up does; an axis is used as given (the caller gives unit vectors).
+  void evaluate(std::uint64_t i, const double* drawn, double* row);
   /// Why the last sample evaluated failed: the refusal's message (an Error's), or what could not
   /// be computed and strError(status); empty if it computed.
   const std::string& failure() const { return failure_; }
@@ -126,12 +135,20 @@ class KDL_SPACE_EXPORT StudyEvaluator {
 
  private:
   struct Work;
-  void sample(std::uint64_t i, double* row);  ///< evaluate, but a set-up's refusal throws
+  void sample(std::uint64_t i, const double* drawn, double* row);  ///< evaluate, but a set-up's refusal throws
   std::shared_ptr<const Study> study_;
   std::size_t columns_;
   std::unique_ptr<Work> work_;
   std::string failure_;
 };
+
+/// The number of input columns of the study's table (after sample and status): one per input,
+/// four for target.tumble, target.inertia.tilt and target.tumble_cone (the value and an axis).
+KDL_SPACE_EXPORT std::size_t studyInputCount(const Study& study);
+
+/// \brief Sample i's inputs as the study draws them (its table's input columns): what
+/// StudyEvaluator::evaluate(i, drawn, row) takes, for a caller that replaces some of them.
+KDL_SPACE_EXPORT std::vector<double> studyDraws(const Study& study, std::uint64_t i);
 
 /// A run of rows [begin, end) in chunks.
 struct StudyChunk {
