@@ -361,40 +361,34 @@ TEST_P(Families, PlanFindsAnOptimumOrSaysWhyNot) {
   }
 }
 
-// study: every sample of a small study computes.
-TEST_P(Families, AStudyComputesEverySample) {
-  const ModelFamily& f = GetParam();
+/// Six samples of a study of the family's capture scenario with these `inputs` (YAML lines): each computes.
+void expectEverySampleComputes(const ModelFamily& f, const std::string& name, const std::string& inputs) {
   const std::string scenario = writeScenario(f, "{type: capture}");
-  const std::string study_path = scenario + ".study.yaml";
-  std::ofstream(study_path) << "scenario: " << scenario << "\nsamples: 6\nseed: 34\ninputs:\n"
-                            << "  target.mass: {uniform: [20, 60]}\n  target.twist.wx: {normal: {mean: 0.03, std: 0.01}}\n";
+  const std::string study_path = scenario + "." + name + ".yaml";
+  std::ofstream(study_path) << "scenario: " << scenario << "\nsamples: 6\nseed: 34\ninputs:\n" << inputs;
   const auto study = std::make_shared<const Study>(loadStudy(study_path));
   StudyEvaluator eval(study);
   std::vector<double> row(eval.columns());
   for (std::uint64_t i = 0; i < 6; ++i) {
     eval.evaluate(i, row.data());
-    EXPECT_EQ(row[1], 0.0) << f.name << " sample " << i << ": " << eval.failure();
+    EXPECT_EQ(row[1], 0.0) << f.name << " " << name << " sample " << i << ": " << eval.failure();
   }
+}
+
+// study: every sample of a small study computes.
+TEST_P(Families, AStudyComputesEverySample) {
+  expectEverySampleComputes(GetParam(), "study",
+                            "  target.mass: {uniform: [20, 60]}\n  target.twist.wx: {normal: {mean: 0.03, std: 0.01}}\n");
 }
 
 // study: the target's shape and tumble as engineers state their uncertainty (principal moments by
 // their own factors, the axes tilted, the tumble's axis in a cone) compute on every robot (each row
 // against its target built by hand: tests/study/test_study_target_shape.cpp).
 TEST_P(Families, AStudyOfTheTargetsShapeComputesEverySample) {
-  const ModelFamily& f = GetParam();
-  const std::string scenario = writeScenario(f, "{type: capture}");
-  const std::string study_path = scenario + ".shape.yaml";
-  std::ofstream(study_path) << "scenario: " << scenario << "\nsamples: 6\nseed: 35\ninputs:\n"
-                            << "  target.inertia.I1: {uniform: [0.9, 1.1]}\n  target.inertia.I3: {uniform: [0.9, 1.1]}\n"
-                            << "  target.inertia.tilt: {deg: {uniform: [0, 10]}}\n"
-                            << "  target.tumble: {uniform: [0.01, 0.05]}\n  target.tumble_cone: {deg: {uniform: [0, 10]}}\n";
-  const auto study = std::make_shared<const Study>(loadStudy(study_path));
-  StudyEvaluator eval(study);
-  std::vector<double> row(eval.columns());
-  for (std::uint64_t i = 0; i < 6; ++i) {
-    eval.evaluate(i, row.data());
-    EXPECT_EQ(row[1], 0.0) << f.name << " sample " << i << ": " << eval.failure();
-  }
+  expectEverySampleComputes(GetParam(), "shape",
+                            "  target.inertia.I1: {uniform: [0.9, 1.1]}\n  target.inertia.I3: {uniform: [0.9, 1.1]}\n"
+                            "  target.inertia.tilt: {deg: {uniform: [0, 10]}}\n"
+                            "  target.tumble: {uniform: [0.01, 0.05]}\n  target.tumble_cone: {deg: {uniform: [0, 10]}}\n");
 }
 
 // check: the loader's and the checker's verdicts agree, and every family loads.
