@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "kdl_space/study/study.hpp"
+#include "study_rows.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space {
@@ -118,15 +119,8 @@ TEST(Study, EachRowIsTheCaptureItsInputsDescribe) {
 
 TEST(Study, RowsAreTheSameOnAnyThreadsAndChunks) {
   const auto st = std::make_shared<const Study>(loadStudy(kScenarios + "study_grasp_configuration.yaml"));
-  const std::size_t m = studyColumns(*st).size();
-  const auto run = [&](unsigned threads, std::uint64_t chunk) {
-    std::vector<double> all(static_cast<std::size_t>(st->samples) * m);
-    runStudy(st, studyChunks(0, st->samples, chunk), threads, [&](const StudyChunk& c, const std::vector<double>& rows) {
-      std::copy(rows.begin(), rows.end(), all.begin() + static_cast<std::ptrdiff_t>(c.begin * m));
-    });
-    return all;
-  };
-  const std::vector<double> one = run(1, 400), two = run(2, 7), three = run(3, 64);
+  const std::vector<double> one = test::studyTable(st, 1, 400), two = test::studyTable(st, 2, 7),
+                            three = test::studyTable(st, 3, 64);
   EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(double)), 0);
   EXPECT_EQ(std::memcmp(one.data(), three.data(), one.size() * sizeof(double)), 0);
   // A chunk grid is the same from any start: the chunks of [130, 400) are those of [0, 400) cut.

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "kdl_space/study/study.hpp"
+#include "study_rows.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space {
@@ -134,15 +135,7 @@ TEST(TargetShapeStudy, RowsAreBitIdenticalOnAnyThreadsAndChunks) {
   for (const char* sampling : {"random", "latin_hypercube"}) {
     const auto st = std::make_shared<const Study>(
         loadStudy(shapeStudyFile("threads.yaml", kShapeInputs, std::string("sampling: ") + sampling + "\n")));
-    const std::size_t m = studyColumns(*st).size();
-    const auto run = [&](unsigned threads, std::uint64_t chunk) {
-      std::vector<double> all(static_cast<std::size_t>(st->samples) * m);
-      runStudy(st, studyChunks(0, st->samples, chunk), threads, [&](const StudyChunk& c, const std::vector<double>& rows) {
-        std::copy(rows.begin(), rows.end(), all.begin() + static_cast<std::ptrdiff_t>(c.begin * m));
-      });
-      return all;
-    };
-    const std::vector<double> one = run(1, 40), three = run(3, 7);
+    const std::vector<double> one = test::studyTable(st, 1, 40), three = test::studyTable(st, 3, 7);
     EXPECT_EQ(std::memcmp(one.data(), three.data(), one.size() * sizeof(double)), 0) << sampling;
   }
 }
