@@ -1,6 +1,7 @@
 #include "plan_command.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -32,7 +33,8 @@ void usageOrInput(const InputError& e) {
   for (const auto& [field, option] : {std::pair<std::string, std::string>{"self_motion: ", "--self-motion: "},
                                       {"wrist_roll: ", "--wrist-roll: "}, {"timing: ", "--timing: "},
                                       {"closing_speed: ", "--closing-speed: "},
-                                      {"objective: ", "--weights: "}, {"scan: ", "--scan: "}})
+                                      {"objective: ", "--weights: "}, {"scan: ", "--scan: "},
+                                      {"horizon: ", "--horizon: "}, {"settling_band: ", "--settling-band: "}})
     if (what.rfind(field, 0) == 0) throw UsageError(option + what.substr(field.size()));
   if (what.rfind("plan: nothing to plan", 0) == 0)
     throw UsageError(what + "; give a range with --self-motion (a redundant arm), --wrist-roll, --timing or "
@@ -44,6 +46,17 @@ void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
       << std::setw(12) << t.objective << "   base_rate " << t.base_rate << " rad/s, impulse " << t.impulse
       << " N s, largest joint-rate jump " << t.joint_rate_jump << "\n";
   if (!t.feasible) out << "           not within the limits: " << t.infeasible << "\n";
+  if (!t.motion) return;
+  const MotionMeasures& m = *t.motion;
+  out << "           after: peak base rate " << m.peak_base_rate << " rad/s, final " << m.final_base_rate
+      << " rad/s, attitude excursion " << m.attitude_excursion * 180.0 / M_PI << " deg, settling " << m.settling_time
+      << " s\n";
+  out << "                  peak joint torque ";
+  if (m.peak_torque_joint.empty()) out << "(no effort limits)";
+  else out << m.peak_torque_ratio * 100.0 << " % of " << m.peak_torque_joint << "'s effort limit";
+  if (!std::isnan(m.peak_grasp_force))
+    out << ", peak grasp force " << m.peak_grasp_force << " N, moment " << m.peak_grasp_moment << " N m";
+  out << "\n";
 }
 
 }  // namespace
@@ -54,9 +67,20 @@ CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
               "speed, the arm configuration "
               "whose capture disturbs the servicer least, within the joints' position and velocity limits");
   cmd->add_option("SCENARIO", o.scenario, "Scenario file (YAML or JSON) with a capture: robot, target, law")->required();
-  cmd->add_option("--objective", o.objective, "What to minimise: base_rate (|w| of the base after), impulse (|f| of "
-                                              "the impulse) or joint_rate_jump (largest |dqdot|); default base_rate");
+  cmd->add_option("--objective", o.objective,
+                  "What to minimise. At the capture's instant: base_rate (|w| of the base after), impulse (|f| of the "
+                  "impulse), joint_rate_jump (largest |dqdot|). Over the motion after it (--horizon): peak_base_rate, "
+                  "final_base_rate, attitude_excursion, settling_time, peak_torque_ratio (|tau|/effort), "
+                  "peak_grasp_force, peak_grasp_moment (a compliant law). Default base_rate");
   cmd->add_option("--weights", o.weights, "A weighted sum instead: NAME=W,... (e.g. base_rate=1,impulse=0.01)");
+  cmd->add_option("--horizon", o.horizon,
+                  "Seconds of motion after each capture that the operation terms read, the scenario's servos holding "
+                  "its configuration and its base control acting (default: the scenario's simulation.duration); "
+                  "given, the optimum and the nominal report that motion whatever the objective")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--settling-band", o.settling_band,
+                  "The settling time's band about the base's final angular velocity, relative to its farthest (0, 1)")
+      ->check(CLI::Range(1e-6, 0.999999));
   cmd->add_option("--self-motion", o.self_motion, "A redundant arm's self-motion range A,B [rad] (default -1,1)")
       ->expected(2)->delimiter(',')->check(finiteNumber());
   cmd->add_option("--wrist-roll", o.wrist_roll, "The hand's roll about the contact frame's z: range A,B [rad] "
@@ -101,6 +125,8 @@ PlanOptions planOptions(const PlanCliOptions& o) {
   if (!o.closing_speed.empty()) p.closing_speed = rangeOf(o.closing_speed, "--closing-speed");
   p.scan = o.scan;
   p.polish_starts = o.polish_starts;
+  if (o.horizon > 0.0) p.horizon = o.horizon;
+  p.settling_band = o.settling_band;
   p.cancelled = [] { return interruptFlag().load(std::memory_order_relaxed); };
   return p;
 }
@@ -130,6 +156,12 @@ void runPlan(const PlanCliOptions& o, std::ostream& out) {
   out << " (" << plan.evaluations << " captures computed)\n";
   printTerms(out, "optimum", plan.optimum);
   printTerms(out, "nominal", plan.nominal);
+  if (plan.horizon > 0.0 && plan.optimum.motion)
+    out << "over " << plan.horizon << " s after the capture (servos holding, the scenario's base control); the "
+        << "stack's momentum-determined rate once its joints are still: " << plan.optimum.motion->momentum_rate
+        << " rad/s at the optimum (" << (plan.nominal.motion ? plan.nominal.motion->momentum_rate : std::nan(""))
+        << " nominal): its momentum is the same in every configuration, only its inertia differs; the base "
+           "control or a detumble removes it\n";
   out << "parameters:";
   for (const auto& [name, value] : plan.parameters) out << " " << name << " = " << std::setprecision(9) << value;
   out << (plan.parameters.empty() ? " none" : "") << "\njoint angles at the optimum [rad or m] (nominal in brackets):\n";

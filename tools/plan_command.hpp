@@ -1,7 +1,8 @@
 // `kdl_space plan SCENARIO [--objective NAME | --weights NAME=W,...] [--self-motion A,B]
-// [--wrist-roll A,B] [--timing A,B] [--closing-speed A,B] [--scan N] [--json]`: the arm configuration whose capture
-// disturbs the servicer least (the library's planCapture, printed): the joint angles by name, the
-// parameters, the objective at the optimum and at the scenario as written. Exit 2 for a usage
+// [--wrist-roll A,B] [--timing A,B] [--closing-speed A,B] [--horizon S] [--scan N] [--json]`: the arm
+// configuration whose capture disturbs the servicer least, at its instant or over the motion after
+// it (the library's planCapture, printed): the joint angles by name, the parameters, the objective
+// at the optimum and at the scenario as written, and with a horizon what the bus feels over it. Exit 2 for a usage
 // mistake (an unknown objective, bad weights, nothing to plan), 3 for a scenario it cannot plan.
 #pragma once
 
@@ -26,6 +27,8 @@ struct PlanCliOptions {
   std::vector<double> closing_speed;   ///< A B [m/s]; empty: the scenario's rates before
   unsigned int scan = 21;
   unsigned int polish_starts = 5;
+  double horizon = 0.0;                ///< [s]; 0: unset (the scenario's, if an operation term asks)
+  double settling_band = 0.05;
   bool json = false;
 };
 

@@ -413,6 +413,23 @@ def test_plan_finds_an_optimum_or_says_why_not(tmp_path, family):
 
 
 @pytest.mark.parametrize("family", FAMILIES, ids=IDS)
+def test_an_operation_plan_measures_the_motion(tmp_path, family):
+    """plan_capture over the motion after the capture (peak_base_rate, horizon 0.5 s): every family
+    with joints gets its optimum and nominal measured; a robot without joints: "no movable joint"."""
+    path = write_scenario(tmp_path, family)
+    if family.joints == 0:
+        with pytest.raises(kdl_space.InputError, match="no movable joint"):
+            kdl_space.plan_capture(str(path), objective="peak_base_rate", horizon=0.5, scan=3)
+        return
+    plan = kdl_space.plan_capture(str(path), objective="peak_base_rate", horizon=0.5, scan=3, polish_starts=1)
+    m = plan.optimum["motion"]
+    assert plan.objective == m["peak_base_rate"] <= plan.nominal["motion"]["peak_base_rate"] + 1e-12
+    assert m["peak_base_rate"] >= m["final_base_rate"]
+    assert math.isfinite(plan.momentum_rate)
+    assert sorted(m["peak_torque_by_name"]) == sorted(plan.joint_names)
+
+
+@pytest.mark.parametrize("family", FAMILIES, ids=IDS)
 def test_a_study_computes_every_sample(tmp_path, family):
     """kdl_space.study: four samples of the box's mass and spin, every status 0."""
     scenario = write_scenario(tmp_path, family)

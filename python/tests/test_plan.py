@@ -1,6 +1,7 @@
 """kdl_space.plan_capture: the same plan as `kdl_space plan --json` (one library, deterministic),
 inside the URDF's limits (read here with ElementTree), better than the scenario as written, a
-weighted sum that is the sum of its terms; the refusals."""
+weighted sum that is the sum of its terms; over the operation, the motion run_operation shows at
+the optimum's angles; the refusals."""
 import json
 import subprocess
 
@@ -86,3 +87,58 @@ def test_ctrl_c_ends_plan_capture_within_a_second():
         timer.cancel()
         timer.join()
     assert sent and time.monotonic() - sent[0] < 1.0
+
+
+def _scenario_at(tmp_path, q_by_name):
+    """The shipped capture scenario with its joints at q_by_name and its servos holding them (the
+    plan's motion after the capture), its URDF path made absolute."""
+    import re
+    text = CAPTURE_SCENARIO.read_text()
+    q = ", ".join(f"{name}: {value!r}" for name, value in q_by_name.items())
+    text = re.sub(r"(?m)^  q: \{.*\}$", "  q: {" + q + "}", text)
+    text = re.sub(r"set_point: [-0-9.]+", "set_point: hold", text)
+    text = text.replace("../urdf/", str(SOURCE_DIR / "urdf") + "/")
+    path = tmp_path / "planned.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_an_operation_plan_is_the_commands_and_what_run_operation_shows(cli, tmp_path):
+    """Over the motion after the capture: the same plan as the command's, and its optimum's
+    predicted peak base rate, final rate, attitude excursion and peak torques are those of
+    run_operation at its joint angles (read here from the samples with NumPy)."""
+    import numpy as np
+    plan = kdl_space.plan_capture(str(CAPTURE_SCENARIO), objective="peak_base_rate", horizon=2.0, scan=5,
+                                  polish_starts=1)
+    tool = json.loads(subprocess.run([cli, "plan", str(CAPTURE_SCENARIO), "--objective", "peak_base_rate", "--horizon",
+                                      "2", "--scan", "5", "--polish-starts", "1", "--json"], check=True,
+                                     capture_output=True, text=True).stdout)
+    assert plan.optimum == tool["optimum"]
+    assert plan.nominal == tool["nominal"]
+    assert plan.horizon == tool["horizon"] == 2.0
+    assert plan.momentum_rate == tool["momentum_rate"] == plan.optimum["motion"]["momentum_rate"]
+    m = plan.optimum["motion"]
+    assert plan.objective == m["peak_base_rate"]
+
+    run = kdl_space.run_operation(str(_scenario_at(tmp_path, plan.q_by_name)), duration=2.0)
+    s = run["samples"]
+    post = np.asarray(s["phase"]) == "post"
+    w = np.linalg.norm(np.asarray(s["base_twist"])[post, 3:], axis=1)
+    assert w.max() == pytest.approx(m["peak_base_rate"], rel=1e-12)
+    assert w[-1] == pytest.approx(m["final_base_rate"], rel=1e-12)
+    quat = np.asarray(s["base_quaternion"])[post]
+    turn = 2.0 * np.arccos(np.clip(np.abs(quat @ quat[0]), 0.0, 1.0))
+    assert turn.max() == pytest.approx(m["attitude_excursion"], abs=1e-7)
+    tau = np.abs(np.asarray(s["tau"])[post])
+    for k, name in enumerate(s["joint_names"]):
+        if name in m["peak_torque_by_name"]:
+            assert tau[:, k].max() == pytest.approx(m["peak_torque_by_name"][name], rel=1e-12), name
+
+
+def test_operation_refusals():
+    with pytest.raises(kdl_space.InputError, match="peak_grasp_force is a compliant grasp's load"):
+        kdl_space.plan_capture(str(ARM6), objective="peak_grasp_force")
+    with pytest.raises(kdl_space.InputError, match="horizon: must be finite and > 0"):
+        kdl_space.plan_capture(str(ARM6), objective="peak_base_rate", horizon=-1.0)
+    with pytest.raises(kdl_space.InputError, match="settling_band"):
+        kdl_space.plan_capture(str(ARM6), objective="settling_time", settling_band=2.0)

@@ -267,6 +267,19 @@ double estimatedOutputRows(const Scenario& sc, const OperationOptions& o) {
   return n;
 }
 
+namespace {
+
+/// The capture at the contact instant r.t_capture (a compliant law's contact, or the impulsive
+/// law's), then the system after it and its motion.
+void captureAndMotion(const Scenario& sc, const CaptureProblem& at_contact, const OperationOptions& o, OperationResult& r) {
+  std::optional<CaptureResult> capture;
+  if (sc.impact) capture = operation::inScenario(sc, [&] { return solveCapture(at_contact); });
+  if (sc.compliant) operation::compliantCapture(sc, at_contact, capture, o, r);  // its limit beside it
+  else runMotionAfterCapture(sc, at_contact, capture, r.t_capture, o, r);
+}
+
+}  // namespace
+
 OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& o) {
   using operation::inScenario;
   OperationResult r;
@@ -281,11 +294,18 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
       r.base_control_phases.push_back("approach");
     operation::approach(sc, r.output_step, o.cancelled, r, s);
   }
-  std::optional<CaptureResult> capture;
-  if (sc.impact) capture = inScenario(sc, [&] { return solveCapture(r.at_contact); });
   const CaptureProblem at_contact = r.at_contact;
-  if (sc.compliant) operation::compliantCapture(sc, at_contact, capture, o, r);  // its limit beside it
-  else runMotionAfterCapture(sc, at_contact, capture, r.t_capture, o, r);
+  captureAndMotion(sc, at_contact, o, r);
+  return r;
+}
+
+OperationResult runOperationFrom(const Scenario& sc, const CaptureProblem& at_contact, const OperationOptions& o) {
+  OperationResult r;
+  r.duration = o.duration.value_or(sc.simulation.duration);
+  r.output_step = o.output_step.value_or(sc.simulation.output_step);
+  if (o.motion) checkStepBudget(sc, r.duration, r.output_step);
+  r.at_contact = at_contact;
+  captureAndMotion(sc, at_contact, o, r);
   return r;
 }
 

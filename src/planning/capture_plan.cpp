@@ -171,7 +171,7 @@ CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
 
   const FloatingModel& model = *scenario.capture.robot.model;
   plan.joint_names = model.jointNames();
-  plan.optimum = evaluator.evaluate(s.best, &plan);
+  plan.optimum = evaluator.evaluate(s.best, &plan, true);  // with its motion, when a horizon is asked
   const std::vector<std::string>& names = planParameters();
   for (int k = 0; k < 4; ++k) {
     if (k == 0 && !evaluator.redundant()) continue;
@@ -180,7 +180,8 @@ CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options) {
     plan.parameters.emplace_back(names[k], coordinate(s.best, k));
     if (ranges[k].searched()) plan.searched.emplace_back(names[k]);
   }
-  plan.nominal = evaluator.evaluate(PlanPoint{});  // the scenario as written
+  plan.nominal = evaluator.evaluate(PlanPoint{}, nullptr, true);  // the scenario as written
+  plan.horizon = evaluator.horizon();
   plan.nominal_q.resize(model.nj());
   for (unsigned int j = 0; j < model.nj(); ++j) plan.nominal_q[j] = scenario.capture.robot.state.q(j);
   plan.evaluations = s.evaluations + 2;

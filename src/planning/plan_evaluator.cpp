@@ -10,6 +10,7 @@
 
 #include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/operation/capture_operation.hpp"
 
 namespace kdl_space {
 namespace {
@@ -27,9 +28,34 @@ void checkRange(const PlanRange& r, const char* name, double lowest) {
 }  // namespace
 
 const std::vector<std::string>& planObjectiveTerms() {
-  static const std::vector<std::string> terms{"base_rate", "impulse", "joint_rate_jump"};
+  static const std::vector<std::string> terms{
+      "base_rate",         "impulse",          "joint_rate_jump",  "peak_base_rate",    "final_base_rate",
+      "attitude_excursion", "settling_time",   "peak_torque_ratio", "peak_grasp_force", "peak_grasp_moment"};
   return terms;
 }
+
+bool isOperationTerm(const std::string& term) {
+  return term != "base_rate" && term != "impulse" && term != "joint_rate_jump";
+}
+
+namespace {
+
+/// A term's value at a configuration (an operation term's from its measures).
+double termValue(const std::string& name, const PlanTerms& t) {
+  if (name == "base_rate") return t.base_rate;
+  if (name == "impulse") return t.impulse;
+  if (name == "joint_rate_jump") return t.joint_rate_jump;
+  const MotionMeasures& m = *t.motion;
+  if (name == "peak_base_rate") return m.peak_base_rate;
+  if (name == "final_base_rate") return m.final_base_rate;
+  if (name == "attitude_excursion") return m.attitude_excursion;
+  if (name == "settling_time") return m.settling_time;
+  if (name == "peak_torque_ratio") return m.peak_torque_ratio;
+  if (name == "peak_grasp_force") return m.peak_grasp_force;
+  return m.peak_grasp_moment;
+}
+
+}  // namespace
 
 const std::vector<std::string>& planParameters() {
   static const std::vector<std::string> names{"self_motion", "wrist_roll", "timing", "closing_speed"};
@@ -80,6 +106,55 @@ PlanEvaluator::PlanEvaluator(const Scenario& scenario, const PlanOptions& option
   problem_ = scenario.capture;
   if (rigid) target_at_ = *rigid;
   if (options_.closing_speed) setUpClosing();
+  setUpMotion();
+}
+
+void PlanEvaluator::setUpMotion() {
+  for (const auto& [name, weight] : options_.weights) score_motion_ |= isOperationTerm(name);
+  if (options_.horizon && !(*options_.horizon > 0.0 && std::isfinite(*options_.horizon)))
+    throw InputError("horizon: must be finite and > 0 [s], got " + detail::number(*options_.horizon));
+  if (options_.output_step && !(*options_.output_step > 0.0 && std::isfinite(*options_.output_step)))
+    throw InputError("output_step: must be finite and > 0 [s], got " + detail::number(*options_.output_step));
+  if (!score_motion_ && !options_.horizon) return;
+  horizon_ = options_.horizon.value_or(scenario_.simulation.duration);
+  const FloatingModel& robot = *scenario_.capture.robot.model;
+  for (const auto& [name, weight] : options_.weights) {
+    if ((name == "peak_grasp_force" || name == "peak_grasp_moment") && !scenario_.compliant)
+      throw InputError("objective: " + name + " is a compliant grasp's load during its contact; the scenario's law "
+                       "is impulsive (its load is an impulse: the term impulse): give law.type compliant, or "
+                       "another term");
+    if (name == "peak_torque_ratio" &&
+        std::none_of(robot.jointProperties().begin(), robot.jointProperties().end(), [](const JointProperties& p) {
+          return p.effort > 0.0 && std::isfinite(p.effort);
+        }))
+      throw InputError("objective: peak_torque_ratio: no joint of the robot has an effort limit (the URDF's "
+                       "<limit effort=...>): give them, or another term");
+  }
+  measurer_.emplace(robot, options_.settling_band);  // or InputError "settling_band: ..."
+}
+
+bool PlanEvaluator::measured(PlanTerms& t) {
+  OperationOptions o;
+  o.duration = horizon_;
+  o.output_step = options_.output_step;
+  o.hold_servos = true;  // the servos hold the planned configuration, not the scenario's set points
+  o.keep_samples = false;
+  o.cancelled = options_.cancelled;
+  measurer_->reset();
+  o.observer = [this](const OperationResult& so_far, const MotionSample& x) { measurer_->add(so_far, x); };
+  MotionMeasures m;
+  try {
+    const OperationResult r = runOperationFrom(scenario_, problem_, o);
+    if (const int rc = measurer_->finish(r, m)) {
+      t.infeasible = std::string("the motion after the capture: the stack's momentum rate: ") + strError(rc);
+      return false;
+    }
+  } catch (const Error& e) {  // a motion that failed (blew up, out of steps, cancelled), or refused
+    t.infeasible = std::string("the motion after the capture: ") + e.what();
+    return false;
+  }
+  t.motion = m;
+  return true;
 }
 
 void PlanEvaluator::setUpClosing() {
@@ -228,7 +303,7 @@ double PlanEvaluator::violation(const FloatingSystem& robot, const KDL::JntArray
   return v;
 }
 
-PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, CapturePlan* joints) {
+PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, CapturePlan* joints, bool measure) {
   PlanTerms t;
   t.objective = std::numeric_limits<double>::quiet_NaN();
   if (!handPlaced(x, t.infeasible)) return t;
@@ -267,9 +342,9 @@ PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, CapturePlan* joints) {
   }
   t.base_rate = toEigen(r->robot.after.base_twist).tail<3>().norm();
   t.impulse = r->impulse.F.head<3>().norm();
+  if ((score_motion_ || (measure && measurer_)) && !measured(t)) return t;
   t.objective = 0.0;
-  for (const auto& [name, weight] : options_.weights)
-    t.objective += weight * (name == "base_rate" ? t.base_rate : name == "impulse" ? t.impulse : t.joint_rate_jump);
+  for (const auto& [name, weight] : options_.weights) t.objective += weight * termValue(name, t);
   t.violation = violation(robot, r->robot.after.qdot, closes, t.infeasible);
   t.feasible = t.violation == 0.0 && std::isfinite(t.objective);
   if (joints) {

@@ -31,7 +31,10 @@ class PlanEvaluator {
   PlanEvaluator(const Scenario& scenario, const PlanOptions& options);
   /// The terms at `x`; the joints and the rates before and after into `joints` (may be null).
   /// Never throws for a configuration that cannot be reached or computed: infeasible, and why.
-  PlanTerms evaluate(const PlanPoint& x, CapturePlan* joints = nullptr);
+  /// With `measure` (or an operation term weighted), the motion after the capture too (terms.motion).
+  PlanTerms evaluate(const PlanPoint& x, CapturePlan* joints = nullptr, bool measure = false);
+  /// The horizon the measures read [s]: 0 when neither an operation term nor a horizon was asked.
+  double horizon() const { return horizon_; }
   /// The penalised objective the optimiser sees: the objective, or 1e6 + the violation.
   static double score(const PlanTerms& terms);
   bool redundant() const { return redundant_; }
@@ -45,6 +48,9 @@ class PlanEvaluator {
   /// into robot.velocity; false: the arm cannot give the hand that twist (why in `why`).
   bool closing(FloatingSystem& robot, double closing_speed, std::string& why);
   void setUpClosing();
+  void setUpMotion();
+  /// The motion after the capture of problem_ (its measures into t.motion); false: it failed (why in t).
+  bool measured(PlanTerms& t);
   /// The excess over the position limits, the rate limits after the capture and, when the plan
   /// set them (`rates_before`), before it.
   double violation(const FloatingSystem& robot, const KDL::JntArray& qdot_after, bool rates_before, std::string& why) const;
@@ -55,6 +61,9 @@ class PlanEvaluator {
   KDL::Frame hand0_;  ///< the contact frame at the scenario's state (H0)
   std::optional<FreeRigidMotion> tumble_;  ///< a rigid target's motion (timing searched)
   CaptureSolver capture_;
+  bool score_motion_ = false;  ///< an operation term is weighted: every evaluation runs the motion
+  double horizon_ = 0.0;
+  std::optional<MotionMeasurer> measurer_;
   CaptureProblem problem_;
   // The last (wrist_roll, timing) placed: its joints, its self-motion and the target then.
   std::optional<std::pair<double, double>> placed_key_;

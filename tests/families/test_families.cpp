@@ -361,6 +361,36 @@ TEST_P(Families, PlanFindsAnOptimumOrSaysWhyNot) {
   }
 }
 
+// plan over the operation: the motion after each capture measured (the servos holding), an
+// optimum no worse than the nominal, or a refusal that names what is missing.
+TEST_P(Families, PlanOverTheOperationMeasuresTheMotionOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const Scenario sc = loadScenario(writeScenario(f, "{type: capture}"));
+  PlanOptions o;
+  o.weights = {{"peak_base_rate", 1.0}, {"attitude_excursion", 0.1}, {"settling_time", 1e-3}};
+  o.horizon = 0.5;
+  o.scan = 3;
+  o.polish_starts = 1;
+  o.polish_evaluations = 10;
+  try {
+    const CapturePlan p = planCapture(sc, o);
+    EXPECT_GT(f.joints, 0u) << f.name << ": a robot without joints has nothing to plan";
+    ASSERT_TRUE(p.optimum.motion && p.nominal.motion) << f.name;
+    const MotionMeasures& m = *p.optimum.motion;
+    EXPECT_NEAR(p.optimum.objective, m.peak_base_rate + 0.1 * m.attitude_excursion + 1e-3 * m.settling_time,
+                1e-12 * std::max(1e-300, p.optimum.objective)) << f.name;
+    EXPECT_LE(p.optimum.objective, p.nominal.objective + 1e-12) << f.name;
+    EXPECT_GE(m.peak_base_rate, m.final_base_rate) << f.name;
+    EXPECT_TRUE(std::isfinite(m.momentum_rate)) << f.name;
+    EXPECT_EQ(m.peak_torque.size(), f.joints) << f.name;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_FALSE(what.empty());
+    EXPECT_EQ(f.joints, 0u) << f.name << " refused: " << what;  // every family with joints computes
+    if (f.joints == 0) EXPECT_NE(what.find("no movable joint"), std::string::npos) << what;
+  }
+}
+
 /// Six samples of a study of the family's capture scenario with these `inputs` (YAML lines): each computes.
 void expectEverySampleComputes(const ModelFamily& f, const std::string& name, const std::string& inputs) {
   const std::string scenario = writeScenario(f, "{type: capture}");

@@ -148,6 +148,14 @@ class KDL_SPACE_EXPORT OperationError : public InputError {
 /// motion that blew up), with what was done until then.
 KDL_SPACE_EXPORT OperationResult runCaptureOperation(const Scenario& scenario, const OperationOptions& options = {});
 
+/// \brief The operation from its contact instant (t = 0) at a given capture problem: its capture
+/// (a compliant law's contact, or the impulsive law's), the system that moves on and its motion;
+/// runCaptureOperation without the approach, at `at_contact` instead of the scenario's (a planned
+/// or drawn configuration: the same robot and target, other states). options.approach is ignored.
+/// \throws as runCaptureOperation.
+KDL_SPACE_EXPORT OperationResult runOperationFrom(const Scenario& scenario, const CaptureProblem& at_contact,
+                                                  const OperationOptions& options = {});
+
 /// \brief The motion after a capture alone: `capture` solved for `at_contact` (a scenario's
 /// problem, or one a study drew from it), the system that moves on after it, and its motion from
 /// t_capture. `result` gets everything of that (approach and the rest untouched).

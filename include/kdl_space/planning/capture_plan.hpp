@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "kdl_space/export.hpp"
+#include "kdl_space/operation/motion_measures.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 
 namespace kdl_space {
@@ -49,11 +50,28 @@ struct PlanRange {
 
 /// What planCapture searches and minimises.
 struct PlanOptions {
-  /// The objective: the weighted sum of the named terms (each weight > 0):
+  /// The objective: the weighted sum of the named terms (each weight > 0). At the instant of the
+  /// capture (computed in microseconds: the fast proxy):
   ///   "base_rate"        |w| of the base after the capture [rad/s]
   ///   "impulse"          |f|, the linear part of the impulse on the robot [N s]
   ///   "joint_rate_jump"  max_j |qdot_j after - qdot_j before| [rad/s or m/s]
+  /// Over the operation: the motion after the capture over `horizon` (runOperationFrom: the
+  /// scenario's simulation section, its PD servos holding the capture configuration, its base
+  /// control, a compliant law's contact), read at its output samples (MotionMeasures):
+  ///   "peak_base_rate"     max |w| of the base [rad/s]
+  ///   "final_base_rate"    |w| of the base at the horizon [rad/s]
+  ///   "attitude_excursion" the base's largest turn from its attitude at the capture [rad]
+  ///   "settling_time"      when the base's w last left its band about its final value [s]
+  ///   "peak_torque_ratio"  max_j max_t |tau_j| / effort_j (the URDF's effort limits) [-]
+  ///   "peak_grasp_force"   a compliant grasp's largest |f| during its contact [N]
+  ///   "peak_grasp_moment"  and |n| [N m]
   std::vector<std::pair<std::string, double>> weights{{"base_rate", 1.0}};
+  /// The motion after each capture that the operation terms score [s], > 0. Unset: the
+  /// scenario's simulation.duration. Given (or an operation term weighted), the optimum and the
+  /// nominal report their MotionMeasures (PlanTerms::motion) whatever the objective.
+  std::optional<double> horizon;
+  std::optional<double> output_step;  ///< where the motion is read [s]; unset: the scenario's
+  double settling_band = 0.05;        ///< the settling time's band, relative (0, 1)
   /// The self-motion's range [rad of joint-space arc length]. Unset: [-1, 1] for an arm with a
   /// one-parameter self-motion (7 joints on the path to the contact), fixed at 0 otherwise.
   std::optional<PlanRange> self_motion;
@@ -85,6 +103,9 @@ struct PlanTerms {
   /// How far outside: the sum over the joints of the position and rate excesses (0: feasible).
   double violation = 0.0;
   std::string infeasible;  ///< why not (the first joint and limit), or what could not be computed
+  /// The motion after the capture over the horizon (PlanOptions::horizon): when an operation term
+  /// is weighted, or the horizon is given (the optimum and the nominal only); unset otherwise.
+  std::optional<MotionMeasures> motion;
 };
 
 /// A planned capture.
@@ -101,6 +122,7 @@ struct CapturePlan {
   PlanTerms optimum;                     ///< at the optimum (always feasible)
   PlanTerms nominal;                     ///< the scenario as written (may be infeasible)
   std::vector<double> nominal_q;
+  double horizon = 0.0;                  ///< of the motion the measures read [s] (0: none measured)
   unsigned int evaluations = 0;          ///< configurations computed, scan and polishes
   bool cancelled = false;                ///< PlanOptions::cancelled stopped the search
 };
@@ -113,11 +135,16 @@ struct CapturePlan {
 /// configuration evaluated.
 /// \throws InputError "plan: ..." for a scenario with nothing to plan (no rigid-target capture,
 /// no searched parameter), an unknown term or a weight <= 0 ("objective: ..."), a range that
-/// cannot be used ("self_motion: ...", "wrist_roll: ...", "timing: ..."), or no feasible
-/// configuration in the box.
+/// cannot be used ("self_motion: ...", "wrist_roll: ...", "timing: ..."), an operation term the
+/// scenario cannot measure ("objective: ...": a grasp load without a compliant law, a torque
+/// ratio without effort limits), a horizon <= 0 ("horizon: ..."), or no feasible configuration in
+/// the box. A configuration whose motion fails (blows up, runs out of steps) is infeasible.
 KDL_SPACE_EXPORT CapturePlan planCapture(const Scenario& scenario, const PlanOptions& options = {});
 
 /// The names of the objective's terms, in the order of the documentation.
 KDL_SPACE_EXPORT const std::vector<std::string>& planObjectiveTerms();
+
+/// Whether a term is read over the operation (the motion after the capture), not at its instant.
+KDL_SPACE_EXPORT bool isOperationTerm(const std::string& term);
 
 }  // namespace kdl_space
