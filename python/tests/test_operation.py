@@ -69,6 +69,14 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
     # tests/cli/test_cli_approach_robot_target.cpp, which captures from them).
     if now.get("approach"):
         assert set(now["approach"].pop("states_at_contact")) == {"t", "robot", "target"}
+        # ... and the approach from stowed (issue 38): the Jacobian, the limit guard, the pre-grasp
+        # move, the cause of a failure. The golden approach keeps away from its joints' limits, so
+        # the guard never acted and every number above is what it was.
+        a = now["approach"]
+        assert a.pop("jacobian") == "generalized (J*)"
+        assert set(a.pop("time_at_limit_by_name").values()) == {0.0}
+        assert a.pop("time_rate_limited") >= 0.0 and a.pop("time_near_singular") >= 0.0
+        assert a.pop("pre_grasp") is None and a.pop("cause") is None
     # ... and a compliant capture's contact (issue 28): null for the golden files' laws (its
     # values: test_compliant_operation below, tests/cli/test_cli_compliant_simulate.cpp).
     assert now.pop("compliant") is None

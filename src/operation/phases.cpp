@@ -25,10 +25,9 @@ namespace {
 std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
   std::ostringstream why;
   why << std::setprecision(6) << sc.file << ": approach: the hand never reached the grasp point in "
-      << sc.approach->max_duration << " s (approach.max_duration): closest " << r.closest_distance << " m at t = "
-      << r.closest_time << " s, " << r.final_distance << " m at the end (tolerance " << sc.approach->position_tolerance
-      << " m); smallest singular value of J* " << r.min_sigma
-      << ": is the grasp point within the arm's reach, the gain high enough, the target slow enough?";
+      << sc.approach->max_duration << " s (approach.max_duration): " << r.cause << "; closest " << r.closest_distance
+      << " m at t = " << r.closest_time << " s, " << r.final_distance << " m at the end (tolerance "
+      << sc.approach->position_tolerance << " m); control with the " << toString(r.base) << " Jacobian";
   return why.str();
 }
 

@@ -2,8 +2,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <string>
+
+#include "simulation/pre_grasp.hpp"
 
 namespace kdl_space {
 
@@ -48,6 +53,14 @@ ApproachController::ApproachController(std::shared_ptr<const FloatingModel> mode
   positive(spec_.position_tolerance, "the position tolerance");
   positive(spec_.orientation_tolerance, "the orientation tolerance");
   positive(spec_.max_duration, "the longest approach");
+  positive(spec_.limit_gain, "the limit gain");
+  if (!(spec_.limit_zone >= 0.0 && spec_.limit_zone < 0.5)) refuse("the limit zone must lie in [0, 0.5)");
+  if (spec_.pre_grasp) {
+    if (!(spec_.pre_grasp->standoff >= 0.0) || !std::isfinite(spec_.pre_grasp->standoff))
+      refuse("the pre-grasp standoff must be finite and >= 0");
+    if (!(spec_.pre_grasp->rate > 0.0 && spec_.pre_grasp->rate <= 1.0)) refuse("the pre-grasp rate must lie in (0, 1]");
+    positive(spec_.pre_grasp->acceleration, "the pre-grasp acceleration");
+  }
   if (!(spec_.damping >= 0.0) || !std::isfinite(spec_.damping)) refuse("the damping must be finite and >= 0");
   if (!(spec_.speed_tolerance > 0.0)) refuse("the speed tolerance must be > 0");
   if (spec_.rate_limits.empty()) spec_.rate_limits = defaultRateLimits(*model_);
@@ -67,6 +80,89 @@ int ApproachController::target(double t, RigidTarget& out) {
   return rigid ? rigid->at(t, out) : E_BAD_ARGUMENT;
 }
 
+const char* toString(ApproachBase base) {
+  switch (base) {
+    case ApproachBase::Held: return "grounded (J)";
+    case ApproachBase::AttitudeHeld: return "attitude held (J - [A_mP / w; 0])";
+    default: return "generalized (J*)";
+  }
+}
+
+Eigen::VectorXd ApproachController::solveTask(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                              const Eigen::VectorXd& fixed, const std::vector<bool>& clamped,
+                                              double l2, Eigen::MatrixXd* N) const {
+  const Eigen::Index n = A.cols(), m = A.rows();
+  Eigen::MatrixXd A_f = A;
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (clamped[static_cast<std::size_t>(j)]) A_f.col(j).setZero();
+  const Eigen::VectorXd rest = b - (A - A_f) * fixed;  // what the free joints must do
+  const Eigen::MatrixXd AAt = A_f * A_f.transpose();
+  // The damping of the free joints' Jacobian (a clamp may bring it nearer a singularity).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(AAt, Eigen::EigenvaluesOnly);
+  const double ratio = std::sqrt(std::max(eig.eigenvalues()(0), 0.0)) / spec_.threshold;
+  const double damping2 = std::max(l2, ratio < 1.0 ? spec_.damping * spec_.damping * (1.0 - ratio * ratio) : 0.0);
+  const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + (damping2 + 1e-300) * Eigen::MatrixXd::Identity(m, m));
+  Eigen::VectorXd qdot = A_f.transpose() * damped.solve(rest);
+  if (N) {
+    *N = Eigen::MatrixXd::Identity(n, n) - A_f.transpose() * damped.solve(A_f);
+    for (Eigen::Index j = 0; j < n; ++j)
+      if (clamped[static_cast<std::size_t>(j)]) N->row(j).setZero(), N->col(j).setZero();
+  }
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (clamped[static_cast<std::size_t>(j)]) qdot(j) = fixed(j);
+  return qdot;
+}
+
+void ApproachController::limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                     double l2, Eigen::VectorXd& qdot, std::vector<int>& clamped_out) const {
+  const unsigned int n = model_->nj();
+  clamped_out.clear();
+  const auto limited = [&](unsigned int j) {
+    const JointProperties& p = model_->jointProperties()[j];
+    return std::isfinite(p.lower) && std::isfinite(p.upper);
+  };
+  // The push away from a limit, inside its zone: the gradient of sum ((q - mid) / half range)^2
+  // in effect, as large as limit_gain x the depth into the zone (at most half the rate limit).
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
+  for (unsigned int j = 0; j < n; ++j) {
+    if (!limited(j)) continue;
+    const JointProperties& p = model_->jointProperties()[j];
+    const double zone = spec_.limit_zone * (p.upper - p.lower), cap = 0.5 * spec_.rate_limits[j];
+    if (p.upper - q(j) < zone) z(j) = -std::min(spec_.limit_gain * (zone - (p.upper - q(j))), cap);
+    else if (q(j) - p.lower < zone) z(j) = std::min(spec_.limit_gain * (zone - (q(j) - p.lower)), cap);
+  }
+  std::vector<bool> clamped(n, false);
+  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
+  Eigen::MatrixXd N;
+  const bool push = !z.isZero(0.0);
+  if (push) {
+    solveTask(A, b, fixed, clamped, l2, &N);
+    qdot += N * z;
+  }
+  // The guard: a joint's rate toward its limit at most limit_gain x its distance from it.
+  for (unsigned int pass = 0; pass < n; ++pass) {
+    bool more = false;
+    for (unsigned int j = 0; j < n; ++j) {
+      if (clamped[j] || !limited(j)) continue;
+      const JointProperties& p = model_->jointProperties()[j];
+      const double up = spec_.limit_gain * (p.upper - q(j)), down = -spec_.limit_gain * (q(j) - p.lower);
+      if (qdot(j) > up || qdot(j) < down) {
+        fixed(j) = qdot(j) > up ? up : down;
+        clamped[j] = more = true;
+      }
+    }
+    if (!more) break;
+    qdot = solveTask(A, b, fixed, clamped, l2, push ? &N : nullptr);
+    if (push) {
+      for (unsigned int j = 0; j < n; ++j)
+        if (clamped[j]) z(j) = 0.0;
+      qdot += N * z;
+    }
+  }
+  for (unsigned int j = 0; j < n; ++j)
+    if (clamped[j]) clamped_out.push_back(static_cast<int>(j));
+}
+
 int ApproachController::command(const SimulationState& s, ApproachCommand& out) {
   const unsigned int n = model_->nj();
   if (s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
@@ -75,9 +171,18 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   if (const int rc = solver_.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return rc;
   const KDL::JntArray still(n);
   KDL::Twist drift, t_h;
-  if (grounded_) {  // the base held: t_h = J qdot
+  if (base_ == ApproachBase::Held) {  // the base held: t_h = J qdot
     if (const int rc = solver_.J(hand_, J_)) return rc;
     t_h = toTwist(J_.data * s.velocity.qdot.data);
+  } else if (base_ == ApproachBase::AttitudeHeld) {
+    // w_b = 0, the linear momentum P = w v_b + A_mP qdot: v_b = (P - A_mP qdot) / w, so
+    // t_h = (J - [A_mP / w; 0]) qdot + (P / w; 0).
+    if (const int rc = solver_.J(hand_, J_)) return rc;
+    J_.data.topRows(3) -= solver_.A_m().topRows(3) / solver_.w();
+    Vector6d d = Vector6d::Zero();
+    d.head<3>() = PL_g.head<3>() / solver_.w();
+    drift = toTwist(d);
+    t_h = toTwist(J_.data * s.velocity.qdot.data + d);
   } else {
     if (const int rc = solver_.J_star(hand_, J_)) return rc;
     if (const int rc = solver_.handTwist(hand_, still, PL_g, drift)) return rc;  // eq. 4, qdot = 0
@@ -102,7 +207,7 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   const double l2 = ratio < 1.0 ? spec_.damping * spec_.damping * (1.0 - ratio * ratio) : 0.0;
   const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + l2 * Eigen::MatrixXd::Identity(m, m));  // J J^T + l^2 E
   Eigen::VectorXd qdot = A.transpose() * damped.solve(b);
-  if (spec_.null_space == NullSpaceTask::Reaction && !grounded_ && static_cast<int>(n) > m) {
+  if (spec_.null_space == NullSpaceTask::Reaction && base_ == ApproachBase::Free && static_cast<int>(n) > m) {
     // Of qdot + N z (N = E - J+ J*: rates that leave the hand's twist alone), the one whose base
     // angular velocity w_b = A_w qdot + c (the base's J* and drift) is least.
     if (const int rc = solver_.J_star(Contact{0, KDL::Vector::Zero()}, J_base_)) return rc;
@@ -117,6 +222,7 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
     const Eigen::VectorXd z = -B.transpose() * (BBt + mu * Matrix3d::Identity()).ldlt().solve(w_b);
     qdot += N * z;
   }
+  limitJoints(s.state.q, A, b, l2, qdot, out.clamped);
   double scale = 1.0;
   for (unsigned int j = 0; j < n; ++j)
     if (std::abs(qdot(j)) * scale > spec_.rate_limits[j]) scale = spec_.rate_limits[j] / std::abs(qdot(j));
@@ -147,10 +253,35 @@ double contactMargin(const ApproachSpec& spec, const ApproachCommand& c) {
 }
 }  // namespace
 
+namespace {
+
+/// One run of the simulator with the approach's callbacks, cleared after it (also on a throw);
+/// a command that failed inside is its code.
+template <typename Run>
+int guarded(Simulator& sim, Run run) {
+  int rc = E_NOERROR;
+  try {
+    rc = run();
+  } catch (const CommandFailed& f) {
+    rc = f.rc;
+  } catch (...) {
+    sim.setTorqueCallback({});
+    sim.setStopCondition({});
+    sim.setStopEvent({});
+    throw;
+  }
+  sim.setTorqueCallback({});
+  sim.setStopEvent({});
+  return rc;
+}
+
+}  // namespace
+
 int runApproach(Simulator& sim, ApproachController& controller, SimulationState& s, double output_dt,
                 const std::function<void(const SimulationState&, const ApproachCommand&)>& observer,
                 ApproachRecord& record) {
-  const unsigned int n = sim.model().nj();
+  const FloatingModel& model = sim.model();
+  const unsigned int n = model.nj();
   const ApproachSpec& spec = controller.spec();
   ApproachRecord rec;
   rec.kv.assign(n, 0.0);
@@ -160,15 +291,22 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
     if (const int rc = sim.apparentInertia(s, j, m)) return rc;
     rec.kv[j] = spec.servo_bandwidth * m;
   }
-  controller.setGrounded(sim.options().grounded);
+  // The Jacobian that matches what holds the base (its control acts in the approach if it is on).
+  const BaseControl& held = sim.baseControl();
+  rec.base = sim.options().grounded ? ApproachBase::Held
+             : held.attitude.on     ? (held.position.on ? ApproachBase::Held : ApproachBase::AttitudeHeld)
+                                    : ApproachBase::Free;
+  controller.setBase(rec.base);
+  rec.time_at_limit.assign(n, 0.0);
+  rec.output_step = output_dt;
   const KDL::Rotation base_start = s.state.world_T_base.M;
   ApproachCommand stage, sample, probe;
   int failure = E_NOERROR;
-  sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
-    if (const int rc = controller.command(x, stage)) throw CommandFailed{rc};
-    for (unsigned int j = 0; j < n; ++j) tau(j) += rec.kv[j] * (stage.qdot(j) - x.velocity.qdot(j));
-  });
+  double last_seen = -std::numeric_limits<double>::infinity();
+  bool in_control = false;
   const auto watch = [&](const SimulationState& x) {
+    if (x.t == last_seen) return;  // the pre-grasp move's end is the control's start
+    last_seen = x.t;
     if ((failure = controller.command(x, sample))) return;  // stops the run: returned below
     const double distance = sample.error.head<3>().norm(), angle = sample.error.tail<3>().norm();
     if (distance < rec.closest_distance) {
@@ -180,35 +318,39 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
     rec.min_sigma = std::min(rec.min_sigma, sample.sigma_min);
     rec.max_damping = std::max(rec.max_damping, sample.damping);
     rec.min_scale = std::min(rec.min_scale, sample.scale);
+    if (in_control) {  // the resolved-rate control's own samples (not the pre-grasp move's)
+      for (const int j : sample.clamped) rec.time_at_limit[static_cast<std::size_t>(j)] += output_dt;
+      if (sample.scale < 0.99) rec.time_rate_limited += output_dt;
+      if (sample.sigma_min < spec.threshold) rec.time_near_singular += output_dt;
+    }
     if (observer) observer(x, sample);
   };
   sim.setStopCondition([&](const SimulationState&) { return failure != E_NOERROR; });
-  // The contact instant located between the steps (the simulator's stop event): the run ends
-  // there and its last output, the capture's state, is that instant.
-  sim.setStopEvent([&](const SimulationState& x) {
-    if (const int rc = controller.command(x, probe)) throw CommandFailed{rc};
-    return contactMargin(spec, probe);
-  });
   const double t0 = s.t;
   int rc = E_NOERROR;
-  try {
-    rc = sim.run(s, t0 + spec.max_duration, output_dt, watch);
-  } catch (const CommandFailed& f) {
-    rc = f.rc;
-  } catch (...) {
-    sim.setTorqueCallback({});
-    sim.setStopCondition({});
-    sim.setStopEvent({});
-    throw;
+  if (spec.pre_grasp) rc = guarded(sim, [&] { return approach_phases::preGrasp(sim, controller, s, output_dt, rec, watch); });
+  if (rc == E_NOERROR && rec.cause.empty()) {
+    in_control = true;
+    sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
+      if (const int crc = controller.command(x, stage)) throw CommandFailed{crc};
+      for (unsigned int j = 0; j < n; ++j) tau(j) += rec.kv[j] * (stage.qdot(j) - x.velocity.qdot(j));
+    });
+    // The contact instant located between the steps (the simulator's stop event): the run ends
+    // there and its last output, the capture's state, is that instant.
+    sim.setStopEvent([&](const SimulationState& x) {
+      if (const int erc = controller.command(x, probe)) throw CommandFailed{erc};
+      return contactMargin(spec, probe);
+    });
+    rc = guarded(sim, [&] { return sim.run(s, std::max(t0 + spec.max_duration, s.t), output_dt, watch); });
   }
-  sim.setTorqueCallback({});
   sim.setStopCondition({});
-  sim.setStopEvent({});
   if (rc == E_NOERROR) rc = failure;
-  rec.reached = rc == E_NOERROR && std::isfinite(sim.stats().event_time);
+  rec.reached = rc == E_NOERROR && rec.cause.empty() && std::isfinite(sim.stats().event_time);
   if (rec.reached) rec.t_contact = s.t;
   rec.duration = s.t - t0;
   rec.base_rotation = (s.state.world_T_base.M * base_start.Inverse()).GetRot().Norm();
+  if (!rec.reached && rc == E_NOERROR && rec.cause.empty())
+    rec.cause = approach_phases::approachCause(rec, controller, model, s);
   record = rec;
   return rc;
 }

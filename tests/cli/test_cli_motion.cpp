@@ -366,9 +366,12 @@ TEST(Operation, AnUnreachableGraspPointIsReportedWithTheClosestDistanceAndTheApp
   std::ofstream(path) << text;
   const ToolRun r = kdlSpace("simulate " + path + " --csv " + csv);
   EXPECT_EQ(r.rc, 3) << r.err;
-  EXPECT_NE(r.err.find("approach: the hand never reached the grasp point in 3 s (approach.max_duration): closest "),
+  // Its cause: 8 m off the target is farther than the arm reaches (issue 38: a failure names it).
+  EXPECT_NE(r.err.find("approach: the hand never reached the grasp point in 3 s (approach.max_duration): out of "
+                       "reach: the grasp point is "),
             std::string::npos)
       << r.err;
+  EXPECT_NE(r.err.find("; closest "), std::string::npos) << r.err;
   EXPECT_EQ(r.out, "");
   const std::vector<std::string> p = phases(csv);
   ASSERT_EQ(p.size(), 61u);  // 0, 0.05, ..., 3 s

@@ -114,7 +114,7 @@ const std::vector<Broken>& corpus() {
       {"approach_missing_grasp.yaml", "{f}:17: approach.grasp: missing (a required field)", false},
       {"approach_unknown_field.yaml",
        "{f}:18: approach.speed: unknown field (expected one of grasp, track, gain, damping, singular_threshold, "
-       "rate_limits, servo_bandwidth, null_space, tolerance, max_duration)",
+       "rate_limits, servo_bandwidth, null_space, tolerance, max_duration, pre_grasp, joint_limits)",
        false},
       {"target_joints_rigid.yaml",
        "{f}:21: simulation.target_joints: only a free-floating target (target.urdf with movable joints) has joints", false},

@@ -6,6 +6,8 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "kdl_space/export.hpp"
@@ -40,7 +42,31 @@ struct ApproachSpec {
   double orientation_tolerance = 0.05;  ///< contact: angle between hand and grasp frames [rad]
   double speed_tolerance = std::numeric_limits<double>::infinity();  ///< contact: relative speed [m/s]
   double max_duration = 60.0;  ///< [s]: no contact by then: the approach failed
+  /// Joint limits (positions): a joint within `limit_zone` x its range of a limit is pushed away in
+  /// the null space (the gradient of sum ((q - mid) / half range)^2, Liegeois), and its rate toward
+  /// the limit is never more than limit_gain x its distance from it (the joint clamped there and
+  /// the task re-solved by the others): it never crosses. Joints without limits are free.
+  double limit_zone = 0.1;
+  double limit_gain = 2.0;  ///< [1/s]
+  /// The joint-space move to a pre-grasp pose first (unset: none): see JointMove (joint_move.hpp).
+  struct PreGrasp {
+    double standoff = 0.2;      ///< [m] back from the grasp along the contact frame's z (the approach axis)
+    double rate = 0.5;          ///< fraction of each joint's rate limit the move may use, (0, 1]
+    double acceleration = 0.1;  ///< [rad/s^2 or m/s^2] per joint
+  };
+  std::optional<PreGrasp> pre_grasp;
 };
+
+/// What the resolved-rate control assumes of the base, from what holds it during the approach.
+enum class ApproachBase {
+  Free,          ///< nothing holds it: J* and the momentum's drift (eq. 4)
+  Held,          ///< grounded, or its attitude and position both controlled: the fixed-base J
+  AttitudeHeld,  ///< its attitude controlled, its position free: J - [A_m,P / w; 0], drift (P / w; 0)
+};
+
+/// The Jacobian's name as the reports give it: "generalized (J*)", "grounded (J)",
+/// "attitude held (J - [A_mP / w; 0])".
+KDL_SPACE_EXPORT const char* toString(ApproachBase base);
 
 /// The URDF's velocity limits per joint (model order), infinity where a joint has none: the
 /// approach's rate limits unless the spec gives its own.
@@ -56,6 +82,9 @@ struct ApproachCommand {
   double damping = 0.0;      ///< l of the damped least squares used
   double scale = 1.0;        ///< the factor the rate limits put on the command (1: none)
   double relative_speed = 0.0;  ///< |v_hand - v_grasp point| [m/s]
+  /// The joints clamped at their limit guard (model order; empty: none): their rate toward the
+  /// limit bounded, the task re-solved by the others.
+  std::vector<int> clamped;
 };
 
 /// \brief Resolved motion rate control with J*: qdot = J*+ (v_ref - R_h M_a^-1 (P_g; L_g)), so
@@ -73,6 +102,7 @@ class KDL_SPACE_EXPORT ApproachController {
   ApproachController(std::shared_ptr<const FloatingModel> model, const Contact& hand, ApproachSpec spec,
                      std::shared_ptr<ApproachTarget> target);
   const ApproachSpec& spec() const { return spec_; }
+  const Contact& hand() const { return hand_; }
   /// The grasp frame and the twist (v of the grasp point; w) at time t.
   int grasp(double t, KDL::Frame& frame, Vector6d& twist);
   /// The commanded joint rates at s (and what they came from).
@@ -83,7 +113,10 @@ class KDL_SPACE_EXPORT ApproachController {
   ApproachTarget& targetMotion() { return *target_; }
   /// A grounded base (held still): the fixed-base J and no drift instead of J* and the momentum's
   /// term (runApproach sets it from the simulator's options); the reaction null space does nothing.
-  void setGrounded(bool grounded) { grounded_ = grounded; }
+  void setGrounded(bool grounded) { base_ = grounded ? ApproachBase::Held : ApproachBase::Free; }
+  /// What holds the base (runApproach sets it from the simulator: grounded, or its base control).
+  void setBase(ApproachBase base) { base_ = base; }
+  ApproachBase base() const { return base_; }
 
  private:
   std::shared_ptr<const FloatingModel> model_;
@@ -92,7 +125,16 @@ class KDL_SPACE_EXPORT ApproachController {
   std::shared_ptr<ApproachTarget> target_;
   FreeFloatingSolver solver_;
   KDL::Jacobian J_, J_base_;
-  bool grounded_ = false;
+  ApproachBase base_ = ApproachBase::Free;
+  /// The joints' rates that do the task: J+ b by damped least squares, with `clamped` joints at
+  /// their given rates (their columns out); N the null space of the free joints (n x n).
+  Eigen::VectorXd solveTask(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& fixed,
+                            const std::vector<bool>& clamped, double l2, Eigen::MatrixXd* N) const;
+  /// The joint limits (ApproachSpec::limit_zone, limit_gain) on the task's rates `qdot`: the
+  /// joints in their zones pushed away in the null space, then those whose rate would carry them
+  /// past their guard clamped there and the task re-solved by the others (their indices out).
+  void limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double l2,
+                   Eigen::VectorXd& qdot, std::vector<int>& clamped) const;
 };
 
 /// What an approach did.
@@ -109,9 +151,29 @@ struct ApproachRecord {
   double min_scale = 1.0;              ///< the smallest rate-limit factor
   double base_rotation = 0.0;          ///< the base's attitude change over the approach [rad]
   std::vector<double> kv;              ///< the servo gains used (model order)
+  ApproachBase base = ApproachBase::Free;  ///< the Jacobian the control used
+  /// Per joint (model order): how long [s] of the output samples it was clamped at its limit guard
+  std::vector<double> time_at_limit;
+  double time_rate_limited = 0.0;      ///< [s] of the samples with the command scaled below 0.99
+  double time_near_singular = 0.0;     ///< [s] of the samples with sigma_min below the threshold
+  double output_step = 0.0;            ///< the samples' spacing these times count
+  /// The pre-grasp move (ApproachSpec::pre_grasp): its duration [s] (0: none), the joints it went
+  /// to (model order: the inverse kinematics of the pre-grasp pose), and how far the hand was from
+  /// that pose when it ended [m] (the base turned under it)
+  double pre_grasp_duration = 0.0;
+  std::vector<double> pre_grasp_q;
+  double pre_grasp_miss = 0.0;
+  /// Not reached: why, in words (a joint held at its limit, rates saturated, a singularity, out of
+  /// reach, the pre-grasp pose out of reach, or too slow); empty when reached.
+  std::string cause;
 };
 
-/// \brief Runs the approach: the joints velocity-servoed to the controller's command (a torque
+/// \brief Runs the approach: with spec().pre_grasp, first the joint-space move (JointMove, each
+/// joint within pre_grasp.rate x its rate limit and pre_grasp.acceleration, its rates
+/// velocity-servoed to the profile's plus gain x its position error) to the inverse kinematics
+/// (within the joints' limits, preferring the start's posture, with the base where it is) of the
+/// pre-grasp pose: the grasp frame at the move's end, backed off `standoff` along its z (three
+/// passes: the move's duration sets where the target is); then the joints velocity-servoed to the controller's command (a torque
 /// callback on `sim`, with its effort limits), from s until the contact condition holds or
 /// spec().max_duration has passed. The contact instant is the first time the condition holds,
 /// located between the steps (Simulator::setStopEvent on the largest of the margins

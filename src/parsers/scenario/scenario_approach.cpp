@@ -13,7 +13,7 @@ using fields::Field;
 
 ApproachSpec approach(const Field& f, const FloatingModel& robot, const KDL::Vector* grasp_position) {
   f.onlyKeys({"grasp", "track", "gain", "damping", "singular_threshold", "rate_limits", "servo_bandwidth", "null_space",
-              "tolerance", "max_duration"});
+              "tolerance", "max_duration", "pre_grasp", "joint_limits"});
   ApproachSpec a;
   const auto positive = [](const Field& owner, const char* key, double& value) {
     if (!owner.has(key)) return;
@@ -55,6 +55,30 @@ ApproachSpec approach(const Field& f, const FloatingModel& robot, const KDL::Vec
       return v;
     };
     for (const auto& [j, v] : byJoint<double>(f.at("rate_limits"), robot, limit)) a.rate_limits[j] = v;
+  }
+  if (f.has("pre_grasp")) {  // {} for the defaults
+    const Field g = f.at("pre_grasp");
+    g.onlyKeys({"standoff", "rate", "acceleration"});
+    ApproachSpec::PreGrasp pre;
+    if (g.has("standoff")) {
+      pre.standoff = g.at("standoff").number();
+      if (!(pre.standoff >= 0.0)) g.at("standoff").fail("must be >= 0 [m], got " + number(pre.standoff));
+    }
+    positive(g, "rate", pre.rate);
+    if (pre.rate > 1.0) g.at("rate").fail("is the fraction of each joint's rate limit the move may use: at most 1, got " + number(pre.rate));
+    positive(g, "acceleration", pre.acceleration);
+    a.pre_grasp = pre;
+  }
+  if (f.has("joint_limits")) {
+    const Field l = f.at("joint_limits");
+    l.onlyKeys({"zone", "gain"});
+    if (l.has("zone")) {
+      a.limit_zone = l.at("zone").number();
+      if (!(a.limit_zone >= 0.0 && a.limit_zone < 0.5))
+        l.at("zone").fail("is the fraction of each joint's range near a limit where it is pushed away: [0, 0.5), got " +
+                          number(a.limit_zone));
+    }
+    positive(l, "gain", a.limit_gain);
   }
   if (f.has("tolerance")) {
     const Field t = f.at("tolerance");
