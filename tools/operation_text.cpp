@@ -16,6 +16,7 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
   if (r.approach) {
     printApproach(out, sc, *r.approach);
     printWarnings(out, r.approach->start_warnings);
+    printWarnings(out, r.approach->overlaps);
   }
   if (r.capture) {
     printCaptureSummary(out, sc, *r.capture);

@@ -260,3 +260,34 @@ def test_compliant_capture_in_the_operation_and_alone():
         kdl_space.solve_compliant_capture(touch, stiffness=[1e6, 1e6, 0, 1e4, 1e4, 1e4])
     with pytest.raises(ValueError, match="damping"):
         kdl_space.solve_compliant_capture(touch, damping=[1] * 6, damping_time=1e-3)
+
+
+def test_an_approach_from_stowed_with_a_pre_grasp_move(tmp_path):
+    """Issue 38: from a stowed arm, the pre-grasp joint-space move then the final approach reach
+    the grasp; every sample's joints inside the URDF's limits and rates within them (read here with
+    ElementTree and NumPy); the dict says which Jacobian and what the pre-grasp did. Without the
+    move, the failure names the joint held at its limit."""
+    import re
+    from urdf_numpy import urdf_limits
+    text = (SOURCE_DIR / "scenarios" / "approach_tumbling_box.yaml").read_text()
+    text = text.replace("../urdf/", str(SOURCE_DIR / "urdf") + "/")
+    text = re.sub(r"(?m)^  q: \{.*\}$", "  q: {joint2: -1.2, joint3: 0.0, joint4: 2.6, joint6: 1.0}", text)
+    with_move = tmp_path / "stowed.yaml"
+    with_move.write_text(text.replace("  max_duration: 30", "  max_duration: 120\n  pre_grasp: {standoff: 0.15}"))
+    run = kdl_space.run_operation(str(with_move), duration=0.2)
+    a = run["approach"]
+    assert a["reached"] and a["cause"] is None
+    assert a["jacobian"] == "generalized (J*)"
+    assert a["pre_grasp"]["standoff"] == 0.15 and a["pre_grasp"]["duration"] > 1.0
+    s = run["samples"]
+    approach = np.isin(np.asarray(s["phase"]), ["approach", "capture"])
+    q, qdot = np.asarray(s["q"])[approach], np.asarray(s["qdot"])[approach]
+    limits = urdf_limits(SOURCE_DIR / "urdf" / "space_arm7.urdf")
+    for k, name in enumerate(s["joint_names"]):
+        lower, upper, velocity = limits[name]
+        assert lower < q[:, k].min() and q[:, k].max() < upper, name
+        assert np.abs(qdot[:, k]).max() <= 1.01 * velocity, name
+    without = tmp_path / "stowed_without.yaml"
+    without.write_text(text)
+    with pytest.raises(kdl_space.InputError, match="joint joint3 held at its limit"):
+        kdl_space.run_operation(str(without), duration=0.2)

@@ -122,6 +122,33 @@ std::vector<Diagnostic> overlapWarnings(const CaptureProblem& problem, const std
   return overlapWarnings(problem, g, moment, allowance);
 }
 
+std::vector<Diagnostic> busOverlapWarnings(const FloatingModel& model, const State& state, const LinkGeometry& robot,
+                                           const std::string& moment, double allowance) {
+  Kinematics kin(model);
+  if (robot.boxes.empty() || forwardKinematics(model, state, kin) != E_NOERROR) return {};
+  std::vector<OrientedBox> bus;
+  for (const OrientedBox& b : robot.boxes[0]) bus.push_back(inWorld(kin.pose(0), b));
+  // The joints between each body and the base: the first two links of an arm are not checked.
+  std::vector<bool> skip(model.bodies().size(), true);
+  std::vector<int> joints(model.bodies().size(), 0);
+  for (std::size_t i = 1; i < model.bodies().size(); ++i) {
+    const Body& b = model.bodies()[i];
+    joints[i] = joints[static_cast<std::size_t>(b.parent)] + (b.joint >= 0 ? 1 : 0);
+    skip[i] = joints[i] <= 2;
+  }
+  std::vector<Diagnostic> out;
+  for (const BoxPenetration& p : penetrations(kin, robot.boxes, bus, skip, allowance)) {
+    const std::string& link = model.bodies()[static_cast<std::size_t>(p.body)].name;
+    Diagnostic d{link,
+                 "link '" + link + "' penetrates its own bus's box by " + detail::number(p.depth) + " m (more than " +
+                     detail::number(allowance) + " m)",
+                 "overlap", Severity::Warning};
+    d.details = {{"link", link}, {"target", std::string("bus")}, {"depth", p.depth}, {"moment", moment}};
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 std::vector<Diagnostic> overlapWarnings(const Scenario& scenario, const CaptureProblem& at, const std::string& moment) {
   if (!scenario.impact) return {};
   return overlapWarnings(at, linkGeometry(*at.robot.model, robotVisuals(scenario)), moment);

@@ -1,6 +1,7 @@
 #include "operation/phases.hpp"
 
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include "spatial/message_text.hpp"
@@ -30,6 +31,54 @@ std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
       << sc.approach->position_tolerance << " m); control with the " << toString(r.base) << " Jacobian";
   return why.str();
 }
+
+/// The overlaps an approach goes through, one per link and obstacle (ApproachOutcome::overlaps).
+class OverlapsSeen {
+ public:
+  OverlapsSeen(const Scenario& sc) : sc_(sc), geometry_(linkGeometry(*sc.capture.robot.model, robotVisuals(sc))) {}
+  /// The robot at `robot` and the target at `target` (a problem at the sample's instant), at t.
+  void look(const CaptureProblem& at, double t) {
+    std::vector<Diagnostic> found = overlapWarnings(at, geometry_, "approach");
+    for (Diagnostic& d : busOverlapWarnings(*at.robot.model, at.robot.state, geometry_, "approach")) found.push_back(std::move(d));
+    for (const Diagnostic& d : found) {
+      std::string link, target;
+      double depth = 0.0;
+      for (const auto& [key, value] : d.details) {
+        if (key == "link") link = std::get<std::string>(value);
+        if (key == "target") target = std::get<std::string>(value);
+        if (key == "depth") depth = std::get<double>(value);
+      }
+      Seen& seen = seen_[link + "\n" + target];
+      if (seen.link.empty()) seen = Seen{link, target, t, depth, t};
+      if (depth > seen.deepest) seen.deepest = depth, seen.at = t;
+    }
+  }
+  std::vector<Diagnostic> warnings() const {
+    std::vector<Diagnostic> out;
+    for (const auto& [key, s] : seen_) {
+      Diagnostic d{s.link,
+                   "during the approach: link '" + s.link + "' went inside " +
+                       (s.target == "bus" ? std::string("its own bus's box") : "the " + s.target + "'s box of inertia") +
+                       " from t = " + detail::number(s.from) + " s, " + detail::number(s.deepest) + " m deep at t = " +
+                       detail::number(s.at) + " s: another start, a pre-grasp pose (approach.pre_grasp) or a "
+                       "longer standoff keeps the arm clear",
+                   "overlap", Severity::Warning};
+      d.details = {{"link", s.link}, {"target", s.target}, {"depth", s.deepest}, {"moment", std::string("approach")},
+                   {"from", s.from}, {"deepest_at", s.at}};
+      out.push_back(std::move(d));
+    }
+    return out;
+  }
+
+ private:
+  struct Seen {
+    std::string link, target;
+    double from = 0.0, deepest = 0.0, at = 0.0;
+  };
+  const Scenario& sc_;
+  LinkGeometry geometry_;
+  std::map<std::string, Seen> seen_;
+};
 
 }  // namespace
 
@@ -93,13 +142,24 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
   if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
   std::vector<MotionSample>& samples = result.approach_samples;
   int observer_rc = E_NOERROR;
+  OverlapsSeen overlaps(sc);
+  CaptureProblem at = sc.capture;
   const auto observer = [&](const SimulationState& x, const ApproachCommand& cmd) {
+    at.robot.state = x.state;  // the arm and the target at the sample, against each other and the bus
+    if (auto* rigid = std::get_if<RigidTarget>(&at.target)) {
+      if (controller->target(x.t, *rigid) == E_NOERROR) overlaps.look(at, x.t);
+    } else if (SimulationState target; floating_target && floating_target->state(x.t, target) == E_NOERROR) {
+      std::get<FloatingSystem>(at.target).state = target.state;
+      overlaps.look(at, x.t);
+    }
     MotionSample smp;
     if (const int rc = sampleOf(*sim, x, Phase::Approach, smp)) observer_rc = rc;
     smp.grasp_distance = cmd.error.head<3>().norm();
     samples.push_back(std::move(smp));
   };
   const int rc = runApproach(*sim, *controller, s, output_step, observer, outcome.record);
+  outcome.overlaps = overlaps.warnings();
+  result.approach = outcome;  // what it did so far, also when it failed
   if (rc || observer_rc) {
     std::ostringstream why;
     if (rc == E_CANCELLED)

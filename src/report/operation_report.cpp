@@ -169,6 +169,7 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
   // The pose an approach started from first, then the configuration at the capture, then what the
   // motion found (a sampled controller's gains, a stiff servo).
   std::vector<Diagnostic> warnings = r.approach ? r.approach->start_warnings : std::vector<Diagnostic>{};
+  if (r.approach) warnings.insert(warnings.end(), r.approach->overlaps.begin(), r.approach->overlaps.end());
   if (r.capture)
     for (Diagnostic& d : captureWarnings(sc, r.at_contact)) warnings.push_back(std::move(d));
   warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());

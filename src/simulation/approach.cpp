@@ -145,7 +145,10 @@ void ApproachController::limitJoints(const KDL::JntArray& q, const Eigen::Matrix
     for (unsigned int j = 0; j < n; ++j) {
       if (clamped[j] || !limited(j)) continue;
       const JointProperties& p = model_->jointProperties()[j];
-      const double up = spec_.limit_gain * (p.upper - q(j)), down = -spec_.limit_gain * (q(j) - p.lower);
+      // The guard stands the servo's lag at the full rate (rate / bandwidth) twice inside the limit:
+      // the joint follows its command that far behind, so it stops at the limit, not past it.
+      const double lag = std::min(2.0 * spec_.rate_limits[j] / spec_.servo_bandwidth, 0.25 * (p.upper - p.lower));
+      const double up = spec_.limit_gain * (p.upper - lag - q(j)), down = -spec_.limit_gain * (q(j) - p.lower - lag);
       if (qdot(j) > up || qdot(j) < down) {
         fixed(j) = qdot(j) > up ? up : down;
         clamped[j] = more = true;
@@ -226,7 +229,7 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
   double scale = 1.0;
   for (unsigned int j = 0; j < n; ++j)
     if (std::abs(qdot(j)) * scale > spec_.rate_limits[j]) scale = spec_.rate_limits[j] / std::abs(qdot(j));
-  qdot *= scale;
+  qdot *= scale * (fade_ > 0.0 ? std::clamp((s.t - fade_t0_) / fade_, 0.0, 1.0) : 1.0);
   if (!qdot.allFinite()) return E_NOT_FINITE;
   if (out.qdot.rows() != n) out.qdot = KDL::JntArray(n);
   out.qdot.data = qdot;
@@ -331,6 +334,7 @@ int runApproach(Simulator& sim, ApproachController& controller, SimulationState&
   if (spec.pre_grasp) rc = guarded(sim, [&] { return approach_phases::preGrasp(sim, controller, s, output_dt, rec, watch); });
   if (rc == E_NOERROR && rec.cause.empty()) {
     in_control = true;
+    if (spec.pre_grasp) controller.setFadeIn(s.t, 2.0);  // from rest at the pre-grasp pose
     sim.setTorqueCallback([&](const SimulationState& x, KDL::JntArray& tau) {
       if (const int crc = controller.command(x, stage)) throw CommandFailed{crc};
       for (unsigned int j = 0; j < n; ++j) tau(j) += rec.kv[j] * (stage.qdot(j) - x.velocity.qdot(j));

@@ -56,7 +56,7 @@ void JointMove::at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qdot) const {
       v = sddot_ * r;
     }
   }
-  q = q0_ + s * (q1_ - q0_);
+  q = t >= T_ ? q1_ : Eigen::VectorXd(q0_ + s * (q1_ - q0_));  // the end exactly at the end
   qdot = v * (q1_ - q0_);
 }
 

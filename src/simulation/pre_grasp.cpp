@@ -57,14 +57,13 @@ bool preGraspMove(const FloatingModel& model, const Contact& hand, ApproachContr
   std::vector<double> rates(n), accelerations(n, spec.pre_grasp->acceleration);
   for (unsigned int j = 0; j < n; ++j) rates[j] = spec.pre_grasp->rate * spec.rate_limits[j];
   IkOptions o;
-  o.preferred = s.state.q;  // the posture it starts from, among a redundant arm's solutions
+  o.preferred = s.state.q;  // among a redundant arm's solutions, the one nearest the start's posture
   double T = 0.0;
   State at_end = s.state;  // the base where the move will leave it (a free base turns under the arm)
-  for (int pass = 0; pass < 3; ++pass) {
-    if (pass > 0 && controller.base() == ApproachBase::Free && !predictBase(model, s, move, at_end.world_T_base)) {
-      why = "the base's motion under the pre-grasp move cannot be predicted";
-      return false;
-    }
+  // Fixed-point passes: the grasp where the target will be when the move ends, the joints with
+  // the base where the move will leave it; until the move stops changing (1 mm, 1 mrad, 1 ms).
+  const bool free = controller.base() == ApproachBase::Free;
+  for (int pass = 0; pass < 12; ++pass) {
     KDL::Frame G;
     Vector6d twist;
     if (const int rc = controller.grasp(s.t + T, G, twist)) {
@@ -76,11 +75,22 @@ bool preGraspMove(const FloatingModel& model, const Contact& hand, ApproachContr
       const IkResult r = solveInverseKinematics(model, at_end, hand, pre, o);
       move = JointMove(s.state.q.data, r.q.data, rates, accelerations);
     } catch (const InputError& e) {
+      if (pass > 0) break;  // a later pass that went out of reach: the last move that was in reach
       why = std::string("the pre-grasp pose (") + detail::number(spec.pre_grasp->standoff) +
             " m back from the grasp) is out of reach within the joints' limits: " + e.what();
       return false;
     }
+    KDL::Frame base = at_end.world_T_base;
+    if (free && !predictBase(model, s, move, base)) {
+      why = "the base's motion under the pre-grasp move cannot be predicted";
+      return false;
+    }
+    const bool settled = (base.p - at_end.world_T_base.p).Norm() < 1e-3 &&
+                         (base.M * at_end.world_T_base.M.Inverse()).GetRot().Norm() < 1e-3 &&
+                         std::abs(move.duration() - T) < 1e-3;
+    at_end.world_T_base = base;
     T = move.duration();
+    if (settled) break;
   }
   return true;
 }

@@ -391,6 +391,40 @@ TEST_P(Families, PlanOverTheOperationMeasuresTheMotionOrSaysWhyNot) {
   }
 }
 
+// approach from where the robot is, with a pre-grasp move: it reaches, or it stops and says why
+// (the target is 2.5 m away: out of most families' reach), and no joint leaves its limits.
+TEST_P(Families, AnApproachWithAPreGraspReachesOrSaysWhyInsideTheLimits) {
+  const ModelFamily& f = GetParam();
+  Scenario sc;
+  try {
+    sc = loadScenario(writeScenario(f, "{type: capture}",
+                                    "approach: {grasp: {position: [-0.4, 0, 0]}, pre_grasp: {standoff: 0.1}, "
+                                    "max_duration: 3}\n"));
+  } catch (const InputError& e) {  // a robot without joints has no approach to run
+    EXPECT_EQ(f.joints, 0u) << f.name << ": " << e.what();
+    return;
+  }
+  OperationOptions o;
+  o.motion = false;
+  std::shared_ptr<const OperationResult> r;
+  try {
+    r = std::make_shared<const OperationResult>(runCaptureOperation(sc, o));
+  } catch (const OperationError& e) {
+    ASSERT_TRUE(e.partial() && e.partial()->approach) << f.name << ": " << e.what();
+    r = e.partial();
+    EXPECT_FALSE(r->approach->record.cause.empty()) << f.name << ": " << e.what();
+  } catch (const InputError& e) {
+    EXPECT_FALSE(std::string(e.what()).empty());
+    return;
+  }
+  const FloatingModel& model = *sc.capture.robot.model;
+  for (const MotionSample& x : r->approach_samples)
+    for (unsigned int j = 0; j < model.nj(); ++j) {
+      EXPECT_LE(x.q(j), model.jointProperties()[j].upper + 1e-9) << f.name << " " << model.jointNames()[j];
+      EXPECT_GE(x.q(j), model.jointProperties()[j].lower - 1e-9) << f.name << " " << model.jointNames()[j];
+    }
+}
+
 /// Six samples of a study of the family's capture scenario with these `inputs` (YAML lines): each computes.
 void expectEverySampleComputes(const ModelFamily& f, const std::string& name, const std::string& inputs) {
   const std::string scenario = writeScenario(f, "{type: capture}");

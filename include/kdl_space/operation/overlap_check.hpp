@@ -55,6 +55,14 @@ KDL_SPACE_EXPORT std::vector<Diagnostic> overlapWarnings(const CaptureProblem& p
                                                          const std::string& moment,
                                                          double allowance = kOverlapAllowance);
 
+/// \brief The robot's links inside its own bus at `state`: each body more than two joints from the
+/// base (the arm's first links sit on the bus by design) whose boxes (`robot`) penetrate the base
+/// body's deeper than `allowance` [m], deepest first: kind `overlap`, element the link, details
+/// {link, target: "bus", depth [m], moment}. None where the kinematics cannot be computed.
+KDL_SPACE_EXPORT std::vector<Diagnostic> busOverlapWarnings(const FloatingModel& model, const State& state,
+                                                            const LinkGeometry& robot, const std::string& moment,
+                                                            double allowance = kOverlapAllowance);
+
 /// \brief A scenario's overlap warnings at `at` (its own capture problem, or the one at the contact
 /// instant of its approach), its robot's visuals from its URDF; none for a plain motion.
 KDL_SPACE_EXPORT std::vector<Diagnostic> overlapWarnings(const Scenario& scenario, const CaptureProblem& at,

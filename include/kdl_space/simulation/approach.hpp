@@ -44,8 +44,9 @@ struct ApproachSpec {
   double max_duration = 60.0;  ///< [s]: no contact by then: the approach failed
   /// Joint limits (positions): a joint within `limit_zone` x its range of a limit is pushed away in
   /// the null space (the gradient of sum ((q - mid) / half range)^2, Liegeois), and its rate toward
-  /// the limit is never more than limit_gain x its distance from it (the joint clamped there and
-  /// the task re-solved by the others): it never crosses. Joints without limits are free.
+  /// the limit is never more than limit_gain x its distance from a guard twice the servo's lag at
+  /// full rate (2 rate_limit / servo_bandwidth) inside it (the joint clamped there and the task
+  /// re-solved by the others): it stops at the limit, not past it. Joints without limits are free.
   double limit_zone = 0.1;
   double limit_gain = 2.0;  ///< [1/s]
   /// The joint-space move to a pre-grasp pose first (unset: none): see JointMove (joint_move.hpp).
@@ -117,6 +118,9 @@ class KDL_SPACE_EXPORT ApproachController {
   /// What holds the base (runApproach sets it from the simulator: grounded, or its base control).
   void setBase(ApproachBase base) { base_ = base; }
   ApproachBase base() const { return base_; }
+  /// The command fades in over `duration` [s] from `t0` (after a pre-grasp move: the servos take
+  /// the switch from rest smoothly); duration 0: at once.
+  void setFadeIn(double t0, double duration) { fade_t0_ = t0, fade_ = duration; }
 
  private:
   std::shared_ptr<const FloatingModel> model_;
@@ -126,6 +130,7 @@ class KDL_SPACE_EXPORT ApproachController {
   FreeFloatingSolver solver_;
   KDL::Jacobian J_, J_base_;
   ApproachBase base_ = ApproachBase::Free;
+  double fade_t0_ = 0.0, fade_ = 0.0;
   /// The joints' rates that do the task: J+ b by damped least squares, with `clamped` joints at
   /// their given rates (their columns out); N the null space of the free joints (n x n).
   Eigen::VectorXd solveTask(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& fixed,
