@@ -35,7 +35,16 @@ std::string approachFailure(const Scenario& sc, const ApproachRecord& r) {
 /// The overlaps an approach goes through, one per link and obstacle (ApproachOutcome::overlaps).
 class OverlapsSeen {
  public:
-  OverlapsSeen(const Scenario& sc) : sc_(sc), geometry_(linkGeometry(*sc.capture.robot.model, robotVisuals(sc))) {}
+  explicit OverlapsSeen(const Scenario& sc) : geometry_(linkGeometry(*sc.capture.robot.model, robotVisuals(sc))) {
+    // The link that carries the hand closes on the target by design: its depth at the capture is
+    // the capture's check (overlapWarnings' allowance there), not the approach's.
+    const FloatingModel& model = *sc.capture.robot.model;
+    const std::vector<bool> hand = contactBodies(model, sc.capture.robot.contact.body);
+    for (std::size_t i = 0; i < hand.size(); ++i) {
+      const int parent = model.bodies()[i].parent;
+      if (hand[i] && parent >= 0 && !hand[static_cast<std::size_t>(parent)]) wrist_ = model.bodies()[static_cast<std::size_t>(parent)].name;
+    }
+  }
   /// The robot at `robot` and the target at `target` (a problem at the sample's instant), at t.
   void look(const CaptureProblem& at, double t) {
     std::vector<Diagnostic> found = overlapWarnings(at, geometry_, "approach");
@@ -48,6 +57,7 @@ class OverlapsSeen {
         if (key == "target") target = std::get<std::string>(value);
         if (key == "depth") depth = std::get<double>(value);
       }
+      if (link == wrist_ && target != "bus") continue;
       Seen& seen = seen_[link + "\n" + target];
       if (seen.link.empty()) seen = Seen{link, target, t, depth, t};
       if (depth > seen.deepest) seen.deepest = depth, seen.at = t;
@@ -75,8 +85,8 @@ class OverlapsSeen {
     std::string link, target;
     double from = 0.0, deepest = 0.0, at = 0.0;
   };
-  const Scenario& sc_;
   LinkGeometry geometry_;
+  std::string wrist_;
   std::map<std::string, Seen> seen_;
 };
 

@@ -69,7 +69,8 @@ struct ApproachOutcome {
   /// The warnings about the pose it started from (approachStartWarnings), found before it ran.
   std::vector<Diagnostic> start_warnings = {};
   /// What the arm went through on its way, at the output samples (kind `overlap`): a link inside
-  /// the target's boxes (overlapWarnings' rules: the hand's bodies are not checked) or inside its
+  /// the target's boxes (overlapWarnings' rules; the hand's bodies and the link that carries them,
+  /// which closes on the target by design, are not checked: the capture's check is theirs) or inside its
   /// own bus (busOverlapWarnings), one warning per link and obstacle: from when, how deep at most
   /// and when (details {link, target, depth, moment: "approach", from, deepest_at}).
   std::vector<Diagnostic> overlaps = {};
