@@ -17,6 +17,7 @@
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/operation/overlap_check.hpp"
 #include "kdl_space/simulation/joint_move.hpp"
+#include "arm_variants.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {
@@ -50,20 +51,6 @@ std::string stowed(std::string text, const std::string& approach_lines) {
 }
 
 std::string asIs(std::string urdf) { return urdf; }
-
-/// The arm's links four times as heavy on an 80 kg bus (the bundled one is 400 kg).
-std::string heavyArm(const std::string& urdf) {
-  const std::regex mass("<mass value=\"([0-9.]+)\"/>");
-  std::string out;
-  std::size_t last = 0;
-  for (auto it = std::sregex_iterator(urdf.begin(), urdf.end(), mass); it != std::sregex_iterator(); ++it) {
-    const double m = std::stod((*it)[1]);
-    out += urdf.substr(last, static_cast<std::size_t>(it->position()) - last);
-    out += "<mass value=\"" + std::to_string(m == 400.0 ? 80.0 : 4.0 * m) + "\"/>";
-    last = static_cast<std::size_t>(it->position() + it->length());
-  }
-  return out + urdf.substr(last);
-}
 
 // --- The pre-grasp move's profile ---------------------------------------------------------------
 
@@ -171,7 +158,7 @@ TEST(ApproachFromStowed, AHeavyArmOnALightBusStaysInsideItsLimitsAndSaysWhyItSto
   const Scenario sc = loadScenario(variant("heavy", [](std::string t) {
     return stowed(t, "\n  pre_grasp: {standoff: 0.15}\n  singular_threshold: 0.01") +
            "  base_control:\n    phases: [approach]\n    attitude: {kp: 2000, kd: 4000, set_point: hold}\n";
-  }, heavyArm));
+  }, heavyArmOnLightBus));
   OperationOptions o;
   o.duration = 0.5;
   std::shared_ptr<const OperationResult> r;

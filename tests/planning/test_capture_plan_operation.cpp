@@ -20,6 +20,7 @@
 #include "kdl_space/operation/motion_measures.hpp"
 #include "kdl_space/planning/capture_plan.hpp"
 #include "kdl_space/study/study.hpp"
+#include "arm_variants.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space::test {
@@ -44,21 +45,9 @@ std::string defaultOn(const std::string& tag, Edit edit, const std::string& law 
   return dir + "/capture.yaml";
 }
 
-/// A heavy arm on a light bus: the bundled arm's links four times as heavy (their inertias as
-/// they are: still physical), its 400 kg bus 80 kg.
+/// A heavy arm on a light bus (arm_variants.hpp).
 std::string heavyArmOnLightBus() {
-  return defaultOn("heavy_arm", [](const std::string& urdf) {
-    const std::regex mass("<mass value=\"([0-9.]+)\"/>");
-    std::string out;
-    std::size_t last = 0;
-    for (auto it = std::sregex_iterator(urdf.begin(), urdf.end(), mass); it != std::sregex_iterator(); ++it) {
-      const double m = std::stod((*it)[1]);
-      out += urdf.substr(last, static_cast<std::size_t>(it->position()) - last);
-      out += "<mass value=\"" + std::to_string(m == 400.0 ? 80.0 : 4.0 * m) + "\"/>";
-      last = static_cast<std::size_t>(it->position() + it->length());
-    }
-    return out + urdf.substr(last);
-  });
+  return defaultOn("heavy_arm", [](const std::string& urdf) { return test::heavyArmOnLightBus(urdf); });
 }
 
 /// The peak |w| of the base over the motion after a capture at joints `q`, from the samples of the
