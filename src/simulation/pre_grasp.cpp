@@ -17,9 +17,10 @@ namespace {
 /// Where a free base is when `move` ends: its momentum (at s, conserved: nothing acts on it)
 /// and the move's joint rates give its twist (FreeFloatingSolver::baseTwist, eq. 4), integrated
 /// by the midpoint rule at 0.02 s steps at most. False where the dynamics cannot be computed.
-bool predictBase(const FloatingModel& model, const SimulationState& s, const JointMove& move, KDL::Frame& base) {
-  FreeFloatingSolver solver(std::shared_ptr<const FloatingModel>(&model, [](const FloatingModel*) {}),
-                            FreeFloatingSolver::Extent::Jacobians);
+bool predictBase(const std::shared_ptr<const FloatingModel>& robot, const SimulationState& s, const JointMove& move,
+                 KDL::Frame& base) {
+  const FloatingModel& model = *robot;
+  FreeFloatingSolver solver(robot, FreeFloatingSolver::Extent::Jacobians);
   Vector6d PL_g;
   if (solver.compute(s.state) || solver.momentum(s.velocity.base_twist, s.velocity.qdot, PL_g)) return false;
   const int steps = std::max(1, static_cast<int>(std::ceil(move.duration() / 0.02)));
@@ -81,7 +82,7 @@ bool preGraspMove(const FloatingModel& model, const Contact& hand, ApproachContr
       return false;
     }
     KDL::Frame base = at_end.world_T_base;
-    if (free && !predictBase(model, s, move, base)) {
+    if (free && !predictBase(controller.model(), s, move, base)) {
       why = "the base's motion under the pre-grasp move cannot be predicted";
       return false;
     }

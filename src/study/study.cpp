@@ -10,6 +10,7 @@
 #include "spatial/message_text.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
+#include "kdl_space/operation/motion_measures.hpp"
 #include "kdl_space/simulation/rigid_motion.hpp"
 #include "study/study_sampling.hpp"
 #include "kdl_space/algorithm/self_motion.hpp"
@@ -79,21 +80,20 @@ KDL::Frame handFrame(const Kinematics& kin, const Contact& h) {
 int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureResult& r, std::vector<double>& peak,
                 double& peak_base_rate, double& rate_ratio) {
   const FloatingModel& robot = *problem.robot.model;
-  std::vector<unsigned int> in_model;  // the robot's joints in the system after the capture
+  MotionMeasurer measurer(robot);  // the peaks, as `plan` reads them
+  std::vector<int> in_model;       // the robot's joints in the system after the capture
   OperationOptions o;
   o.duration = st.motion_duration;
   o.output_step = st.motion_output_step;
   o.hold_servos = true;
   o.keep_samples = false;
   o.observer = [&](const OperationResult& so_far, const MotionSample& x) {
+    measurer.add(so_far, x);
+    if (!st.limits.joint_rate) return;
     if (in_model.size() != robot.nj())
-      for (unsigned int j = 0; j < robot.nj(); ++j)
-        in_model.push_back(static_cast<unsigned int>(so_far.model->jointIndex(robot.jointNames()[j])));
-    for (unsigned int j = 0; j < robot.nj(); ++j) {
-      peak[j] = std::max(peak[j], std::abs(x.tau(in_model[j])));
-      if (st.limits.joint_rate) rate_ratio = std::max(rate_ratio, std::abs(x.qd(in_model[j])) / (*st.limits.joint_rate)[j]);
-    }
-    peak_base_rate = std::max(peak_base_rate, x.twist.tail<3>().norm());
+      for (unsigned int j = 0; j < robot.nj(); ++j) in_model.push_back(so_far.model->jointIndex(robot.jointNames()[j]));
+    for (unsigned int j = 0; j < robot.nj(); ++j)
+      rate_ratio = std::max(rate_ratio, std::abs(x.qd(in_model[j])) / (*st.limits.joint_rate)[j]);
   };
   OperationResult motion;
   try {
@@ -102,6 +102,9 @@ int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureRes
     if (e.code() == E_NOERROR) throw;   // (evaluate reports it as the sample's failure, in its words)
     return e.code();
   }
+  const MotionMeasures& m = measurer.peaks();
+  for (unsigned int j = 0; j < robot.nj(); ++j) peak[j] = std::max(peak[j], m.peak_torque[j]);
+  peak_base_rate = std::max(peak_base_rate, m.peak_base_rate);
   return E_NOERROR;
 }
 

@@ -57,6 +57,8 @@ class KDL_SPACE_EXPORT MotionMeasurer {
   int finish(const OperationResult& done, MotionMeasures& out);
   /// Forget the samples seen, for the next run.
   void reset();
+  /// The peaks of the samples seen so far (the settling time and the momentum rate come with finish()).
+  const MotionMeasures& peaks() const { return m_; }
 
  private:
   const FloatingModel& robot_;

@@ -104,6 +104,7 @@ class KDL_SPACE_EXPORT ApproachController {
                      std::shared_ptr<ApproachTarget> target);
   const ApproachSpec& spec() const { return spec_; }
   const Contact& hand() const { return hand_; }
+  const std::shared_ptr<const FloatingModel>& model() const { return model_; }
   /// The grasp frame and the twist (v of the grasp point; w) at time t.
   int grasp(double t, KDL::Frame& frame, Vector6d& twist);
   /// The commanded joint rates at s (and what they came from).
