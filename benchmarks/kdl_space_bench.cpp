@@ -9,6 +9,7 @@
 //
 //   kdl_space_bench [--model FILE.urdf --tip LINK [--offset X Y Z]] [--sizes 7,14,...]
 //                   [--simulate 7,100] [--mimic-sizes 10,30,50,100] [--markdown FILE]
+//   kdl_space_bench --plan SCENARIO.yaml   (planCapture alone: plan_bench.hpp)
 //                   [Google Benchmark flags, e.g. --benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
@@ -27,6 +28,7 @@
 #include "crb_forward_dynamics.hpp"
 #include "generated_chain.hpp"
 #include "mimic_bench.hpp"
+#include "plan_bench.hpp"
 #include "kdl_space/impact/collision.hpp"
 #include "kdl_space/algorithm/forward_dynamics.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -625,7 +627,7 @@ std::string fmt(double ns) {
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  std::string model, tip, markdown;
+  std::string model, tip, markdown, plan;
   KDL::Vector offset = KDL::Vector::Zero();
   std::vector<int> sizes{7, 14, 28, 50, 100}, simulate{7, 100};
   std::vector<int> mimic_sizes{10, 20, 30, 50, 100};  // the mimic section (mimic_bench.hpp); "" for none
@@ -646,6 +648,7 @@ int main(int argc, char** argv) {
     if (a == "--model") need(1), model = argv[++i];
     else if (a == "--tip") need(1), tip = argv[++i];
     else if (a == "--markdown") need(1), markdown = argv[++i];
+    else if (a == "--plan") need(1), plan = argv[++i];
     else if (a == "--offset") {
       need(3);
       offset = KDL::Vector(std::stod(argv[i + 1]), std::stod(argv[i + 2]), std::stod(argv[i + 3]));
@@ -663,6 +666,16 @@ int main(int argc, char** argv) {
       std::cerr << "kdl_space_bench: unknown argument " << a << "\n";
       return 2;
     }
+  }
+  if (!plan.empty()) {  // the plan alone (plan_bench.hpp)
+    try {
+      bench::registerPlan(plan);
+    } catch (const Error& e) {
+      std::cerr << "kdl_space_bench: " << e.what() << "\n";
+      return 3;
+    }
+    benchmark::RunSpecifiedBenchmarks();
+    return 0;
   }
   try {
     if (!model.empty()) {

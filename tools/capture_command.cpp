@@ -16,6 +16,7 @@
 #include "kdl_space/operation/overlap_check.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
 #include "kdl_space/report/capture_report.hpp"
+#include "kdl_space/report/inspection_json.hpp"
 #include "kdl_space/report/scene_writer.hpp"
 
 namespace kdl_space::cli {

@@ -6,6 +6,8 @@
 #include <kdl/chainiksolvervel_pinv.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -33,24 +35,25 @@ constexpr double kPi = 3.14159265358979323846;
 /// coarse for a 1e-9 tolerance.
 double length(const KDL::Vector& v) { return std::sqrt(KDL::dot(v, v)); }
 
-/// The rotation vector (axis times angle) of R, accurate at small angles: KDL's
-/// Rotation::GetRot (and so KDL::diff, which its position solvers' convergence test uses) reads
-/// every angle below about 1e-6 rad as 0, too coarse for a 1e-9 rad tolerance.
-KDL::Vector rotationVector(const KDL::Rotation& R) {
-  const KDL::Vector v(0.5 * (R(2, 1) - R(1, 2)), 0.5 * (R(0, 2) - R(2, 0)), 0.5 * (R(1, 0) - R(0, 1)));  // sin(a) axis
-  const double c = 0.5 * (R(0, 0) + R(1, 1) + R(2, 2) - 1.0);                                        // cos(a)
-  if (c < 0.0) return R.GetRot();  // beyond 90 degrees KDL's own is accurate (and handles 180)
-  const double s = length(v);
-  if (s == 0.0) return KDL::Vector::Zero();
-  return v * (std::atan2(s, c) / s);
-}
-
 /// The error twist that takes `current` to `goal` (base frame, reference point at the tip).
 KDL::Twist poseError(const KDL::Frame& current, const KDL::Frame& goal) {
   return KDL::Twist(goal.p - current.p, rotationVector(goal.M * current.M.Inverse()));
 }
 
 double clampTo(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
+
+/// The squares of J's singular values, J^T = Q R (n x 6, n >= 6): R^T R's eigenvalues, ascending.
+Eigen::Matrix<double, 6, 1> singularSquares(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
+  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(R.transpose() * R, Eigen::EigenvaluesOnly).eigenvalues();
+}
+double smallestSingular(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
+  return std::sqrt(std::max(0.0, singularSquares(qr)(0)));
+}
+double smallestSingularRatio(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
+  const Eigen::Matrix<double, 6, 1> s2 = singularSquares(qr);
+  return s2(5) > 0.0 ? std::sqrt(std::max(0.0, s2(0) / s2(5))) : 0.0;
+}
 
 /// The solvers on one chain (each keeps a reference to it: it outlives them).
 class IkSearch {
@@ -122,9 +125,15 @@ class IkSearch {
     return length(e.vel) + length(e.rot);
   }
 
-  /// An orthonormal basis of the self-motion at q (the null space of the chain's Jacobian).
+  /// An orthonormal basis of the self-motion at q (the null space of the chain's Jacobian): the
+  /// last n - 6 columns of Q in J^T = Q R when J has full rank 6, else by J's SVD.
   Eigen::MatrixXd nullBasis(const KDL::JntArray& q) {
     const Eigen::MatrixXd J = jacobian(q);
+    if (J.cols() > 6) {
+      const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J.transpose());
+      if (smallestSingularRatio(qr) > 1e-9)
+        return (qr.householderQ() * Eigen::MatrixXd::Identity(J.cols(), J.cols())).rightCols(J.cols() - 6);
+    }
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
     return svd.matrixV().rightCols(J.cols() - svd.rank());
   }
@@ -138,12 +147,23 @@ class IkSearch {
 
   /// The least-norm coordinate step for the error twist `e`: KDL's ChainIkSolverVel_pinv on an
   /// uncoupled chain; on a coupled one the same pseudo-inverse (singular values below 1e-9
-  /// dropped, as KDL's) of J T.
+  /// dropped, as KDL's) of J T. Away from a singularity (every singular value above 1e-8, KDL's
+  /// cut 1e-9 below) the same least-norm step by J^T = Q R, dq = Q_1 R^-T e (to round-off).
   int velocity(const KDL::JntArray& q, const KDL::Twist& e, KDL::JntArray& dq) {
-    if (!c_.coupled) return vel_.CartToJnt(q, e, dq);
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian(q), Eigen::ComputeThinU | Eigen::ComputeThinV);
     Eigen::Matrix<double, 6, 1> t;
     t << e.vel.x(), e.vel.y(), e.vel.z(), e.rot.x(), e.rot.y(), e.rot.z();
+    const Eigen::MatrixXd J = jacobian(q);
+    if (J.cols() >= 6) {
+      const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J.transpose());
+      if (smallestSingular(qr) > 1e-8) {
+        Eigen::VectorXd y = Eigen::VectorXd::Zero(J.cols());
+        y.head<6>() = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>().transpose().solve(t);
+        dq.data = qr.householderQ() * y;
+        return dq.data.allFinite() ? 0 : -1;
+      }
+    }
+    if (!c_.coupled) return vel_.CartToJnt(q, e, dq);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
     Eigen::VectorXd ut = svd.matrixU().transpose() * t;
     for (Eigen::Index i = 0; i < ut.size(); ++i) ut(i) = svd.singularValues()(i) < 1e-9 ? 0.0 : ut(i) / svd.singularValues()(i);
     dq.data = svd.matrixV() * ut;

@@ -1,11 +1,40 @@
 #include "kdl_space/algorithm/self_motion.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/QR>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {
+namespace {
+
+/// J's smallest singular value is more than 1e-6 of its largest. J J^T = R^T R (J^T = Q R): its
+/// eigenvalues are their squares (to round-off of the largest: 1e-4 of the threshold's square).
+bool fullRank(const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>>& qr) {
+  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(R.transpose() * R, Eigen::EigenvaluesOnly);
+  return eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(5);
+}
+
+/// Bit for bit (KDL's operator== on a Rotation compares within an epsilon).
+bool samePose(const KDL::Frame& a, const KDL::Frame& b) {
+  for (int i = 0; i < 3; ++i)
+    if (a.p.data[i] != b.p.data[i]) return false;
+  for (int i = 0; i < 9; ++i)
+    if (a.M.data[i] != b.M.data[i]) return false;
+  return true;
+}
+
+/// The twist that takes the hand from F back to F0 (v; w), world frame, at the hand; the rotation
+/// by rotationVector (KDL::diff reads a rotation below ~1e-6 rad as none: a short step's drift).
+Vector6d handError(const KDL::Frame& F, const KDL::Frame& F0) {
+  Vector6d err;
+  err << toEigen(F0.p - F.p), toEigen(rotationVector(F0.M * F.M.Inverse()));
+  return err;
+}
+
+}  // namespace
 
 SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact& h, const State& nominal)
     : solver_(model, FreeFloatingSolver::Extent::Jacobians), h_(h), J_(model->nj()) {
@@ -13,15 +42,19 @@ SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact
     throw InputError("robot.self_motion: the arm's Jacobian cannot be computed at the scenario's state");
   for (unsigned int j = 0; j < model->nj(); ++j)
     if (J_.data.col(j).norm() > 0.0) path_.push_back(static_cast<int>(j));
-  J_path_.resize(6, static_cast<Eigen::Index>(path_.size()));
   const std::string arm = std::to_string(path_.size()) + " joints on the path to the contact link";
   if (path_.size() != 7)
     throw InputError("robot.self_motion: the arm has " + arm + "; a self-motion holding the hand's pose is a "
                      "one-parameter family only for 7 (one redundant joint)");
-  for (std::size_t k = 0; k < path_.size(); ++k) J_path_.col(static_cast<Eigen::Index>(k)) = J_.data.col(path_[k]);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J_path_);
-  if (!(svd.singularValues()(5) > 1e-6 * svd.singularValues()(0)))
+  if (pathJacobian(nominal) != E_NOERROR || !fullRank(Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>>(J_path_.transpose())))
     throw InputError("robot.self_motion: the arm is singular at the scenario's state (the hand's Jacobian has rank < 6)");
+}
+
+int SelfMotion::pathJacobian(const State& state) {
+  if (const int rc = solver_.compute(state)) return rc;
+  if (const int rc = solver_.J(h_, J_)) return rc;
+  for (Eigen::Index k = 0; k < 7; ++k) J_path_.col(k) = J_.data.col(path_[static_cast<std::size_t>(k)]);
+  return E_NOERROR;
 }
 
 int SelfMotion::handFrame(const State& state, KDL::Frame& F) {
@@ -31,18 +64,17 @@ int SelfMotion::handFrame(const State& state, KDL::Frame& F) {
   return E_NOERROR;
 }
 
-int SelfMotion::direction(const State& state, const Eigen::VectorXd& previous, Eigen::VectorXd& v) {
-  if (const int rc = solver_.compute(state)) return rc;
-  if (const int rc = solver_.J(h_, J_)) return rc;
-  for (std::size_t k = 0; k < path_.size(); ++k) J_path_.col(static_cast<Eigen::Index>(k)) = J_.data.col(path_[k]);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J_path_, Eigen::ComputeFullV);
-  if (!(svd.singularValues()(5) > 1e-6 * svd.singularValues()(0))) return E_NOT_POSITIVE_DEFINITE;
-  v = svd.matrixV().col(6);
-  if (previous.size() == 0) {
+int SelfMotion::direction(const State& state, const PathVector* previous, PathVector& v) {
+  if (const int rc = pathJacobian(state)) return rc;
+  // J^T = Q R: Q's last column spans J's null space (the self-motion's tangent).
+  const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>> qr(J_path_.transpose());
+  if (!fullRank(qr)) return E_NOT_POSITIVE_DEFINITE;
+  v = qr.householderQ() * PathVector::Unit(6);
+  if (!previous) {
     Eigen::Index largest = 0;
     v.cwiseAbs().maxCoeff(&largest);
     if (v(largest) < 0.0) v = -v;
-  } else if (v.dot(previous) < 0.0) {
+  } else if (v.dot(*previous) < 0.0) {
     v = -v;
   }
   return E_NOERROR;
@@ -52,37 +84,73 @@ int SelfMotion::holdHand(State& state, const KDL::Frame& F0) {
   KDL::Frame F;
   for (int iteration = 0; iteration < 8; ++iteration) {
     if (const int rc = handFrame(state, F)) return rc;
-    const KDL::Twist e = KDL::diff(F, F0);  // what takes the hand back, world frame, at the hand
-    Vector6d err;
-    err << e.vel.x(), e.vel.y(), e.vel.z(), e.rot.x(), e.rot.y(), e.rot.z();
+    const Vector6d err = handError(F, F0);  // what takes the hand back, world frame, at the hand
     if (err.norm() < 1e-13) return E_NOERROR;
-    if (const int rc = solver_.J(h_, J_)) return rc;
-    for (std::size_t k = 0; k < path_.size(); ++k) J_path_.col(static_cast<Eigen::Index>(k)) = J_.data.col(path_[k]);
-    const Eigen::VectorXd dq = J_path_.jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(err);
-    for (std::size_t k = 0; k < path_.size(); ++k) state.q(path_[k]) += dq(static_cast<Eigen::Index>(k));
+    if (const int rc = pathJacobian(state)) return rc;
+    // The least-norm step: J = R^T Q_1^T, dq = Q_1 R^-T err.
+    const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>> qr(J_path_.transpose());
+    PathVector y = PathVector::Zero();
+    y.head<6>() = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>().transpose().solve(err);
+    const PathVector dq = qr.householderQ() * y;
+    for (Eigen::Index k = 0; k < 7; ++k) state.q(path_[static_cast<std::size_t>(k)]) += dq(k);
   }
   if (const int rc = handFrame(state, F)) return rc;
-  const KDL::Twist e = KDL::diff(F, F0);
-  return e.vel.Norm() + e.rot.Norm() < 1e-10 ? E_NOERROR : E_NOT_FINITE;
+  const Vector6d err = handError(F, F0);
+  return err.head<3>().norm() + err.tail<3>().norm() < 1e-10 ? E_NOERROR : E_NOT_FINITE;
+}
+
+int SelfMotion::step(State& state, double h, const PathVector* previous, PathVector& v_mid) {
+  PathVector v;
+  if (const int rc = direction(state, previous, v)) return rc;
+  State mid = state;
+  for (Eigen::Index i = 0; i < 7; ++i) mid.q(path_[static_cast<std::size_t>(i)]) += 0.5 * h * v(i);
+  if (const int rc = direction(mid, &v, v_mid)) return rc;
+  for (Eigen::Index i = 0; i < 7; ++i) state.q(path_[static_cast<std::size_t>(i)]) += h * v_mid(i);
+  return holdHand(state, F0_);
+}
+
+int SelfMotion::restart(const State& state) {
+  started_ = false;
+  walk_[0].clear();
+  walk_[1].clear();
+  failed_[0] = failed_[1] = 0;
+  if (const int rc = handFrame(state, F0_)) return rc;
+  start_ = state;
+  started_ = true;
+  return E_NOERROR;
+}
+
+int SelfMotion::extend(int way, std::size_t k) {
+  std::vector<Checkpoint>& walk = walk_[way];
+  State x = start_;
+  if (!walk.empty())
+    for (Eigen::Index i = 0; i < 7; ++i) x.q(path_[static_cast<std::size_t>(i)]) = walk.back().q(i);
+  while (walk.size() < k && !failed_[way]) {
+    Checkpoint c;
+    if ((failed_[way] = step(x, way == 0 ? kStep : -kStep, walk.empty() ? nullptr : &walk.back().v, c.v))) break;
+    for (Eigen::Index i = 0; i < 7; ++i) c.q(i) = x.q(path_[static_cast<std::size_t>(i)]);
+    walk.push_back(c);
+  }
+  return walk.size() < k ? failed_[way] : E_NOERROR;
 }
 
 int SelfMotion::move(State& state, double s) {
   if (!std::isfinite(s)) return E_NOT_FINITE;
-  KDL::Frame F0;
-  if (const int rc = handFrame(state, F0)) return rc;
-  const int steps = static_cast<int>(std::ceil(std::abs(s) / 0.05));
-  const double h = steps > 0 ? s / steps : 0.0;
-  Eigen::VectorXd v, v_mid, none;
-  State mid = state;
-  for (int k = 0; k < steps; ++k) {
-    if (const int rc = direction(state, k == 0 ? none : v_mid, v)) return rc;
-    mid.q = state.q;
-    for (std::size_t i = 0; i < path_.size(); ++i) mid.q(path_[i]) += 0.5 * h * v(static_cast<Eigen::Index>(i));
-    if (const int rc = direction(mid, v, v_mid)) return rc;
-    for (std::size_t i = 0; i < path_.size(); ++i) state.q(path_[i]) += h * v_mid(static_cast<Eigen::Index>(i));
-    if (const int rc = holdHand(state, F0)) return rc;
-  }
-  return E_NOERROR;
+  const bool same = started_ && state.q.data == start_.q.data && samePose(state.world_T_base, start_.world_T_base);
+  if (!same)
+    if (const int rc = restart(state)) return rc;
+  // The checkpoint at the largest multiple of kStep within |s| (a multiple within round-off is one).
+  const double steps = std::abs(s) / kStep;
+  const double nearest = std::round(steps);
+  const std::size_t m = static_cast<std::size_t>(std::abs(steps - nearest) < 1e-9 ? nearest : std::floor(steps));
+  const int way = s < 0.0 ? 1 : 0;
+  if (const int rc = extend(way, m)) return rc;
+  if (m > 0)
+    for (Eigen::Index i = 0; i < 7; ++i) state.q(path_[static_cast<std::size_t>(i)]) = walk_[way][m - 1].q(i);
+  const double rest = std::abs(s) - static_cast<double>(m) * kStep;
+  if (std::abs(rest) < 1e-12) return E_NOERROR;
+  PathVector v_mid;
+  return step(state, way == 0 ? rest : -rest, m > 0 ? &walk_[way][m - 1].v : nullptr, v_mid);
 }
 
 }  // namespace kdl_space

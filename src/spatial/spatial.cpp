@@ -87,4 +87,13 @@ Matrix6d rigidBodyG(double m, const Matrix3d& I_com, const Vector3d& r_bc) {
   return R_b * M_inv_Rt;  // eq. 17: G_B = R_b M_b^-1 R_b^T
 }
 
+KDL::Vector rotationVector(const KDL::Rotation& R) {
+  const KDL::Vector v(0.5 * (R(2, 1) - R(1, 2)), 0.5 * (R(0, 2) - R(2, 0)), 0.5 * (R(1, 0) - R(0, 1)));  // sin(a) axis
+  const double c = 0.5 * (R(0, 0) + R(1, 1) + R(2, 2) - 1.0);                                        // cos(a)
+  if (c < 0.0) return R.GetRot();  // beyond 90 degrees KDL's own is accurate (and handles 180)
+  const double s = std::sqrt(KDL::dot(v, v));
+  if (s == 0.0) return KDL::Vector::Zero();
+  return v * (std::atan2(s, c) / s);
+}
+
 }  // namespace kdl_space

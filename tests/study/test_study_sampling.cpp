@@ -2,6 +2,7 @@
 // Latin hypercube, the normal quantile, grids; and the self-motion of the redundant arm.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -245,6 +246,85 @@ TEST(StudySelfMotion, HoldsTheHandAndMovesTheArmAlongJsNullSpace) {
       const Eigen::VectorXd dq = (moved.q.data - r.state.q.data) / s;
       EXPECT_LT((J.data * dq).norm(), 1e-3 * dq.norm());
     }
+  }
+}
+
+/// The scenario's arm and its hand frame by the library's kinematics (FreeFloatingSolver).
+struct ArmAtScenario {
+  Scenario sc = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/tumbling_box_capture.yaml");
+  const FloatingSystem& r = sc.capture.robot;
+  FreeFloatingSolver solver{r.model};
+  KDL::Frame hand(const State& s) {
+    EXPECT_EQ(solver.compute(s), 0);
+    const KDL::Frame b = solver.bodyPose(r.contact.body);
+    return KDL::Frame(b.M, b * r.contact.offset);
+  }
+  State moved(SelfMotion& m, double s) {
+    State x = r.state;
+    EXPECT_EQ(m.move(x, s), 0) << s;
+    return x;
+  }
+};
+
+TEST(StudySelfMotion, HoldsTheHandToRoundOffAfterShortAndLongSteps) {
+  // The angle by Eigen's quaternion of R0^T R (accurate at small angles): a walk's last short step
+  // drifts the hand by ~1e-8 rad, below what KDL::diff reads (about 1e-6 rad).
+  ArmAtScenario a;
+  SelfMotion motion(a.r.model, a.r.contact, a.r.state);
+  const KDL::Frame F0 = a.hand(a.r.state);
+  for (const double s : {1e-4, 0.05 + 1e-5, 0.3 + 3e-6, -0.7 - 2e-5, 1.2, -1.5 + 1e-3}) {
+    const KDL::Frame F = a.hand(a.moved(motion, s));
+    const double angle = Eigen::AngleAxisd(toEigen(F0.M).transpose() * toEigen(F.M)).angle();
+    EXPECT_LT(angle, 1e-12) << s;
+    EXPECT_LT((toEigen(F.p) - toEigen(F0.p)).norm(), 1e-12) << s;
+  }
+}
+
+TEST(StudySelfMotion, IsContinuousInTheArcLength) {
+  // |q(s + d) - q(s)| ~ |d| across the walk's checkpoints (multiples of 0.05) and where s / 0.05
+  // rounds either way (a walk in s / ceil(s / 0.05) steps jumped there by ~2e-6). A step's
+  // pull back onto the hand's pose lengthens it by less than 1e-3 of it (second order in 0.05).
+  ArmAtScenario a;
+  SelfMotion motion(a.r.model, a.r.contact, a.r.state);
+  for (const double s : {0.1, 0.30000000000000004, 0.3, -0.25, -1.0, 0.123}) {
+    for (const double d : {1e-11, -1e-11, 1e-7, -1e-7, 1e-3}) {
+      const Eigen::VectorXd q = a.moved(motion, s).q.data, p = a.moved(motion, s + d).q.data;
+      EXPECT_LE((p - q).norm(), std::abs(d) * (1.0 + 1e-3) + 1e-13) << s << " + " << d;
+    }
+  }
+}
+
+TEST(StudySelfMotion, AWalkKeptIsTheWalkAFreshOneTakes) {
+  // Moves from the same start reuse the walk's checkpoints: bit for bit what a new SelfMotion
+  // gives, in any order; a move from elsewhere starts a new walk.
+  ArmAtScenario a;
+  SelfMotion kept(a.r.model, a.r.contact, a.r.state);
+  for (const double s : {0.73, -0.41, 0.2, 1.3, -1.05, 0.0, 0.05}) {
+    SelfMotion fresh(a.r.model, a.r.contact, a.r.state);
+    EXPECT_EQ(a.moved(kept, s).q.data, a.moved(fresh, s).q.data) << s;
+  }
+  State elsewhere = a.moved(kept, 0.4);
+  State twice = elsewhere;
+  ASSERT_EQ(kept.move(twice, 0.3), 0);
+  SelfMotion fresh(a.r.model, a.r.contact, elsewhere);
+  ASSERT_EQ(fresh.move(elsewhere, 0.3), 0);
+  EXPECT_EQ(twice.q.data, elsewhere.q.data);
+}
+
+TEST(StudySelfMotion, ItsParameterIsTheArcLengthInJointSpace) {
+  // The polygon through 400 points of the walk from 0 to s is as long as s, to the midpoint
+  // rule's error (second order in the 0.05 step).
+  ArmAtScenario a;
+  SelfMotion motion(a.r.model, a.r.contact, a.r.state);
+  for (const double s : {1.0, -0.8}) {
+    double length = 0.0;
+    Eigen::VectorXd previous = a.r.state.q.data;
+    for (int k = 1; k <= 400; ++k) {
+      const Eigen::VectorXd q = a.moved(motion, s * k / 400.0).q.data;
+      length += (q - previous).norm();
+      previous = q;
+    }
+    EXPECT_NEAR(length, std::abs(s), 1e-4 * std::abs(s)) << s;
   }
 }
 

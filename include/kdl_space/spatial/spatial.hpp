@@ -110,6 +110,10 @@ inline Vector6d toEigen(const KDL::Wrench& w) {
   return r;
 }
 KDL_SPACE_EXPORT Matrix3d toEigen(const KDL::Rotation& R);
+/// The rotation vector (axis times angle) of R, accurate at small angles: KDL's Rotation::GetRot
+/// (and so KDL::diff) reads every angle below about 1e-6 rad as 0, too coarse for a 1e-9 rad
+/// tolerance.
+KDL_SPACE_EXPORT KDL::Vector rotationVector(const KDL::Rotation& R);
 inline KDL::Vector toKDL(const Vector3d& v) { return KDL::Vector(v.x(), v.y(), v.z()); }
 inline KDL::Twist toTwist(const Vector6d& t) {
   return KDL::Twist(KDL::Vector(t(0), t(1), t(2)), KDL::Vector(t(3), t(4), t(5)));
