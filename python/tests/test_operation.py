@@ -97,7 +97,12 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
     (counts_a, sizes_a, sat_a), (counts_b, sizes_b, sat_b) = loose(before), loose(now)
     for a, b, share in zip(counts_a, counts_b, (0.02, 0.2)):
         assert (a is None) == (b is None) and (a is None or abs(a - b) <= max(3, share * a)), (a, b)
-    for a, b, rel in zip(sizes_a, sizes_b, (0.5, 1e-3, 0.02)):  # smallest: a retry; mean: 1 / the count
+    # The smallest step is a retry after a rejection at the base control's saturation corner: its
+    # size follows where the last bits put the trial (issue 38's packed Cholesky of the base twist
+    # moved it from 1.4e-6 to 3.2e-6 s): within a factor of 3. The largest within 1e-3, the mean 2 %.
+    a, b = sizes_a[0], sizes_b[0]
+    assert (a is None) == (b is None) and (a is None or max(a, b) <= 3 * min(a, b)), (a, b)
+    for a, b, rel in zip(sizes_a[1:], sizes_b[1:], (1e-3, 0.02)):
         assert (a is None) == (b is None) and (a is None or math.isclose(a, b, rel_tol=rel)), (a, b)
     assert (sat_a is None) == (sat_b is None) and (sat_a is None or abs(sat_a - sat_b) <= sizes_a[1]), (sat_a, sat_b)
     # The same build type on the same kind of machine: the same floating-point code, so the same
