@@ -53,10 +53,20 @@ std::string approachCause(const ApproachRecord& r, ApproachController& controlle
     why << "joint " << model.jointNames()[worst] << " held at its limit for " << r.time_at_limit[worst] << " s of "
         << active << " s: from this start the hand needs it beyond its range (a pre-grasp move, approach.pre_grasp, "
         << "starts it on another branch)";
-  else if (r.time_near_singular > 0.25 * active)
+  else if (r.time_near_singular > 0.25 * active) {
     why << "near a singularity: the smallest singular value of the Jacobian was below " << spec.threshold << " for "
         << r.time_near_singular << " s (smallest " << r.min_sigma << ")";
-  else if (r.time_rate_limited > 0.5 * active)
+    // With the bus free to move, the hand's Jacobian is a virtual manipulator's about the stack's
+    // centre of mass (Vafa and Dubowsky): its links shortened by the bus's share of the mass, it
+    // stretches out short of the grounded arm's reach; a free attitude adds the dynamic
+    // singularities (Papadopoulos and Dubowsky) inside it.
+    if (r.base == ApproachBase::AttitudeHeld)
+      why << ": with only the bus's attitude held it recoils along the arm's pull, which shortens the arm's "
+          << "reach; hold its position too (base_control.position) or grasp nearer";
+    else if (r.base == ApproachBase::Free)
+      why << ": the free bus turns and recoils under the arm, which shortens its reach; hold the bus "
+          << "(base_control attitude and position) or grasp nearer";
+  } else if (r.time_rate_limited > 0.5 * active)
     why << "rates saturated: the joints' rate limits scaled the command down (to " << r.min_scale << ") for "
         << r.time_rate_limited << " s: give it longer (approach.max_duration) or faster joints";
   else

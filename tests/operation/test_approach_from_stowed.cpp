@@ -149,12 +149,22 @@ TEST(ApproachFromStowed, TheBundledArmReachesItsGraspInsideItsLimits) {
   expectReachedFromStowed(variant("bundled", [](std::string t) { return stowed(t, "\n  pre_grasp: {standoff: 0.15}"); }, asIs));
 }
 
+TEST(ApproachFromStowed, AHeavyArmOnALightBusHeldByItsControlReachesItsGraspInsideItsLimits) {
+  // The arm's links four times as heavy on an 80 kg bus whose attitude and position control act
+  // in the approach (wheels and thrusters): the grounded Jacobian, the pre-grasp move, the final
+  // approach; every joint inside its limits, every rate within its limit.
+  expectReachedFromStowed(variant("heavy_held", [](std::string t) {
+    return stowed(t, "\n  pre_grasp: {standoff: 0.15}\n  singular_threshold: 0.01") +
+           "  base_control:\n    phases: [approach]\n    attitude: {kp: 2000, kd: 4000, set_point: hold}\n"
+           "    position: {kp: 2000, kd: 4000, set_point: hold}\n";
+  }, heavyArmOnLightBus), ApproachBase::Held);
+}
+
 TEST(ApproachFromStowed, AHeavyArmOnALightBusStaysInsideItsLimitsAndSaysWhyItStops) {
-  // The arm's links four times as heavy on an 80 kg bus, its attitude control acting in the
-  // approach (a free bus turns ~60 degrees under this arm): the attitude-held Jacobian. It does
-  // not reach its grasp yet (issue 38 stays open: its final approach runs near a singularity of
-  // that Jacobian, 8 mm short); what holds already: no joint leaves its limits and the failure
-  // says why.
+  // The same with only the bus's attitude held (a free bus turns ~60 degrees under this arm): the
+  // attitude-held Jacobian. The bus recoils along the arm's pull and the hand stops 8 mm short,
+  // the Jacobian near a singularity (a virtual manipulator about the stack's centre of mass,
+  // stretched out): no joint leaves its limits and the failure says why, and what to do.
   const Scenario sc = loadScenario(variant("heavy", [](std::string t) {
     return stowed(t, "\n  pre_grasp: {standoff: 0.15}\n  singular_threshold: 0.01") +
            "  base_control:\n    phases: [approach]\n    attitude: {kp: 2000, kd: 4000, set_point: hold}\n";
@@ -169,6 +179,9 @@ TEST(ApproachFromStowed, AHeavyArmOnALightBusStaysInsideItsLimitsAndSaysWhyItSto
     r = e.partial();
     EXPECT_FALSE(r->approach->record.cause.empty());
     EXPECT_NE(std::string(e.what()).find(r->approach->record.cause), std::string::npos);
+    EXPECT_NE(r->approach->record.cause.find("near a singularity"), std::string::npos) << r->approach->record.cause;
+    EXPECT_NE(r->approach->record.cause.find("recoils along the arm's pull"), std::string::npos);
+    EXPECT_NE(r->approach->record.cause.find("base_control.position"), std::string::npos);
   }
   EXPECT_EQ(r->approach->record.base, ApproachBase::AttitudeHeld);
   EXPECT_GT(r->approach->record.pre_grasp_duration, 1.0);
