@@ -9,8 +9,8 @@
 //
 //   kdl_space_bench [--model FILE.urdf --tip LINK [--offset X Y Z]] [--sizes 7,14,...]
 //                   [--simulate 7,100] [--mimic-sizes 10,30,50,100] [--markdown FILE]
-//   kdl_space_bench --plan SCENARIO.yaml   (planCapture alone: plan_bench.hpp)
 //                   [Google Benchmark flags, e.g. --benchmark_repetitions=5]
+//   kdl_space_bench --plan SCENARIO.yaml [Google Benchmark flags]   (planCapture alone: plan_bench.hpp)
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Cholesky>
