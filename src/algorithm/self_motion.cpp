@@ -52,6 +52,10 @@ SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact
 
 int SelfMotion::pathJacobian(const State& state) {
   if (const int rc = solver_.compute(state)) return rc;
+  return pathJacobian();
+}
+
+int SelfMotion::pathJacobian() {
   if (const int rc = solver_.J(h_, J_)) return rc;
   for (Eigen::Index k = 0; k < 7; ++k) J_path_.col(k) = J_.data.col(path_[static_cast<std::size_t>(k)]);
   return E_NOERROR;
@@ -86,7 +90,7 @@ int SelfMotion::holdHand(State& state, const KDL::Frame& F0) {
     if (const int rc = handFrame(state, F)) return rc;
     const Vector6d err = handError(F, F0);  // what takes the hand back, world frame, at the hand
     if (err.norm() < 1e-13) return E_NOERROR;
-    if (const int rc = pathJacobian(state)) return rc;
+    if (const int rc = pathJacobian()) return rc;  // at the state handFrame computed
     // The least-norm step: J = R^T Q_1^T, dq = Q_1 R^-T err.
     const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>> qr(J_path_.transpose());
     PathVector y = PathVector::Zero();

@@ -40,6 +40,7 @@ class KDL_SPACE_EXPORT SelfMotion {
     PathVector v;
   };
   int pathJacobian(const State& state);
+  int pathJacobian();  ///< at the state the solver last computed
   int direction(const State& state, const PathVector* previous, PathVector& v);
   int handFrame(const State& state, KDL::Frame& F);
   int holdHand(State& state, const KDL::Frame& F0);
