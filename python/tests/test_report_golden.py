@@ -40,9 +40,9 @@ def test_ik_plan_and_inspect_json_are_what_the_tool_printed_before(cli, what, ar
         # multiply-adds): the count within 5 %, the optimum it finds at 1e-9.
         a, b = before.pop("evaluations"), now.pop("evaluations")
         assert abs(a - b) <= 0.05 * a, (a, b)
-        # Its joints are an inverse kinematics' (pose tolerance 1e-10, the self-motion's origin
-        # where the null-space steps to the preferred posture stop): fixed to 1e-9 rad, not to 1e-9
-        # of each angle (the QR factorisations of issue 38 moved a 0.19 rad joint by 3.6e-10).
+        # Its joints are an inverse kinematics' (pose tolerance 1e-10; the self-motion's origin,
+        # the posture nearest the scenario's, to round-off since issue 38: plan.json was printed
+        # again then, README there): fixed to 1e-9 rad, not to 1e-9 of each angle.
         assert_same(before, now, 1e-9, 1e-9)
         return
     assert_same(before, now, 1e-9, 1e-12)

@@ -6,7 +6,6 @@
 #include <kdl/chainiksolvervel_pinv.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include <sstream>
 
 #include "algorithm/contact_chain.hpp"
+#include "algorithm/rank_test.hpp"
 #include "spatial/message_text.hpp"
 #include "kdl_space/algorithm/free_floating_solver.hpp"
 #include "kdl_space/multibody/kinematics.hpp"
@@ -42,17 +42,9 @@ KDL::Twist poseError(const KDL::Frame& current, const KDL::Frame& goal) {
 
 double clampTo(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
 
-/// The squares of J's singular values, J^T = Q R (n x 6, n >= 6): R^T R's eigenvalues, ascending.
-Eigen::Matrix<double, 6, 1> singularSquares(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
-  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(R.transpose() * R, Eigen::EigenvaluesOnly).eigenvalues();
-}
-double smallestSingular(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
-  return std::sqrt(std::max(0.0, singularSquares(qr)(0)));
-}
-double smallestSingularRatio(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
-  const Eigen::Matrix<double, 6, 1> s2 = singularSquares(qr);
-  return s2(5) > 0.0 ? std::sqrt(std::max(0.0, s2(0) / s2(5))) : 0.0;
+/// The 6 x 6 upper triangle of J^T = Q R (J 6 x n, n >= 6): J J^T = R^T R.
+Eigen::Matrix<double, 6, 6> upperR(const Eigen::HouseholderQR<Eigen::MatrixXd>& qr) {
+  return qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
 }
 
 /// The solvers on one chain (each keeps a reference to it: it outlives them).
@@ -131,7 +123,7 @@ class IkSearch {
     const Eigen::MatrixXd J = jacobian(q);
     if (J.cols() > 6) {
       const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J.transpose());
-      if (smallestSingularRatio(qr) > 1e-9)
+      if (detail::wellConditioned(upperR(qr), 1e-9))
         return (qr.householderQ() * Eigen::MatrixXd::Identity(J.cols(), J.cols())).rightCols(J.cols() - 6);
     }
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
@@ -155,7 +147,7 @@ class IkSearch {
     const Eigen::MatrixXd J = jacobian(q);
     if (J.cols() >= 6) {
       const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J.transpose());
-      if (smallestSingular(qr) > 1e-8) {
+      if (detail::singularValuesAbove(upperR(qr), 1e-16)) {
         Eigen::VectorXd y = Eigen::VectorXd::Zero(J.cols());
         y.head<6>() = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>().transpose().solve(t);
         dq.data = qr.householderQ() * y;
@@ -238,20 +230,38 @@ class IkSearch {
     }
   }
 
-  /// Null-space steps towards the preferred posture, each projected back onto the pose.
+  /// Null-space steps towards the preferred posture, each projected back onto the pose, to where
+  /// the way there has no part along the self-motion (|N (preferred - q)| at round-off): the
+  /// nearest configuration on the pose's self-motion, whatever the start. The steps' lengths are
+  /// Barzilai and Borwein's, s.s / s.y (a secant of the curvature: the plain step g converges only
+  /// linearly, by ~0.45 an iteration on a 7-joint arm: 29 iterations, now 5); a step that makes no
+  /// progress is halved, down to 1e-3.
   void preferPosture(KDL::JntArray& q, unsigned int& iterations) {
     if (q.rows() <= 6) return;
+    const double converged = 1e-13 * (1.0 + preferred_.data.norm()), noise = 10.0 * converged;
+    Eigen::VectorXd g = preferenceGradient(q);
     double step = 1.0;
-    for (int k = 0; k < 200 && step > 1e-3; ++k) {
-      const Eigen::VectorXd g = preferenceGradient(q);
-      if (g.norm() < 1e-10) return;
+    for (int k = 0; k < 100 && step > 1e-3 && g.norm() > converged; ++k) {
       KDL::JntArray trial(q.rows());
       for (unsigned int j = 0; j < q.rows(); ++j) trial(j) = clampTo(q(j) + step * g(j), c_.lower(j), c_.upper(j));
-      if (refine(trial, iterations) && (trial.data - preferred_.data).norm() < (q.data - preferred_.data).norm()) {
-        q = trial;
-      } else {
+      if (!refine(trial, iterations)) {
         step *= 0.5;
+        continue;
       }
+      const Eigen::VectorXd g_trial = preferenceGradient(trial);
+      const double d = (q.data - preferred_.data).norm(), d_trial = (trial.data - preferred_.data).norm();
+      // Progress: nearer beyond round-off, or as near with a gradient a tenth smaller (a joint held
+      // at its limit blocks the way: neither, and the steps shrink to the end).
+      if (!(d_trial < d - noise || (d_trial <= d + noise && g_trial.norm() < 0.9 * g.norm()))) {
+        step *= 0.5;
+        continue;
+      }
+      // f = |q - preferred|^2 / 2 on the self-motion, its gradient -g: s.y with y = g - g_trial.
+      const Eigen::VectorXd s = trial.data - q.data;
+      const double sy = s.dot(g - g_trial);
+      step = sy > 0.0 ? std::clamp(s.squaredNorm() / sy, 0.05, 4.0) : 1.0;
+      q = trial;
+      g = g_trial;
     }
   }
 
@@ -392,7 +402,7 @@ IkResult solveInverseKinematics(const FloatingModel& model, const State& seed, c
     r.iterations = iterations;
     if (ok && n > 6)
       r.preference_gradient = (search.minimisesMeasure() ? search.measureGradient(qc) : search.preferenceGradient(qc)).norm();
-    r.reaction_measure = measureOr(qc);
+    if (options.measure_reaction) r.reaction_measure = measureOr(qc);
     if (ok && search.withinLimits(qc) && r.position_residual <= options.position_tolerance &&
         r.orientation_residual <= options.orientation_tolerance)
       return r;

@@ -1,21 +1,16 @@
 #include "kdl_space/algorithm/self_motion.hpp"
 
-#include <Eigen/QR>
-#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
 #include <cmath>
 
+#include "algorithm/rank_test.hpp"
 #include "kdl_space/spatial/errors.hpp"
 
 namespace kdl_space {
 namespace {
 
-/// J's smallest singular value is more than 1e-6 of its largest. J J^T = R^T R (J^T = Q R): its
-/// eigenvalues are their squares (to round-off of the largest: 1e-4 of the threshold's square).
-bool fullRank(const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>>& qr) {
-  const Eigen::Matrix<double, 6, 6> R = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(R.transpose() * R, Eigen::EigenvaluesOnly);
-  return eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(5);
-}
+/// J's smallest singular value is more than 1e-6 of its Frobenius norm.
+bool fullRank(const Eigen::Matrix<double, 6, 6>& JJt) { return detail::gramAbove(JJt, 1e-12 * JJt.trace()); }
 
 /// Bit for bit (KDL's operator== on a Rotation compares within an epsilon).
 bool samePose(const KDL::Frame& a, const KDL::Frame& b) {
@@ -37,43 +32,65 @@ Vector6d handError(const KDL::Frame& F, const KDL::Frame& F0) {
 }  // namespace
 
 SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact& h, const State& nominal)
-    : solver_(model, FreeFloatingSolver::Extent::Jacobians), h_(h), J_(model->nj()) {
-  if (solver_.compute(nominal) != E_NOERROR || solver_.J(h_, J_) != E_NOERROR)
+    : model_(std::move(model)), kin_(*model_), h_(h), J_(Matrix6Xd::Zero(6, model_->nj())) {
+  if (contactCode(true, h_, model_->bodies().size()) != E_NOERROR || forwardKinematics(*model_, nominal, kin_) != E_NOERROR ||
+      pathJacobian() != E_NOERROR)
     throw InputError("robot.self_motion: the arm's Jacobian cannot be computed at the scenario's state");
-  for (unsigned int j = 0; j < model->nj(); ++j)
-    if (J_.data.col(j).norm() > 0.0) path_.push_back(static_cast<int>(j));
+  for (unsigned int j = 0; j < model_->nj(); ++j)
+    if (J_.col(j).norm() > 0.0) path_.push_back(static_cast<int>(j));
   const std::string arm = std::to_string(path_.size()) + " joints on the path to the contact link";
   if (path_.size() != 7)
     throw InputError("robot.self_motion: the arm has " + arm + "; a self-motion holding the hand's pose is a "
                      "one-parameter family only for 7 (one redundant joint)");
-  if (pathJacobian(nominal) != E_NOERROR || !fullRank(Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>>(J_path_.transpose())))
+  if (pathJacobian(nominal) != E_NOERROR || !fullRank(J_path_ * J_path_.transpose()))
     throw InputError("robot.self_motion: the arm is singular at the scenario's state (the hand's Jacobian has rank < 6)");
 }
 
 int SelfMotion::pathJacobian(const State& state) {
-  if (const int rc = solver_.compute(state)) return rc;
+  if (const int rc = forwardKinematics(*model_, state, kin_)) return rc;
   return pathJacobian();
 }
 
 int SelfMotion::pathJacobian() {
-  if (const int rc = solver_.J(h_, J_)) return rc;
-  for (Eigen::Index k = 0; k < 7; ++k) J_path_.col(k) = J_.data.col(path_[static_cast<std::size_t>(k)]);
+  // Each joint's unit twist carried from the base origin to the hand point (a coordinate that
+  // moves several joints, mimic, sums their columns).
+  const std::vector<Body>& bodies = model_->bodies();
+  const Vector3d r = kin_.point(h_) - kin_.p_b;
+  J_.setZero();
+  for (int b = h_.body; b >= 0; b = bodies[b].parent)
+    if (bodies[b].joint >= 0) J_.col(bodies[b].joint) += shiftTwist(kin_.S[b], r);
+  if (!J_.allFinite()) return E_NOT_FINITE;
+  for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(path_.size()); ++k) J_path_.col(k) = J_.col(path_[static_cast<std::size_t>(k)]);
   return E_NOERROR;
 }
 
 int SelfMotion::handFrame(const State& state, KDL::Frame& F) {
-  if (const int rc = solver_.compute(state)) return rc;
-  const KDL::Frame& body = solver_.bodyPose(h_.body);
+  if (const int rc = forwardKinematics(*model_, state, kin_)) return rc;
+  const KDL::Frame body = kin_.pose(h_.body);
   F = KDL::Frame(body.M, body * h_.offset);
   return E_NOERROR;
 }
 
 int SelfMotion::direction(const State& state, const PathVector* previous, PathVector& v) {
   if (const int rc = pathJacobian(state)) return rc;
-  // J^T = Q R: Q's last column spans J's null space (the self-motion's tangent).
-  const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>> qr(J_path_.transpose());
-  if (!fullRank(qr)) return E_NOT_POSITIVE_DEFINITE;
-  v = qr.householderQ() * PathVector::Unit(6);
+  const Eigen::Matrix<double, 6, 6> JJt = J_path_ * J_path_.transpose();
+  if (!fullRank(JJt)) return E_NOT_POSITIVE_DEFINITE;
+  // The self-motion's tangent: a vector projected onto J's null space, P u = u - J^T (J J^T)^-1 J u
+  // (once more for round-off), normalised. u is the direction the walk came along; at the start the
+  // coordinate axis P keeps most of, the sign then making the largest component positive.
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(JJt);
+  PathVector u;
+  if (previous) {
+    u = *previous;
+  } else {
+    const Eigen::Matrix<double, 6, 7> X = llt.solve(J_path_);
+    Eigen::Index kept = 0;
+    (PathVector::Ones() - (J_path_.cwiseProduct(X)).colwise().sum().transpose()).maxCoeff(&kept);
+    u = PathVector::Unit(kept);
+  }
+  for (int pass = 0; pass < 2; ++pass) u -= J_path_.transpose() * llt.solve(J_path_ * u);
+  if (!(u.norm() > 0.0) || !u.allFinite()) return E_NOT_POSITIVE_DEFINITE;
+  v = u.normalized();
   if (!previous) {
     Eigen::Index largest = 0;
     v.cwiseAbs().maxCoeff(&largest);
@@ -91,11 +108,10 @@ int SelfMotion::holdHand(State& state, const KDL::Frame& F0) {
     const Vector6d err = handError(F, F0);  // what takes the hand back, world frame, at the hand
     if (err.norm() < 1e-13) return E_NOERROR;
     if (const int rc = pathJacobian()) return rc;  // at the state handFrame computed
-    // The least-norm step: J = R^T Q_1^T, dq = Q_1 R^-T err.
-    const Eigen::HouseholderQR<Eigen::Matrix<double, 7, 6>> qr(J_path_.transpose());
-    PathVector y = PathVector::Zero();
-    y.head<6>() = qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>().transpose().solve(err);
-    const PathVector dq = qr.householderQ() * y;
+    // The least-norm step dq = J^T (J J^T)^-1 err (J is well conditioned along the walk: the
+    // directions' rank test; a Newton step's round-off is the next one's error).
+    const Eigen::Matrix<double, 6, 6> JJt = J_path_ * J_path_.transpose();
+    const PathVector dq = J_path_.transpose() * Eigen::LLT<Eigen::Matrix<double, 6, 6>>(JJt).solve(err);
     for (Eigen::Index k = 0; k < 7; ++k) state.q(path_[static_cast<std::size_t>(k)]) += dq(k);
   }
   if (const int rc = handFrame(state, F)) return rc;

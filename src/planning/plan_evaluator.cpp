@@ -266,6 +266,7 @@ bool PlanEvaluator::handPlaced(const PlanPoint& x, std::string& why) {
     IkOptions o;  // the scenario's branch: from its state, no restarts elsewhere (capture_plan.hpp)
     o.preferred = robot.state.q;
     o.restarts = 0;
+    o.measure_reaction = false;
     try {
       placed_.q = solveInverseKinematics(*robot.model, robot.state, robot.contact, grasp * KDL::Frame(KDL::Rotation::RotZ(x.wrist_roll)), o).q;
     } catch (const InputError& e) {  // IkUnreachable: out of reach within the limits

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "kdl_space/algorithm/inverse_kinematics.hpp"
+#include "kdl_space/algorithm/self_motion.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 
 namespace kdl_space {
@@ -118,6 +119,44 @@ TEST(InverseKinematics, RedundantArmTakesThePreferredPostureOnItsSelfMotion) {
   EXPECT_LE(d.position_residual, 1e-9);
   EXPECT_LE(d.preference_gradient, 1e-8);
   EXPECT_LT((d.q.data - seed.q.data).norm(), (r.q.data - seed.q.data).norm());
+}
+
+TEST(InverseKinematics, ThePreferredPostureIsTheSameFromEverySeedWithinThePoseTolerance) {
+  // The nearest configuration on the pose's self-motion is one point: seeds on either side of it
+  // reach it, where its first-order condition N (preferred - q) = 0 holds to 1e-13, to within the
+  // pose's tolerance (1e-10: Newton stops at half of it, so 2e-11 apart was measured).
+  // (The step-halving rule before issue 38 stopped where |N (preferred - q)| was ~1e-8: its
+  // solutions from these seeds differed by ~1e-8 rad.) Another route: the distance along the
+  // self-motion, walked 1e-3 either way from the solution, is no smaller.
+  const std::shared_ptr<const FloatingModel> model =
+      std::make_shared<const FloatingModel>(loadUrdfFile(KDL_SPACE_URDF_DIR "/space_arm7.urdf"));
+  const Contact h = model->contact("end_effector");
+  State preferred(*model);
+  preferred.q = jointsByName(*model, {{"joint2", 0.7}, {"joint3", 0.9}, {"joint4", 0.8}, {"joint6", -0.6}});
+  State pose_at = preferred;
+  pose_at.q = jointsByName(*model, {{"joint1", 0.3}, {"joint2", 0.2}, {"joint3", 1.2}, {"joint4", 1.1},
+                                    {"joint5", -0.4}, {"joint6", -0.9}, {"joint7", 0.5}});
+  const KDL::Frame goal = kdlContactFrame(*model, pose_at, "end_effector", KDL::Vector::Zero());
+  IkOptions o;
+  o.preferred = preferred.q;
+  o.restarts = 0;
+  std::vector<IkResult> results;
+  for (const double shift : {-0.2, 0.0, 0.25}) {
+    State seed = pose_at;
+    for (unsigned int j = 0; j < model->nj(); ++j) seed.q(j) += shift * ((j % 3) ? 1.0 : -0.5);
+    results.push_back(solveInverseKinematics(*model, seed, h, goal, o));
+    EXPECT_LE(results.back().preference_gradient, 1e-13 * (1.0 + preferred.q.data.norm()));
+  }
+  for (const IkResult& r : results) EXPECT_LE((r.q.data - results[1].q.data).cwiseAbs().maxCoeff(), 1e-10);
+  State solved = pose_at;
+  solved.q = results[1].q;
+  const double d = (solved.q.data - preferred.q.data).norm();
+  for (const double s : {-1e-3, 1e-3}) {
+    SelfMotion walk(model, h, solved);
+    State x = solved;
+    ASSERT_EQ(walk.move(x, s), E_NOERROR);
+    EXPECT_GT((x.q.data - preferred.q.data).norm(), d + 1e-8);  // a minimum: f'' ~ 0.7, so ~3.5e-7 more
+  }
 }
 
 TEST(InverseKinematics, UnreachablePoseIsRefusedWithTheRemainingDistance) {

@@ -49,6 +49,9 @@ struct IkOptions {
   std::optional<KDL::JntArray> preferred;
   /// Which self-motion solution a redundant arm returns (`preferred` is unused for Reaction).
   IkPreference prefer = IkPreference::Posture;
+  /// Fill IkResult::reaction_measure (a free-floating solve at each attempt's end); false leaves it
+  /// NaN (a caller that solves many poses and reads only q: the capture plan).
+  bool measure_reaction = true;
   /// \brief The caller's way to stop the search (Ctrl-C): called before every Newton-Raphson
   /// iteration and every attempt; true throws Cancelled. It may also throw its own exception
   /// (Python's KeyboardInterrupt), which propagates. Empty: never cancelled.

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "kdl_space/algorithm/free_floating_solver.hpp"
+#include "kdl_space/multibody/kinematics.hpp"
 #include "kdl_space/export.hpp"
 
 namespace kdl_space {
@@ -40,7 +40,7 @@ class KDL_SPACE_EXPORT SelfMotion {
     PathVector v;
   };
   int pathJacobian(const State& state);
-  int pathJacobian();  ///< at the state the solver last computed
+  int pathJacobian();  ///< at the state the kinematics last computed
   int direction(const State& state, const PathVector* previous, PathVector& v);
   int handFrame(const State& state, KDL::Frame& F);
   int holdHand(State& state, const KDL::Frame& F0);
@@ -52,10 +52,12 @@ class KDL_SPACE_EXPORT SelfMotion {
   /// The walk extended to `k` checkpoints on the side `way` (0: s > 0, 1: s < 0).
   int extend(int way, std::size_t k);
 
-  FreeFloatingSolver solver_;
+  // Kinematics only (no mass properties): the hand's frame and its fixed-base Jacobian.
+  std::shared_ptr<const FloatingModel> model_;
+  Kinematics kin_;
   Contact h_;
   std::vector<int> path_;  ///< the joints that move the hand (model order)
-  KDL::Jacobian J_;
+  Matrix6Xd J_;            ///< the hand's Jacobian (v at the hand; w), every coordinate
   PathJacobian J_path_;
   // The walk from the last start: its state, hand frame, and checkpoints at (k + 1) kStep on
   // each side; a side stops at a failure (its code kept, returned for any s beyond it).
