@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "simulation/box_qp.hpp"
 #include "simulation/pre_grasp.hpp"
 
 namespace kdl_space {
@@ -86,33 +87,8 @@ const char* toString(ApproachBase base) {
   }
 }
 
-Eigen::VectorXd ApproachController::solveTask(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                                              const Eigen::VectorXd& fixed, const std::vector<bool>& clamped,
-                                              double l2, Eigen::MatrixXd* N) const {
-  const Eigen::Index n = A.cols(), m = A.rows();
-  Eigen::MatrixXd A_f = A;
-  for (Eigen::Index j = 0; j < n; ++j)
-    if (clamped[static_cast<std::size_t>(j)]) A_f.col(j).setZero();
-  const Eigen::VectorXd rest = b - (A - A_f) * fixed;  // what the free joints must do
-  const Eigen::MatrixXd AAt = A_f * A_f.transpose();
-  // The damping of the free joints' Jacobian (a clamp may bring it nearer a singularity).
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(AAt, Eigen::EigenvaluesOnly);
-  const double ratio = std::sqrt(std::max(eig.eigenvalues()(0), 0.0)) / spec_.threshold;
-  const double damping2 = std::max(l2, ratio < 1.0 ? spec_.damping * spec_.damping * (1.0 - ratio * ratio) : 0.0);
-  const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + (damping2 + 1e-300) * Eigen::MatrixXd::Identity(m, m));
-  Eigen::VectorXd qdot = A_f.transpose() * damped.solve(rest);
-  if (N) {
-    *N = Eigen::MatrixXd::Identity(n, n) - A_f.transpose() * damped.solve(A_f);
-    for (Eigen::Index j = 0; j < n; ++j)
-      if (clamped[static_cast<std::size_t>(j)]) N->row(j).setZero(), N->col(j).setZero();
-  }
-  for (Eigen::Index j = 0; j < n; ++j)
-    if (clamped[static_cast<std::size_t>(j)]) qdot(j) = fixed(j);
-  return qdot;
-}
-
-void ApproachController::limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-                                     double l2, Eigen::VectorXd& qdot, std::vector<int>& clamped_out) const {
+void ApproachController::limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, double l2, Eigen::VectorXd& qdot,
+                                     std::vector<int>& clamped_out) const {
   const unsigned int n = model_->nj();
   clamped_out.clear();
   const auto limited = [&](unsigned int j) {
@@ -129,39 +105,37 @@ void ApproachController::limitJoints(const KDL::JntArray& q, const Eigen::Matrix
     if (p.upper - q(j) < zone) z(j) = -std::min(spec_.limit_gain * (zone - (p.upper - q(j))), cap);
     else if (q(j) - p.lower < zone) z(j) = std::min(spec_.limit_gain * (zone - (q(j) - p.lower)), cap);
   }
-  std::vector<bool> clamped(n, false);
-  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(n);
-  Eigen::MatrixXd N;
-  const bool push = !z.isZero(0.0);
-  if (push) {
-    solveTask(A, b, fixed, clamped, l2, &N);
-    qdot += N * z;
+  if (!z.isZero(0.0)) {  // N z, N = E - J+ J of the damped least squares
+    const Eigen::MatrixXd AAt = A * A.transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> damped(AAt + (l2 + 1e-300) * Eigen::MatrixXd::Identity(A.rows(), A.rows()));
+    qdot += z - A.transpose() * damped.solve(A * z);
   }
-  // The guard: a joint's rate toward its limit at most limit_gain x its distance from it.
-  for (unsigned int pass = 0; pass < n; ++pass) {
-    bool more = false;
-    for (unsigned int j = 0; j < n; ++j) {
-      if (clamped[j] || !limited(j)) continue;
-      const JointProperties& p = model_->jointProperties()[j];
-      // The guard stands the servo's lag at the full rate (rate / bandwidth) twice inside the limit:
-      // the joint follows its command that far behind, so it stops at the limit, not past it.
-      const double lag = std::min(2.0 * spec_.rate_limits[j] / spec_.servo_bandwidth, 0.25 * (p.upper - p.lower));
-      const double up = spec_.limit_gain * (p.upper - lag - q(j)), down = -spec_.limit_gain * (q(j) - p.lower - lag);
-      if (qdot(j) > up || qdot(j) < down) {
-        fixed(j) = qdot(j) > up ? up : down;
-        clamped[j] = more = true;
-      }
-    }
-    if (!more) break;
-    qdot = solveTask(A, b, fixed, clamped, l2, push ? &N : nullptr);
-    if (push) {
-      for (unsigned int j = 0; j < n; ++j)
-        if (clamped[j]) z(j) = 0.0;
-      qdot += N * z;
-    }
+  // The guard: a joint's rate toward its limit at most limit_gain x its distance from a guard,
+  // which stands the servo's lag at the full rate (rate / bandwidth) twice inside the limit (the
+  // joint follows its command that far behind, so it stops at the limit, not past it).
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(n, -std::numeric_limits<double>::infinity());
+  Eigen::VectorXd hi = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  bool inside = true;
+  for (unsigned int j = 0; j < n; ++j) {
+    if (!limited(j)) continue;
+    const JointProperties& p = model_->jointProperties()[j];
+    const double lag = std::min(2.0 * spec_.rate_limits[j] / spec_.servo_bandwidth, 0.25 * (p.upper - p.lower));
+    hi(j) = spec_.limit_gain * (p.upper - lag - q(j));
+    lo(j) = -spec_.limit_gain * (q(j) - p.lower - lag);
+    inside = inside && qdot(j) <= hi(j) && qdot(j) >= lo(j);
   }
+  if (inside) return;
+  // The rates nearest the task's inside the box: a change of the hand's twist costs A^T A, a
+  // joint's own change mu (the damping, at least 1e-6 of |A|^2): the null space fixes what it can,
+  // the hand gives up the least of its twist for the rest. Unique and continuous in the state
+  // (the clamp-and-re-solve this replaced jumped between sets of clamped joints, and the servos
+  // chattered: 1.9 x a wrist's rate limit).
+  Eigen::MatrixXd H = A.transpose() * A;
+  H.diagonal().array() += std::max(l2, 1e-6 * A.squaredNorm());
+  std::vector<int> at;
+  qdot = detail::nearestInBox(H, qdot, lo, hi, at);
   for (unsigned int j = 0; j < n; ++j)
-    if (clamped[j]) clamped_out.push_back(static_cast<int>(j));
+    if (at[j]) clamped_out.push_back(static_cast<int>(j));
 }
 
 int ApproachController::command(const SimulationState& s, ApproachCommand& out) {
@@ -223,7 +197,7 @@ int ApproachController::command(const SimulationState& s, ApproachCommand& out) 
     const Eigen::VectorXd z = -B.transpose() * (BBt + mu * Matrix3d::Identity()).ldlt().solve(w_b);
     qdot += N * z;
   }
-  limitJoints(s.state.q, A, b, l2, qdot, out.clamped);
+  limitJoints(s.state.q, A, l2, qdot, out.clamped);
   double scale = 1.0;
   for (unsigned int j = 0; j < n; ++j)
     if (std::abs(qdot(j)) * scale > spec_.rate_limits[j]) scale = spec_.rate_limits[j] / std::abs(qdot(j));

@@ -108,9 +108,9 @@ TEST(JointMove, SynchronizedWithinEveryLimitOnTheStraightLine) {
 
 // --- The approach from stowed --------------------------------------------------------------------
 
-/// Every approach sample's joints inside their limits and rates within their limits (the
-/// servos track the command within 1 %), read from the samples.
-void expectWithinLimits(const Scenario& sc, const OperationResult& r, bool rates = true) {
+/// Every approach sample's joints inside their limits and rates within `rates` x their limits
+/// (1.01: the servos track the command within 1 %), read from the samples.
+void expectWithinLimits(const Scenario& sc, const OperationResult& r, double rates = 1.01) {
   const FloatingModel& model = *sc.capture.robot.model;
   ASSERT_GT(r.approach_samples.size(), 100u);
   double worst_position = -1.0, worst_rate = 0.0;
@@ -121,7 +121,7 @@ void expectWithinLimits(const Scenario& sc, const OperationResult& r, bool rates
       worst_rate = std::max(worst_rate, std::abs(x.qd(j)) / sc.approach->rate_limits[j]);
     }
   EXPECT_LT(worst_position, 0.0) << "a joint left its limits";
-  if (rates) EXPECT_LE(worst_rate, 1.01) << "a joint's rate beyond its limit";
+  if (rates > 0.0) EXPECT_LE(worst_rate, rates) << "a joint's rate beyond its limit";
 }
 
 void expectReachedFromStowed(const std::string& path, ApproachBase base = ApproachBase::Free) {
@@ -186,7 +186,7 @@ TEST(ApproachFromStowed, AHeavyArmOnALightBusStaysInsideItsLimitsAndSaysWhyItSto
   EXPECT_EQ(r->approach->record.base, ApproachBase::AttitudeHeld);
   EXPECT_GT(r->approach->record.pre_grasp_duration, 1.0);
   EXPECT_LT(r->approach->record.closest_distance, 0.05);
-  expectWithinLimits(sc, *r, false);
+  expectWithinLimits(sc, *r, 0.0);
 }
 
 TEST(ApproachFromStowed, WithoutAPreGraspTheGuardKeepsTheJointsInsideAndTheFailureNamesTheJoint) {
@@ -205,9 +205,12 @@ TEST(ApproachFromStowed, WithoutAPreGraspTheGuardKeepsTheJointsInsideAndTheFailu
     const ApproachRecord& rec = e.partial()->approach->record;
     EXPECT_FALSE(rec.reached);
     EXPECT_GT(rec.time_at_limit[2], 10.0);
-    // Positions only: where the guard clamps a joint the others' commands jump, and the velocity
-    // servos overshoot them (measured: 1.9 x a wrist's limit for a moment; commanded within).
-    expectWithinLimits(sc, *e.partial(), false);
+    // The commands stay within the rate limits and change continuously (the guard's rates are a
+    // strictly convex QP's: before, its clamp-and-re-solve switched between sets of clamped joints
+    // and the servos chattered, 1.95 x a wrist's limit). The servos still lag: held at its guard,
+    // joint3 decelerates while the others speed up, and a velocity servo (kv = bandwidth x the
+    // joint's apparent inertia) lets the coupling carry it to 1.25 x its limit (measured).
+    expectWithinLimits(sc, *e.partial(), 1.3);
   }
 }
 

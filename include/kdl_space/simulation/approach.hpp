@@ -45,8 +45,9 @@ struct ApproachSpec {
   /// Joint limits (positions): a joint within `limit_zone` x its range of a limit is pushed away in
   /// the null space (the gradient of sum ((q - mid) / half range)^2, Liegeois), and its rate toward
   /// the limit is never more than limit_gain x its distance from a guard twice the servo's lag at
-  /// full rate (2 rate_limit / servo_bandwidth) inside it (the joint clamped there and the task
-  /// re-solved by the others): it stops at the limit, not past it. Joints without limits are free.
+  /// full rate (2 rate_limit / servo_bandwidth) inside it (the rates then the nearest to the task's
+  /// within every such bound, the hand's twist given up least): it stops at the limit, not past it.
+  /// Joints without limits are free.
   double limit_zone = 0.1;
   double limit_gain = 2.0;  ///< [1/s]
   /// The joint-space move to a pre-grasp pose first (unset: none): see JointMove (joint_move.hpp).
@@ -132,15 +133,12 @@ class KDL_SPACE_EXPORT ApproachController {
   KDL::Jacobian J_, J_base_;
   ApproachBase base_ = ApproachBase::Free;
   double fade_t0_ = 0.0, fade_ = 0.0;
-  /// The joints' rates that do the task: J+ b by damped least squares, with `clamped` joints at
-  /// their given rates (their columns out); N the null space of the free joints (n x n).
-  Eigen::VectorXd solveTask(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& fixed,
-                            const std::vector<bool>& clamped, double l2, Eigen::MatrixXd* N) const;
-  /// The joint limits (ApproachSpec::limit_zone, limit_gain) on the task's rates `qdot`: the
-  /// joints in their zones pushed away in the null space, then those whose rate would carry them
-  /// past their guard clamped there and the task re-solved by the others (their indices out).
-  void limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double l2,
-                   Eigen::VectorXd& qdot, std::vector<int>& clamped) const;
+  /// The joint limits (ApproachSpec::limit_zone, limit_gain) on the task's rates `qdot` (A the
+  /// task's rows of the Jacobian, l2 its damping): the joints in their zones pushed away in the
+  /// null space; then, if a rate would carry a joint past its guard, the rates nearest the task's
+  /// inside every guard (a box-constrained least squares: the joints held at a guard out).
+  void limitJoints(const KDL::JntArray& q, const Eigen::MatrixXd& A, double l2, Eigen::VectorXd& qdot,
+                   std::vector<int>& clamped) const;
 };
 
 /// What an approach did.
