@@ -94,7 +94,8 @@ void printCaptureSummary(std::ostream& out, const Scenario& sc, const CaptureRes
 }
 
 void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& c, const CaptureResult& r) {
-  const char* ends[3] = {"caught (the grasp locked)", "opened (a bounce)", "timed out (law.max_duration)"};
+  const char* ends[4] = {"caught (the grasp locked)", "opened (a bounce)", "timed out (law.max_duration)",
+                         "settled (the relative motion died out; the grasp stays compliant, law.lock: never)"};
   const char* rules[3] = {"", ": the relative speed fell below law.catch_tolerance",
                           ": the springs' energy passed its maximum (the hand stopped closing)"};
   out << "\nCompliant contact (law.type compliant; the impulsive capture above is its limit):\n"
@@ -104,7 +105,10 @@ void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& c, c
       << "  impulse (f; n)   " << row(c.impulse) << "\n"
       << "  impulsive        " << row(r.impulse.F) << "\n"
       << "  energy dissipated " << c.dissipated << " J, locked in the springs " << c.spring_energy
-      << " J, taken by the lock " << c.lock_loss << " J\n";
+      << " J, taken by the lock " << c.lock_loss << " J\n"
+      << "  the lock's share: " << 100.0 * c.lock_share.linear_impulse << " % of the force's impulse, "
+      << 100.0 * c.lock_share.angular_impulse << " % of the moment's, " << 100.0 * c.lock_share.energy
+      << " % of the energy taken\n";
 }
 
 }  // namespace kdl_space::cli

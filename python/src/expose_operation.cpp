@@ -125,7 +125,7 @@ py::object runOperation(const ScenarioArg& ps, py::object duration, py::object o
 
 /// The scenario's compliant law (or a stiff gripper's defaults), each keyword overriding it.
 CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damping, py::object damping_time,
-                       py::object catch_tolerance, py::object max_duration, py::object normal) {
+                       py::object catch_tolerance, py::object max_duration, py::object normal, py::object lock) {
   CompliantGrasp g = sc.compliant.value_or(CompliantGrasp{});
   if (!stiffness.is_none()) g.stiffness = vec6(stiffness, "stiffness");
   if (!damping.is_none() && !damping_time.is_none())
@@ -139,14 +139,21 @@ CompliantGrasp graspOf(const Scenario& sc, py::object stiffness, py::object damp
     if (!(n.norm() > 1e-12)) throw py::value_error("normal: has zero length");
     g.normal = n.normalized();
   }
+  if (!lock.is_none()) {
+    const std::string rule = argumentAs<std::string>(lock, "lock", "never, tolerance or spring_maximum");
+    if (rule == "never") g.lock = GraspLock::Never;
+    else if (rule == "tolerance") g.lock = GraspLock::Tolerance;
+    else if (rule == "spring_maximum") g.lock = GraspLock::SpringMaximum;
+    else throw py::value_error("lock: '" + rule + "' is not one of never, tolerance, spring_maximum");
+  }
   return g;
 }
 
 py::object solveCompliant(const ScenarioArg& ps, py::object stiffness, py::object damping, py::object damping_time,
-                          py::object catch_tolerance, py::object max_duration, py::object normal) {
+                          py::object catch_tolerance, py::object max_duration, py::object normal, py::object lock) {
   const Scenario& sc = ps.get();
   if (!sc.impact) throw py::value_error("scenario: a plain motion has no target to capture");
-  const CompliantGrasp g = graspOf(sc, stiffness, damping, damping_time, catch_tolerance, max_duration, normal);
+  const CompliantGrasp g = graspOf(sc, stiffness, damping, damping_time, catch_tolerance, max_duration, normal, lock);
   CompliantCaptureResult c;
   {
     py::gil_scoped_release nogil;
@@ -167,14 +174,15 @@ py::object solveCompliant(const ScenarioArg& ps, py::object stiffness, py::objec
 void bindOperation(py::module_& m) {
   m.def("solve_compliant_capture", &solveCompliant, py::arg("scenario"), py::kw_only(), py::arg("stiffness") = py::none(),
         py::arg("damping") = py::none(), py::arg("damping_time") = py::none(), py::arg("catch_tolerance") = py::none(),
-        py::arg("max_duration") = py::none(), py::arg("normal") = py::none(),
+        py::arg("max_duration") = py::none(), py::arg("normal") = py::none(), py::arg("lock") = py::none(),
         "The compliant capture of the scenario's target at the scenario's states (docs/COMPLIANT.md): the two "
         "systems joined at the grasp by a spring-damper, the contact integrated until it is caught or opens. The "
         "law is the scenario's `law: {type: compliant, ...}` (or a stiff gripper's defaults), each keyword "
         "overriding it: stiffness and damping per axis (x, y, z [N/m, N s/m]; about x, y, z [N m/rad, N m s/rad]) "
         "of the robot's contact link, damping_time (D = damping_time * stiffness) [s], catch_tolerance, "
-        "max_duration [s], normal (a one-sided contact). Returns the dict of `kdl_space capture --json`'s "
-        "'compliant' (end, duration, peak_force, impulse, each side's velocities after, energies, history); "
+        "max_duration [s], normal (a one-sided contact), lock (never, tolerance or spring_maximum: when the grasp "
+        "locks). Returns the dict of `kdl_space capture --json`'s 'compliant' (end, duration, peak_force, impulse, "
+        "lock_share, each side's velocities after, energies, history); "
         "solve_capture(scenario) is its impulsive limit. InputError for a parameter out of range.");
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),
         py::arg("output_step") = py::none(), py::arg("approach") = true, py::arg("motion") = true,

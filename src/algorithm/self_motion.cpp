@@ -33,8 +33,8 @@ Vector6d handError(const KDL::Frame& F, const KDL::Frame& F0) {
 
 SelfMotion::SelfMotion(std::shared_ptr<const FloatingModel> model, const Contact& h, const State& nominal)
     : model_(std::move(model)), kin_(*model_), h_(h), J_(Matrix6Xd::Zero(6, model_->nj())) {
-  if (contactCode(true, h_, model_->bodies().size()) != E_NOERROR || forwardKinematics(*model_, nominal, kin_) != E_NOERROR ||
-      pathJacobian() != E_NOERROR)
+  if (contactCode(true, h_, model_->bodies().size()) != E_NOERROR ||
+      forwardKinematics(*model_, nominal, kin_) != E_NOERROR || pathJacobian() != E_NOERROR)
     throw InputError("robot.self_motion: the arm's Jacobian cannot be computed at the scenario's state");
   for (unsigned int j = 0; j < model_->nj(); ++j)
     if (J_.col(j).norm() > 0.0) path_.push_back(static_cast<int>(j));
@@ -60,7 +60,7 @@ int SelfMotion::pathJacobian() {
   for (int b = h_.body; b >= 0; b = bodies[b].parent)
     if (bodies[b].joint >= 0) J_.col(bodies[b].joint) += shiftTwist(kin_.S[b], r);
   if (!J_.allFinite()) return E_NOT_FINITE;
-  for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(path_.size()); ++k) J_path_.col(k) = J_.col(path_[static_cast<std::size_t>(k)]);
+  for (std::size_t k = 0; k < path_.size(); ++k) J_path_.col(static_cast<Eigen::Index>(k)) = J_.col(path_[k]);
   return E_NOERROR;
 }
 
@@ -122,9 +122,9 @@ int SelfMotion::holdHand(State& state, const KDL::Frame& F0) {
 int SelfMotion::step(State& state, double h, const PathVector* previous, PathVector& v_mid) {
   PathVector v;
   if (const int rc = direction(state, previous, v)) return rc;
-  State mid = state;
-  for (Eigen::Index i = 0; i < 7; ++i) mid.q(path_[static_cast<std::size_t>(i)]) += 0.5 * h * v(i);
-  if (const int rc = direction(mid, &v, v_mid)) return rc;
+  mid_ = state;  // (its storage kept from step to step)
+  for (Eigen::Index i = 0; i < 7; ++i) mid_.q(path_[static_cast<std::size_t>(i)]) += 0.5 * h * v(i);
+  if (const int rc = direction(mid_, &v, v_mid)) return rc;
   for (Eigen::Index i = 0; i < 7; ++i) state.q(path_[static_cast<std::size_t>(i)]) += h * v_mid(i);
   return holdHand(state, F0_);
 }

@@ -1,5 +1,6 @@
 #include "kdl_space/operation/capture_operation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -95,8 +96,12 @@ void samplesIn(const FloatingModel& model, const FloatingModel& from, std::vecto
 /// brakes, the controls of simulation.target_joints); with hold_servos the PD joints hold.
 void setModesAfter(const Scenario& sc, const CaptureProblem& problem, const OperationResult& r, bool hold_servos,
                    Simulator& sim) {
-  if (r.joined && r.joined->grasp == GraspJoint::Compliant)  // caught: the grasp locked at its deflection
-    for (const int j : r.joined->grasp_joints) sim.setJointControl(static_cast<unsigned int>(j), {JointControl::Mode::Locked});
+  // A compliant grasp: locked at its deflection, or (law.lock: never) its springs and dampers on.
+  const bool springs = sc.compliant && sc.compliant->lock == GraspLock::Never;
+  if (r.joined && r.joined->grasp == GraspJoint::Compliant)
+    for (int k = 0; k < 6; ++k)
+      sim.setJointControl(static_cast<unsigned int>(r.joined->grasp_joints[static_cast<std::size_t>(k)]),
+                          springs ? sc.compliant->jointSpring(k) : JointControl{JointControl::Mode::Locked});
   if (r.joined)
     if (const auto* target = std::get_if<FloatingSystem>(&problem.target)) {
       const JoinedSystem& joint = *r.joined;
@@ -118,6 +123,9 @@ void setModesAfter(const Scenario& sc, const CaptureProblem& problem, const Oper
     for (unsigned int j = 0; j < r.model->nj(); ++j) {
       JointControl c = sim.jointControls()[j];
       if (c.mode != JointControl::Mode::PD) continue;
+      if (r.joined && std::find(r.joined->grasp_joints.begin(), r.joined->grasp_joints.end(), static_cast<int>(j)) !=
+                          r.joined->grasp_joints.end())
+        continue;  // a compliant grasp's springs hold zero deflection, not where the motion starts
       c.hold = true;
       sim.setJointControl(j, c);
     }

@@ -44,12 +44,13 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
   if (sample_rc)
     throw OperationError(sc.file + ": the compliant contact's samples cannot be evaluated: " + strError(sample_rc),
                          sample_rc, std::make_shared<const OperationResult>(r));
-  if (c.end == ContactEnd::TimedOut) {
+  const bool compliant_after = sc.compliant->lock == GraspLock::Never && c.end != ContactEnd::Opened;
+  if (c.end == ContactEnd::TimedOut && !compliant_after) {
     std::ostringstream why;
     why << std::setprecision(6) << sc.file << ": law.max_duration: the compliant contact was neither caught nor opened in "
         << sc.compliant->max_duration << " s (relative speed still above law.catch_tolerance = "
         << sc.compliant->catch_tolerance << " of its start): raise law.max_duration, the damping "
-        << "(law.damping_time or law.damping), or law.catch_tolerance";
+        << "(law.damping_time or law.damping), or law.catch_tolerance, or leave the grasp compliant (law.lock: never)";
     throw OperationError(why.str(), E_NOERROR, std::make_shared<const OperationResult>(r));
   }
   if (c.end == ContactEnd::Opened && c.duration <= 1e-9)  // the located end's resolution is 1e-10 s
@@ -61,7 +62,7 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
   SimulationState s;
   s.t = t0 + c.duration;
   std::optional<FloatingSystem> separated;
-  if (c.end == ContactEnd::Caught) {  // the grasp locked at its deflection: one system moves on
+  if (c.end == ContactEnd::Caught || compliant_after) {  // one system moves on, the grasp locked or compliant
     r.joined = c.joined;
     r.model = c.joined.model;
     s.state = c.joined.state;

@@ -149,7 +149,7 @@ std::vector<InputFile> scenarioInputs(const Scenario& sc) {
 /// contact gave, in the terms of captureJson's keys, and its history as columns.
 
 Json compliantJson(const CompliantCaptureResult& c) {
-  const char* ends[3] = {"caught", "opened", "timed_out"};
+  const char* ends[4] = {"caught", "opened", "timed_out", "settled"};
   Json history;
   std::vector<double> t;
   std::vector<Json> wrench, deflection, impulse;
@@ -170,6 +170,7 @@ Json compliantJson(const CompliantCaptureResult& c) {
                 {"momentum_after", toJson(momentum)}};  // its own, (P; L about the world origin)
   };
   const char* rules[3] = {nullptr, "tolerance", "spring_maximum"};  // what caught it (null unless caught)
+  const char* locks[3] = {"spring_maximum", "tolerance", "never"};   // law.lock
   return Json{{"end", ends[static_cast<int>(c.end)]},
               {"catch_rule", c.catch_rule == CatchRule::None ? Json(nullptr) : Json(rules[static_cast<int>(c.catch_rule)])},
               {"duration", c.duration},
@@ -178,6 +179,10 @@ Json compliantJson(const CompliantCaptureResult& c) {
               {"peak_force_wrench", toJson(c.peak_force_wrench)},
               {"impulse", toJson(c.impulse)},
               {"lock_impulse", toJson(c.lock_impulse)},
+              {"lock", locks[static_cast<int>(c.lock)]},
+              {"lock_share", Json{{"linear_impulse", c.lock_share.linear_impulse},
+                                  {"angular_impulse", c.lock_share.angular_impulse},
+                                  {"energy", c.lock_share.energy}}},
               {"robot", side(c.robot_end, c.robot_after, c.robot_momentum_after)},
               {"target", side(c.target_end, c.target_after, c.target_momentum_after)},
               {"momentum_before", toJson(c.momentum_before)},

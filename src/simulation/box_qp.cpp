@@ -42,7 +42,10 @@ Eigen::VectorXd nearestInBox(const Eigen::MatrixXd& H, const Eigen::VectorXd& u,
     Eigen::Index blocking = -1;
     for (const Eigen::Index j : F) {
       const double x = u(j) + d(j), to = step(j) > 0.0 ? hi(j) - x : lo(j) - x;
-      if (step(j) != 0.0 && std::isfinite(to) && to / step(j) < alpha) alpha = std::max(0.0, to / step(j)), blocking = j;
+      if (step(j) != 0.0 && std::isfinite(to) && to / step(j) < alpha) {
+        alpha = std::max(0.0, to / step(j));
+        blocking = j;
+      }
     }
     d += alpha * step;
     if (blocking >= 0) {

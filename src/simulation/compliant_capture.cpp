@@ -76,7 +76,9 @@ EndCriteria endCriteria(Probe& probe, const CompliantGrasp& grasp, const EndScal
   }
   // (a) caught: sqrt(qdot^T K qdot) <= catch_tolerance * its start.
   c.speed = std::sqrt(probe.relativeSpeed2(x) / at.speed2) - grasp.catch_tolerance;
-  if (!grasp.normal) {
+  if (!grasp.normal && grasp.lock != GraspLock::SpringMaximum) {
+    // Only the tolerance ends it (GraspLock::Tolerance, Never).
+  } else if (!grasp.normal) {
     // (b) caught: the first maximum of the springs' energy V = 1/2 q^T K q, where dV/dt = q^T K qdot
     // falls to 0: the hand has stopped closing (the relative motion's first rest in the springs'
     // metric). Scaled by sqrt(2 V s0) (Cauchy-Schwarz: within the relative speed's ratio): it tends
@@ -133,6 +135,7 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   if (robot.response == Response::Grounded || target.response == Response::Grounded)
     throw InputError("law.type: a compliant capture joins two free-floating systems (a grounded side is not supported)");
   CompliantCaptureResult res;
+  res.lock = grasp.lock;
   res.joined = joinAtGrasp(robot, robot.velocity, target, target.velocity, GraspJoint::Compliant);
   JoinedSystem& js = res.joined;
   const Vector6d K = grasp.stiffness, D = grasp.dampingPerAxis();
@@ -192,6 +195,8 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
     const EndCriteria c = endCriteria(probe, grasp, scales, s);
     if (c.opening <= std::min(c.speed, c.closing)) {
       end = ContactEnd::Opened;
+    } else if (grasp.lock == GraspLock::Never) {
+      end = ContactEnd::Settled;
     } else {
       end = ContactEnd::Caught;
       res.catch_rule = c.speed <= c.closing ? CatchRule::Tolerance : CatchRule::SpringMaximum;
@@ -228,6 +233,10 @@ CompliantCaptureResult solve(const FloatingSystem& robot, const FloatingSystem& 
   // the start.
   res.impulse = impulseAbout(res.robot_momentum_after, h_robot_before, p);
   if (lock_from) res.lock_impulse = impulseAbout(res.robot_momentum_after, *lock_from, p);
+  const auto share = [](double part, double whole) { return whole > 0.0 ? part / whole : 0.0; };
+  res.lock_share.linear_impulse = share(res.lock_impulse.head<3>().norm(), res.impulse.head<3>().norm());
+  res.lock_share.angular_impulse = share(res.lock_impulse.tail<3>().norm(), res.impulse.tail<3>().norm());
+  res.lock_share.energy = lock_from ? share(res.lock_loss, res.energy_before - res.energy_after) : 0.0;
   return res;
 }
 

@@ -425,6 +425,23 @@ TEST_P(Families, AnApproachWithAPreGraspReachesOrSaysWhyInsideTheLimits) {
     }
 }
 
+// a compliant grasp left compliant (law.lock: never, issue 39): the contact then the joined motion
+// with the grasp's springs on, no lock impulse, the momentum of robot and target kept throughout.
+TEST_P(Families, ACompliantGraspLeftCompliantMovesOnWithItsMomentum) {
+  const ModelFamily& f = GetParam();
+  const Scenario sc = loadScenario(writeScenario(
+      f, "{type: compliant, lock: never, stiffness: [1e5, 1e5, 1e5, 1e3, 1e3, 1e3], max_duration: 0.05}"));
+  const OperationResult r = runCaptureOperation(sc, OperationOptions{});
+  ASSERT_TRUE(r.compliant && r.joined) << f.name;
+  EXPECT_EQ(r.compliant->lock_impulse, Vector6d::Zero()) << f.name;
+  EXPECT_EQ(r.compliant->lock_share.energy, 0.0) << f.name;
+  ASSERT_FALSE(r.samples.empty()) << f.name;
+  const Vector6d h0 = r.compliant->momentum_before;
+  for (const std::vector<MotionSample>* rows : {&r.contact_samples, &r.samples})
+    for (const MotionSample& x : *rows)
+      EXPECT_LE((x.h - h0).norm(), 1e-10 * std::max(1.0, h0.norm())) << f.name << " t = " << x.t;
+}
+
 /// Six samples of a study of the family's capture scenario with these `inputs` (YAML lines): each computes.
 void expectEverySampleComputes(const ModelFamily& f, const std::string& name, const std::string& inputs) {
   const std::string scenario = writeScenario(f, "{type: capture}");

@@ -58,6 +58,7 @@ class KDL_SPACE_EXPORT SelfMotion {
   Contact h_;
   std::vector<int> path_;  ///< the joints that move the hand (model order)
   Matrix6Xd J_;            ///< the hand's Jacobian (v at the hand; w), every coordinate
+  State mid_;              ///< a step's midpoint (workspace)
   PathJacobian J_path_;
   // The walk from the last start: its state, hand frame, and checkpoints at (k + 1) kStep on
   // each side; a side stops at a failure (its code kept, returned for any s beyond it).

@@ -15,6 +15,21 @@
 
 namespace kdl_space {
 
+/// \brief When the compliant grasp locks (CompliantGrasp::lock, the scenario's law.lock).
+enum class GraspLock {
+  /// At the first instant the relative speed has fallen to catch_tolerance of its start, or
+  /// (without a normal) the springs' energy reaches its first maximum: the hand has stopped
+  /// closing. The lock (brakes) then stops the rest of the relative motion: a latching gripper.
+  SpringMaximum,
+  /// Only when the relative speed has fallen to catch_tolerance of its start: the springs and
+  /// dampers take the capture, the lock a remainder of order catch_tolerance^2 of the energy.
+  Tolerance,
+  /// Never: the contact's integration ends when the relative speed has fallen to catch_tolerance
+  /// (or at max_duration) and the grasp stays compliant in the motion after it (its six joints
+  /// PD servos to zero deflection with the grasp's stiffness and damping): no lock impulse.
+  Never,
+};
+
 /// \brief The hand's compliance: a spring-damper per axis of the robot's contact link, acting on
 /// the deflection of the grasp (GraspJoint::Compliant's six coordinates: x, y, z of the grasp
 /// point [m]; the ZYX angles about z, y, x [rad]). The defaults are a stiff gripper.
@@ -41,8 +56,20 @@ struct CompliantGrasp {
   /// speed falls below catch_tolerance (the fingers close on a target that has come to rest in
   /// the hand; not at a minimum). Empty: the grasp holds from the touch (a closed gripper).
   std::optional<Vector3d> normal;
+  /// When the grasp locks (GraspLock).
+  GraspLock lock = GraspLock::SpringMaximum;
   /// The damping per axis (damping, else damping_time * stiffness).
   Vector6d dampingPerAxis() const { return damping ? *damping : Vector6d(damping_time * stiffness); }
+  /// The spring-damper of grasp joint k (JoinedSystem::grasp_joints order: x, y, z, rz, ry, rx) as
+  /// a PD servo to zero deflection: tau = -K q - D qdot, what holds a grasp left compliant.
+  JointControl jointSpring(int k) const {
+    constexpr int axis[6] = {0, 1, 2, 5, 4, 3};  // the stiffness's axis of grasp joint k
+    JointControl c;
+    c.mode = JointControl::Mode::PD;
+    c.kp = stiffness(axis[k]);
+    c.kd = dampingPerAxis()(axis[k]);
+    return c;
+  }
 };
 
 /// One output sample of the contact.
@@ -55,8 +82,16 @@ struct ContactSample {
   Vector6d impulse = Vector6d::Zero();
 };
 
-/// How the contact ended.
-enum class ContactEnd { Caught, Opened, TimedOut };
+/// How the contact ended: caught (the grasp locked), opened (a bounce), timed out, or settled
+/// (GraspLock::Never: the relative motion died out to catch_tolerance; the grasp stays compliant).
+enum class ContactEnd { Caught, Opened, TimedOut, Settled };
+
+/// The lock's part of the capture: of the impulse's force and moment (|lock| / |whole|, each 0
+/// when the whole is 0), and of the kinetic energy the contact took (lock_loss / (energy_before
+/// - energy_after)). 0 with GraspLock::Never.
+struct LockShare {
+  double linear_impulse = 0.0, angular_impulse = 0.0, energy = 0.0;
+};
 
 /// Which criterion caught the relative motion (CompliantGrasp::catch_tolerance): its speed fell to
 /// the tolerance, or the springs' energy reached its first maximum. None unless caught.
@@ -66,6 +101,7 @@ enum class CatchRule { None, Tolerance, SpringMaximum };
 struct CompliantCaptureResult {
   ContactEnd end = ContactEnd::TimedOut;
   CatchRule catch_rule = CatchRule::None;  ///< what caught it (end == Caught)
+  GraspLock lock = GraspLock::SpringMaximum;  ///< the grasp's rule (CompliantGrasp::lock)
   /// [s]: the located instant of the catch or the opening (within 1e-10 s after it, plus the
   /// integration's error), max_duration if timed out
   double duration = 0.0;
@@ -96,6 +132,7 @@ struct CompliantCaptureResult {
   double dissipated = 0.0;     ///< the dampers' work taken [J]
   double spring_energy = 0.0;  ///< held in the springs at the end (locked in by a catch) [J]
   double lock_loss = 0.0;      ///< taken by the lock of the residual relative motion [J]
+  LockShare lock_share;        ///< the lock's part of the impulse and of the energy taken
   long steps = 0;              ///< the integrator's accepted steps
 };
 

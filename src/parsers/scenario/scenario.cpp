@@ -13,6 +13,7 @@
 #include "parsers/scenario/scenario_approach.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
 #include "parsers/scenario/scenario_mount.hpp"
+#include "parsers/scenario/scenario_law.hpp"
 #include "parsers/scenario/scenario_sections.hpp"
 
 namespace kdl_space {
@@ -245,80 +246,6 @@ IkResult placeAtGrasp(const Field& robot_f, FloatingSystem& robot, const KDL::Fr
   }
 }
 
-/// `law: {type: compliant}`: the hand's spring-damper, every field optional (CompliantGrasp's
-/// defaults, a stiff gripper). Its impulsive limit is the rigid capture.
-CompliantGrasp compliantLaw(const Field& f) {
-  f.onlyKeys({"type", "normal", "stiffness", "damping", "damping_time", "catch_tolerance", "max_duration"});
-  CompliantGrasp g;
-  const auto six = [&](const char* key, bool zero_ok) {
-    const Vector6d v = f.at(key).vector(6);
-    for (int k = 0; k < 6; ++k)
-      if (v(k) < 0.0 || (!zero_ok && v(k) == 0.0))
-        f.at(key).fail(std::string("each value must be ") + (zero_ok ? ">= 0" : "> 0") + " (x, y, z [N/m or N s/m]; about "
-                       "x, y, z [N m/rad or N m s/rad]), got " + number(v(k)));
-    return v;
-  };
-  if (f.has("stiffness")) g.stiffness = six("stiffness", false);
-  if (f.has("damping") && f.has("damping_time"))
-    f.at("damping_time").fail("give damping (per axis) or damping_time (D = damping_time * stiffness), not both");
-  if (f.has("damping")) g.damping = six("damping", true);
-  const auto positive = [&](const char* key, double& value, double upper) {
-    if (!f.has(key)) return;
-    value = f.at(key).number();
-    if (!(value >= 0.0) || value > upper || (value == 0.0 && std::string(key) != "damping_time"))
-      f.at(key).fail("must be " + std::string(std::string(key) == "damping_time" ? ">= 0" : "> 0") +
-                     (upper < 1e300 ? " and < " + number(upper) : std::string()) + ", got " + number(value));
-  };
-  positive("damping_time", g.damping_time, 1e308);
-  positive("max_duration", g.max_duration, 1e308);
-  positive("catch_tolerance", g.catch_tolerance, 1.0);
-  if (g.catch_tolerance >= 1.0) f.at("catch_tolerance").fail("must be < 1, got " + number(g.catch_tolerance));
-  if (f.has("normal")) {
-    const Vector3d n = f.at("normal").vector(3);
-    if (!(n.norm() > 1e-12)) f.at("normal").fail("has zero length");
-    g.normal = n.normalized();
-  }
-  return g;
-}
-
-/// The impact law; `has_normal` is set when a normal is given.
-ImpactLaw law(const Field& f, bool& has_normal) {
-  ImpactLaw l;
-  if (f.at("type").text() == "compliant") {  // the impulsive limit: a rigid capture
-    has_normal = f.has("normal");
-    if (has_normal) l.normal = f.at("normal").vector(3).normalized();
-    return l;
-  }
-  f.onlyKeys({"type", "normal", "restitution", "friction"});
-  const std::string type = f.at("type").text();
-  if (type == "capture") l.kind = ImpactKind::Capture;
-  else if (type == "point") l.kind = ImpactKind::PointImpact;
-  else if (type == "friction") l.kind = ImpactKind::FrictionalImpact;
-  else if (type == "translational") l.kind = ImpactKind::TranslationalCapture;
-  else f.at("type").fail(echo(type) + " is not one of capture, point, friction, translational, compliant");
-  const bool point = l.kind == ImpactKind::PointImpact || l.kind == ImpactKind::FrictionalImpact;
-  has_normal = f.has("normal");
-  if (point && !has_normal) f.at("normal");  // reports "missing"
-  if (has_normal) {
-    const Vector3d n = f.at("normal").vector(3);
-    if (!(n.norm() > 1e-12)) f.at("normal").fail("has zero length");
-    l.normal = n.normalized();
-  }
-  if (f.has("restitution")) {
-    l.restitution = f.at("restitution").number();
-    if (l.restitution < 0.0 || l.restitution > 1.0) f.at("restitution").fail("must lie in [0, 1], got " + number(l.restitution));
-  } else if (point) {
-    f.at("restitution");  // reports "missing"
-  }
-  if (f.has("friction")) {
-    l.friction = f.at("friction").number();
-    if (l.friction < 0.0) f.at("friction").fail("must be >= 0, got " + number(l.friction));
-  } else if (l.kind == ImpactKind::FrictionalImpact) {
-    f.at("friction");  // reports "missing"
-  }
-  return l;
-}
-
 // --- The approach of a free-floating robot target (issue 28) -----------------------------------
 
 /// `approach` for a free-floating robot target: the grasp frame in the frame of the target's
@@ -421,8 +348,8 @@ Scenario loadScenario(const std::string& path) {
     }
     if (s.grasp_solution) s.grasp_frame = pose(robot.at("grasp").at("target_frame"));
     if (target.has("grasp")) target.at("grasp").fail("the grasp frame is the robot's field: robot.grasp.target_frame");
-    s.capture.law = law(top.at("law"), s.capture.has_normal);
-    if (top.at("law").at("type").text() == "compliant") s.compliant = compliantLaw(top.at("law"));
+    s.capture.law = laws::law(top.at("law"), s.capture.has_normal);
+    if (top.at("law").at("type").text() == "compliant") s.compliant = laws::compliantLaw(top.at("law"));
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
   }
