@@ -27,35 +27,12 @@
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/parsers/scenario/scenario.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
+#include "compliant_checks.hpp"
 
 namespace kdl_space::test {
 namespace {
 
-CaptureProblem scenarioProblem() {
-  return loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/robot_to_robot_capture.yaml").capture;
-}
-
-Vector6d twistOf(const KDL::Twist& t) { return (Vector6d() << toEigen(t.vel), toEigen(t.rot)).finished(); }
-
-/// The largest relative error of the compliant result against the impulsive capture: the
-/// impulse, then each side's base twist and joint rates (relative to the side's velocity scale
-/// after the impulsive capture: its base twist's norm plus its rates').
-double captureError(const CompliantCaptureResult& c, const CaptureResult& r) {
-  double e = (c.impulse - r.impulse.F).norm() / r.impulse.F.norm();
-  const auto side = [&](const FloatingVelocity& a, const FloatingVelocity& b) {
-    const double scale = twistOf(b.base_twist).norm() + b.qdot.data.norm();
-    e = std::max(e, (twistOf(a.base_twist) - twistOf(b.base_twist)).norm() / scale);
-    e = std::max(e, (a.qdot.data - b.qdot.data).norm() / scale);
-  };
-  side(c.robot_after, r.robot.after);
-  if (r.floating_target) {
-    side(c.target_after, r.floating_target->after);
-  } else {  // a rigid target: one body, its base frame at the CoM (its twist: CaptureResult's)
-    const Vector6d& b = r.target_twist_after;
-    e = std::max(e, (twistOf(c.target_after.base_twist) - b).norm() / b.norm());
-  }
-  return e;
-}
+CaptureProblem scenarioProblem() { return loadScenario(robotToRobotScenario()).capture; }
 
 /// A line of the measured convergence (the test's output; docs/COMPLIANT.md's tables).
 void print(double K, const CompliantCaptureResult& c, double error) {

@@ -23,30 +23,18 @@
 #include "kdl_space/impact/capture.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
 #include "kdl_space/simulation/compliant_capture.hpp"
+#include "compliant_checks.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space {
 namespace {
 
+using test::captureError;
+using test::compliantScenario;
+using test::momentumOf;
 using test::near;
 
-const std::string kScenario = std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/robot_to_robot_capture.yaml";
-
-Vector6d twistOf(const KDL::Twist& t) { return (Vector6d() << toEigen(t.vel), toEigen(t.rot)).finished(); }
-
-/// The largest relative error of the compliant result against the impulsive capture (the
-/// impulse; each side's base twist and rates relative to its velocity scale after).
-double captureError(const CompliantCaptureResult& c, const CaptureResult& r) {
-  double e = (c.impulse - r.impulse.F).norm() / r.impulse.F.norm();
-  const auto side = [&](const FloatingVelocity& a, const FloatingVelocity& b) {
-    const double scale = twistOf(b.base_twist).norm() + b.qdot.data.norm();
-    e = std::max(e, (twistOf(a.base_twist) - twistOf(b.base_twist)).norm() / scale);
-    e = std::max(e, (a.qdot.data - b.qdot.data).norm() / scale);
-  };
-  side(c.robot_after, r.robot.after);
-  side(c.target_after, r.floating_target->after);
-  return e;
-}
+const std::string& kScenario = test::robotToRobotScenario();
 
 CompliantGrasp gripper(double K, GraspLock lock) {
   CompliantGrasp g;
@@ -122,25 +110,6 @@ TEST(CompliantLock, OnASoftGripperTheEnergyMaximumLocksEarlyAndTheToleranceLeave
   EXPECT_LT(late.lock_share.linear_impulse, 0.05);
   EXPECT_LT(late.lock_share.angular_impulse, 0.05);
   EXPECT_LT(late.lock_share.energy, 1e-3);
-}
-
-/// robot_to_robot_capture.yaml with a compliant law and a second of motion after the contact.
-Scenario compliantScenario(const CompliantGrasp& grasp) {
-  Scenario sc = loadScenario(kScenario);
-  sc.compliant = grasp;
-  sc.simulation.duration = 1.0;
-  sc.simulation.output_step = 0.05;
-  sc.simulation.options.rtol = 1e-11;
-  sc.simulation.options.atol = 1e-13;
-  return sc;
-}
-
-Vector6d momentumOf(const FloatingSystem& s) {
-  Kinematics kin(*s.model);
-  EXPECT_EQ(forwardKinematics(*s.model, s.state, kin), E_NOERROR);
-  MomentumSolver m(s.model);
-  EXPECT_EQ(m.compute(kin, s.velocity), E_NOERROR);
-  return m.momentum();
 }
 
 void expectCompliantAfter(const Scenario& sc, ContactEnd end) {

@@ -9,33 +9,15 @@
 
 #include "kdl_space/algorithm/momentum.hpp"
 #include "kdl_space/operation/capture_operation.hpp"
+#include "compliant_checks.hpp"
 #include "test_util.hpp"
 
 namespace kdl_space {
 namespace {
 
+using test::compliantScenario;
+using test::momentumOf;
 using test::near;
-
-/// robot_to_robot_capture.yaml (two free-floating systems at their touch), with a compliant law
-/// and a second of motion after the contact (no servos: the joined system moves freely).
-Scenario compliantScenario(const CompliantGrasp& grasp = {}) {
-  Scenario sc = loadScenario(std::string(KDL_SPACE_SOURCE_DIR) + "/scenarios/robot_to_robot_capture.yaml");
-  sc.compliant = grasp;
-  sc.simulation.duration = 1.0;
-  sc.simulation.output_step = 0.05;
-  sc.simulation.options.rtol = 1e-11;
-  sc.simulation.options.atol = 1e-13;
-  return sc;
-}
-
-/// A system's momentum (P; L about the world origin), computed on its own.
-Vector6d momentumOf(const FloatingSystem& s) {
-  Kinematics kin(*s.model);
-  EXPECT_EQ(forwardKinematics(*s.model, s.state, kin), E_NOERROR);
-  MomentumSolver m(s.model);
-  EXPECT_EQ(m.compute(kin, s.velocity), E_NOERROR);
-  return m.momentum();
-}
 
 /// Both sides' momentum before the contact, each from its own model.
 Vector6d momentumBefore(const Scenario& sc) {
