@@ -439,7 +439,7 @@ TEST_P(Families, ACompliantGraspLeftCompliantMovesOnWithItsMomentum) {
   const Vector6d h0 = r.compliant->momentum_before;
   for (const std::vector<MotionSample>* rows : {&r.contact_samples, &r.samples})
     for (const MotionSample& x : *rows)
-      EXPECT_LE((x.h - h0).norm(), 1e-10 * std::max(1.0, h0.norm())) << f.name << " t = " << x.t;
+      EXPECT_LE((x.h - h0).norm(), 1e-12 * std::max(1.0, h0.norm())) << f.name << " t = " << x.t;
 }
 
 /// Six samples of a study of the family's capture scenario with these `inputs` (YAML lines): each computes.
