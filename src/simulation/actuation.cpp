@@ -32,4 +32,25 @@ Vector6d baseControlWrench(const BaseControl& control, const KDL::Frame& world_T
   return w;
 }
 
+void wheelTorques(const ReactionWheels& wheels, const Eigen::MatrixXd& split, const Matrix3d& R, const Vector3d& n,
+                  const Eigen::VectorXd& h, Eigen::VectorXd& u, bool& saturated) {
+  u.noalias() = -split * (R.transpose() * n);
+  for (Eigen::Index i = 0; i < wheels.count(); ++i) {
+    const double limit = wheels.torque_limit(i);
+    if (std::abs(u(i)) > limit) {
+      u(i) = std::copysign(limit, u(i));
+      saturated = true;
+    }
+    if (std::abs(h(i)) >= wheels.capacity(i) && u(i) * h(i) > 0.0) {  // at its top speed
+      u(i) = 0.0;
+      saturated = true;
+    }
+  }
+}
+
+Vector3d wheelReaction(const ReactionWheels& wheels, const Matrix3d& R, const Vector3d& w, const Eigen::VectorXd& h,
+                       const Eigen::VectorXd& u) {
+  return -R * (wheels.axes * u) - w.cross(R * (wheels.axes * h));
+}
+
 }  // namespace kdl_space

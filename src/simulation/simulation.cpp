@@ -47,29 +47,52 @@ Simulator::Simulator(std::shared_ptr<const FloatingModel> model, SimulationOptio
   tau_extra_ = KDL::JntArray(n);
   acc_.qddot = KDL::JntArray(n);
   f_ext_.assign(this->model().bodies().size(), KDL::Wrench::Zero());
-  const detail::StateLayout layout(n);
-  const int size = layout.size;
-  x_.setZero(size);
-  x_tmp_.setZero(size);
-  x_new_.setZero(size);
-  x_prev_.setZero(size);
-  x_event_.setZero(size);
-  x_located_.setZero(size);
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   if (!positive(options_.step) || !positive(options_.rtol) || !positive(options_.atol) ||
       !positive(options_.max_step) || options_.max_steps <= 0 || !positive(options_.friction_velocity) || !positive(options_.friction_rate))
     throw ModelError(
         "simulation: step, rtol, atol, max_step, max_steps, friction_velocity and friction_rate must be finite and > 0");
   equations_ = std::make_unique<Equations>(*this);
-  // ModelError for an integrator that is no enumerator.
-  stepper_ = detail::makeStepper(options_.integrator, *equations_, size,
-                                 detail::ErrorControl{options_.rtol, options_.atol, layout.work});
+  sizeState();  // ModelError for an integrator that is no enumerator
   if (!options_.gravity.allFinite()) throw ModelError("simulation: gravity must be finite");
   dynamics_->setGravity(options_.gravity);
   dynamics_->setGrounded(options_.grounded);
 }
 
 Simulator::~Simulator() = default;
+
+detail::StateLayout Simulator::layout() const { return detail::StateLayout(model().nj(), wheels_.count()); }
+
+void Simulator::sizeState() {
+  const detail::StateLayout L = layout();
+  for (Vector* v : {&x_, &x_tmp_, &x_new_, &x_prev_, &x_event_, &x_located_}) v->setZero(L.size);
+  stepper_ = detail::makeStepper(options_.integrator, *equations_, L.size,
+                                 detail::ErrorControl{options_.rtol, options_.atol, L.work});
+  wheel_u_.setZero(L.m);
+  scratch_.wheel_momentum.setZero(L.m);
+  scratch_.wheel_torque.setZero(L.m);
+}
+
+void Simulator::setReactionWheels(const ReactionWheels& wheels) {
+  const Eigen::Index m = wheels.count();
+  const auto positive = [](const Eigen::VectorXd& v) { return !v.hasNaN() && (v.array() > 0.0).all(); };
+  if (!wheels.axes.allFinite())
+    throw ModelError("simulation: reaction wheels: the axes must be finite");
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (wheels.axes.col(i).norm() < 1e-9)
+      throw ModelError("simulation: reaction wheel " + std::to_string(i + 1) + ": its axis is zero");
+  if (wheels.torque_limit.size() != m || wheels.capacity.size() != m)
+    throw ModelError("simulation: reaction wheels: one torque limit and one capacity per wheel (" +
+                     std::to_string(m) + " wheels)");
+  if (!positive(wheels.torque_limit) || !positive(wheels.capacity))
+    throw ModelError("simulation: reaction wheels: torque limits and capacities must be > 0 (infinity: none)");
+  if (m > 0 && options_.grounded)
+    throw ModelError("simulation: reaction wheels: the base is grounded (held still): they have nothing to turn");
+  wheels_ = wheels;
+  wheels_.axes.colwise().normalize();
+  wheel_split_ = wheels_.axes.completeOrthogonalDecomposition().pseudoInverse();
+  sizeState();
+}
 
 void Simulator::setJointControl(unsigned int joint, const JointControl& control) {
   if (joint >= controls_.size())
@@ -139,9 +162,12 @@ void Simulator::applyLocks() {
 }
 
 int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O) {
+  const Eigen::Index m = wheels_.count();
+  if (s.wheel_momentum.size() != 0 && s.wheel_momentum.size() != m) return E_SIZE_MISMATCH;
   if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;
   if (const int rc = momentum_.compute(kin_, s.velocity)) return rc;
   h_O = momentum_.momentum();
+  if (s.wheel_momentum.size() != 0) h_O.tail<3>() += kin_.R[0] * (wheels_.axes * s.wheel_momentum);
   T = momentum_.kineticEnergy();
   return E_NOERROR;
 }
@@ -159,11 +185,12 @@ int Simulator::actuation(SimulationState& s) {
   if (s.tau.rows() != n) s.tau = KDL::JntArray(n);
   s.tau.data = scratch_.tau.data;
   s.base_wrench = scratch_.base_wrench;
+  s.wheel_torque = wheel_u_;
   return E_NOERROR;
 }
 
 void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const {
-  const detail::StateLayout L(model().nj());
+  const detail::StateLayout L = layout();
   const KDL::Frame& T = s.state.world_T_base;
   double qx, qy, qz, qw;
   T.M.GetQuaternion(qx, qy, qz, qw);
@@ -172,13 +199,15 @@ void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) c
   x.segment(L.q, L.n) = s.state.q.data;
   x.segment<6>(L.h) = h_O;
   x.segment(L.qdot, L.n) = s.velocity.qdot.data;
+  if (s.wheel_momentum.size() == L.m) x.segment(L.wheels, L.m) = s.wheel_momentum;
+  else x.segment(L.wheels, L.m).setZero();
   x.segment<6>(L.work) << s.work.controller, s.work.friction, s.work.limits, s.work.base_control, s.work.wrenches,
       s.work.gravity;
   x.segment<6>(L.impulse) = s.impulse;
 }
 
 int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
-  const detail::StateLayout L(model().nj());
+  const detail::StateLayout L = layout();
   if (!x.allFinite()) return E_NOT_FINITE;
   const Eigen::Vector4d quat = x.segment<4>(3).normalized();
   s.t = t;
@@ -189,19 +218,22 @@ int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
   const auto w = x.segment<6>(L.work);
   s.work = EnergySplit{w(0), w(1), w(2), w(3), w(4), w(5)};
   s.impulse = x.segment<6>(L.impulse);
+  s.wheel_momentum = x.segment(L.wheels, L.m);
   if (const int rc = forwardKinematics(*model_, s.state, kin_)) return rc;  // the one pass of this stage
   if (options_.grounded) {
     s.velocity.base_twist = KDL::Twist::Zero();
     return E_NOERROR;
   }
-  return momentum_.baseTwist(kin_, x.segment<6>(L.h), s.velocity.qdot, s.velocity.base_twist);  // eq. 2
+  Vector6d h = x.segment<6>(L.h);  // the system's with its wheels: the links' alone for eq. 2
+  if (L.m > 0) h.tail<3>() -= kin_.R[0] * (wheels_.axes * s.wheel_momentum);
+  return momentum_.baseTwist(kin_, h, s.velocity.qdot, s.velocity.base_twist);  // eq. 2
 }
 
 int Simulator::derivative(double t, const Vector& x, Vector& dx) {
-  const detail::StateLayout L(model().nj());
+  const detail::StateLayout L = layout();
   if (const int rc = unpack(x, t, scratch_)) return rc;
   if (const int rc = actuate(t, x)) return rc;
-  const bool external = base_control_.on() || !wrenches_.empty();
+  const bool external = base_control_.on() || !wrenches_.empty() || L.m > 0;
   static const std::vector<KDL::Wrench> none;
   if (const int rc = dynamics_->CartToJnt(kin_, scratch_.velocity, scratch_.tau, external ? f_ext_ : none, acc_))
     return rc;
@@ -213,6 +245,7 @@ int Simulator::derivative(double t, const Vector& x, Vector& dx) {
   dx.segment(L.q, L.n) = x.segment(L.qdot, L.n);
   dx.segment<6>(L.h) = options_.grounded ? Vector6d::Zero() : external_;  // dh_O/dt: the external wrench
   dx.segment(L.qdot, L.n) = acc_.qddot.data;
+  dx.segment(L.wheels, L.m) = wheel_u_;
   const auto& qdot = scratch_.velocity.qdot.data;
   dx.segment<6>(L.work) << tau_control_.data.dot(qdot), tau_friction_.data.dot(qdot), 0.0, external_power_[0],
       external_power_[1], external_power_[2];
@@ -242,6 +275,8 @@ int Simulator::publish(const Vector& x, double t, SimulationState& s) {
   s.base_wrench = scratch_.base_wrench;
   s.work = scratch_.work;
   s.impulse = scratch_.impulse;
+  s.wheel_momentum = scratch_.wheel_momentum;  // sized by run(): no allocation
+  s.wheel_torque = wheel_u_;
   return E_NOERROR;
 }
 
@@ -260,7 +295,8 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   stats_.accepted_steps = stats_.rejected_steps = 0;
   stats_.min_step = kInf;
   stats_.max_step = 0.0;
-  stats_.base_saturation_time = 0.0;
+  stats_.base_saturation_time = stats_.wheel_saturation_time = 0.0;
+  stats_.wheel_saturation_first_time = std::numeric_limits<double>::quiet_NaN();
   stats_.event_time = std::numeric_limits<double>::quiet_NaN();
   std::fill(stats_.joints.begin(), stats_.joints.end(), JointRecord{});
   if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
@@ -268,6 +304,10 @@ int Simulator::run(SimulationState& s, double t_end, double output_dt,
   if (!(output_dt > 0.0) || t_end < s.t) return E_BAD_ARGUMENT;
   if (options_.grounded && toEigen(s.velocity.base_twist) != Vector6d::Zero()) return E_BAD_ARGUMENT;
   if (s.tau.rows() != n) s.tau = KDL::JntArray(n);  // an output: sized once
+  if (s.wheel_momentum.size() == 0) s.wheel_momentum.setZero(wheels_.count());
+  if (s.wheel_momentum.size() != wheels_.count()) return E_SIZE_MISMATCH;
+  if (!s.wheel_momentum.allFinite()) return E_NOT_FINITE;
+  s.wheel_torque.setZero(wheels_.count());
   s.work = EnergySplit{};
   s.impulse.setZero();
   if (const int rc = startRun(s)) return rc;

@@ -58,7 +58,7 @@ int Simulator::actuate(double t, const Vector& x) {
   external_.setZero();
   std::fill(std::begin(external_power_), std::end(external_power_), 0.0);
   scratch_.base_wrench.setZero();
-  base_saturated_ = false;
+  base_saturated_ = wheel_saturated_ = false;
   const auto apply = [&](int body, const Vector3d& r, const Vector3d& f, const Vector3d& m, double& power) {
     f_ext_[body].force += toKDL(f);
     f_ext_[body].torque += toKDL(m + (r - kin_.p[body]).cross(f));
@@ -67,12 +67,26 @@ int Simulator::actuate(double t, const Vector& x) {
     const Vector6d V = bodyTwist(model(), kin_, scratch_.velocity, body);
     power += f.dot(V.head<3>() + V.tail<3>().cross(r - kin_.p_b)) + m.dot(V.tail<3>());
   };
-  if (base_control_.on() || !wrenches_.empty()) {
+  const bool wheels = wheels_.count() > 0;
+  if (base_control_.on() || !wrenches_.empty() || wheels) {
     std::fill(f_ext_.begin(), f_ext_.end(), KDL::Wrench::Zero());
     if (base_control_.on()) {
       scratch_.base_wrench = baseControlWrench(base_control_, scratch_.state.world_T_base,
                                                scratch_.velocity.base_twist, &base_saturated_);
-      apply(0, kin_.com[0], scratch_.base_wrench.head<3>(), scratch_.base_wrench.tail<3>(), external_power_[0]);
+      // With wheels the attitude torque is theirs (below), an internal one.
+      const Vector3d thrust_torque = wheels ? Vector3d::Zero() : Vector3d(scratch_.base_wrench.tail<3>());
+      apply(0, kin_.com[0], scratch_.base_wrench.head<3>(), thrust_torque, external_power_[0]);
+    }
+    if (wheels) {  // the wheels' motors, and the reaction the bus feels (a couple: no momentum changes)
+      const Vector3d w = toEigen(scratch_.velocity.base_twist.rot);
+      wheel_u_.setZero();
+      if (base_control_.attitude.on)
+        wheelTorques(wheels_, wheel_split_, kin_.R[0], scratch_.base_wrench.tail<3>(), scratch_.wheel_momentum,
+                     wheel_u_, wheel_saturated_);
+      const Vector3d n = wheelReaction(wheels_, kin_.R[0], w, scratch_.wheel_momentum, wheel_u_);
+      scratch_.base_wrench.tail<3>() = n;
+      f_ext_[0].torque += toKDL(n);
+      external_power_[0] += n.dot(w);
     }
     for (const ScheduledWrench& w : wrenches_) {
       if (!w.activeAt(std::isnan(wrench_clock_) ? t : wrench_clock_)) continue;
@@ -93,7 +107,7 @@ int Simulator::actuate(double t, const Vector& x) {
       if (const int rc = momentum_.compute(kin_, scratch_.velocity)) return rc;
       external_power_[2] = options_.gravity.dot(momentum_.momentum().head<3>());
     } else {
-      external_power_[2] = options_.gravity.dot(x.segment<3>(detail::StateLayout(model().nj()).h));
+      external_power_[2] = options_.gravity.dot(x.segment<3>(layout().h));
     }
   }
   return E_NOERROR;
@@ -154,7 +168,7 @@ int Simulator::stopJoints(SimulationState& s, const std::vector<unsigned int>& j
 }
 
 double Simulator::overshoot(const Vector& x) const {
-  const detail::StateLayout L(model().nj());
+  const detail::StateLayout L = layout();
   double worst = -std::numeric_limits<double>::infinity();
   for (int j = 0; j < L.n; ++j) {
     if (limit_modes_[j] != LimitMode::Stop || at_stop_[j] || controls_[j].mode == JointControl::Mode::Locked) continue;
@@ -211,7 +225,7 @@ int Simulator::startRun(SimulationState& s) {
 }
 
 int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& t, Vector& x) {
-  const detail::StateLayout L(model().nj());
+  const detail::StateLayout L = layout();
   const std::vector<JointProperties>& props = model().jointProperties();
   // Saturation over the step, as seen by its last evaluation (resolution: one step).
   for (int j = 0; j < L.n; ++j) {
@@ -221,6 +235,10 @@ int Simulator::afterStep(double t_prev, double h, const Vector& x_prev, double& 
     r.saturation_time += t - t_prev;
   }
   if (base_saturated_) stats_.base_saturation_time += t - t_prev;
+  if (wheel_saturated_) {
+    if (std::isnan(stats_.wheel_saturation_first_time)) stats_.wheel_saturation_first_time = t_prev;
+    stats_.wheel_saturation_time += t - t_prev;
+  }
 
   // 1. A hard stop crossed: the instant located by the Illinois method on the step's length.
   std::fill(just_stopped_.begin(), just_stopped_.end(), false);

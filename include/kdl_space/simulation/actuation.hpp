@@ -5,6 +5,7 @@
 #pragma once
 
 #include <kdl/frames.hpp>
+#include <Eigen/Core>
 #include <cmath>
 #include <limits>
 
@@ -83,6 +84,34 @@ struct BaseControl {
 /// base's; `saturated` tells whether a limit was reached on any axis.
 KDL_SPACE_EXPORT Vector6d baseControlWrench(const BaseControl& control, const KDL::Frame& world_T_base,
                                             const KDL::Twist& base_twist, bool* saturated = nullptr);
+
+/// \brief Reaction wheels fixed in the base: a cluster of m wheels, one column of `axes` per wheel
+/// (its spin axis in the base's axes; normalised by Simulator::setReactionWheels). Each wheel's
+/// momentum h_i about its axis [N m s] is part of the simulated state; its motor's torque
+/// u_i = dh_i/dt is limited to +-torque_limit_i, and to zero in the direction past its momentum
+/// capacity +-capacity_i (the wheel at its top speed: saturated). The bus feels the reaction
+/// -d/dt (R A h) = -R A u - w x R A h (world axes; R the base's orientation, w its angular rate):
+/// an internal torque, so the momentum of the system with its wheels, (P; L + R A h), is
+/// invariant. The wheels' rotor inertia is taken as part of the base's (as SpaceDyn's and
+/// Basilisk's simple wheel models): their spin energy is not counted, their motors' work on the
+/// bus is (EnergySplit::base_control).
+struct ReactionWheels {
+  Eigen::Matrix<double, 3, Eigen::Dynamic> axes;  ///< 3 x m, base axes
+  Eigen::VectorXd torque_limit;                   ///< m [N m], > 0 (infinity: none)
+  Eigen::VectorXd capacity;                       ///< m [N m s], > 0 (infinity: none)
+  Eigen::Index count() const { return axes.cols(); }
+};
+
+/// \brief The wheels' motor torques u (m) for a torque n wanted on the bus (world axes, the base
+/// control's): u = -A+ (R^T n) by the least-norm split `split` = A+ (m x 3), then each limited to
+/// +-torque_limit_i and set to zero where it would drive |h_i| past capacity_i. `saturated` tells
+/// whether a limit acted. The gyroscopic part of the reaction (wheelReaction) is not compensated.
+KDL_SPACE_EXPORT void wheelTorques(const ReactionWheels& wheels, const Eigen::MatrixXd& split, const Matrix3d& R,
+                                   const Vector3d& n, const Eigen::VectorXd& h, Eigen::VectorXd& u, bool& saturated);
+
+/// \brief The torque the wheels exert on the bus (world axes): -R A u - w x (R A h).
+KDL_SPACE_EXPORT Vector3d wheelReaction(const ReactionWheels& wheels, const Matrix3d& R, const Vector3d& w,
+                                        const Eigen::VectorXd& h, const Eigen::VectorXd& u);
 
 /// \brief An external wrench on a body over a time window (a thruster firing, a push): the force
 /// f acts at `point` (in the body's frame) and the couple n is added; both in world axes, or in

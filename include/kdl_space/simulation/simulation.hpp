@@ -20,6 +20,7 @@ namespace kdl_space {
 namespace detail {
 class Dynamics;
 class Stepper;
+struct StateLayout;
 }  // namespace detail
 
 /// Integration settings and what acts on every joint; all are the user's.
@@ -72,6 +73,9 @@ struct SimulationState {
   /// about the world origin) integrated. A free base's momentum changes by exactly this (a
   /// grounded base's also by what the ground takes, which is not counted).
   Vector6d impulse = Vector6d::Zero();
+  /// The reaction wheels' momenta about their axes [N m s] (Simulator::setReactionWheels; empty:
+  /// none, or all zero at the start of a run), and, an output, their motors' torques [N m].
+  Eigen::VectorXd wheel_momentum, wheel_torque;
 };
 
 /// Joint torques from the user's own controller, added to those of the joint modes.
@@ -93,6 +97,10 @@ struct SimulationStats {
   double min_step = 0.0, max_step = 0.0;  ///< of the accepted steps (outputs' slivers excluded)
   std::vector<JointRecord> joints;         ///< model order
   double base_saturation_time = 0.0;       ///< how long the base control was limited
+  /// How long a reaction wheel was at its torque limit or its momentum capacity, and when first
+  /// (NaN: never).
+  double wheel_saturation_time = 0.0;
+  double wheel_saturation_first_time = std::numeric_limits<double>::quiet_NaN();
   /// When the stop event (Simulator::setStopEvent) ended the run: the located instant [s]; NaN
   /// if it did not (no event, or not met before t_end, or the run failed).
   double event_time = std::numeric_limits<double>::quiet_NaN();
@@ -153,6 +161,14 @@ class KDL_SPACE_EXPORT Simulator {
   /// that is no rotation, or a base control on a grounded base.
   void setBaseControl(const BaseControl& control);
   const BaseControl& baseControl() const { return base_control_; }
+  /// \brief Reaction wheels in the base (ReactionWheels): their momenta join the state
+  /// (SimulationState::wheel_momentum) and the momentum energyAndMomentum reports; the base
+  /// control's attitude torque is then theirs (wheelTorques: no external torque, the momentum of
+  /// the system with its wheels is invariant), its force still an external one (thrusters).
+  /// \throws ModelError for axes that are not finite or zero, limits or capacities that are not
+  /// > 0 (or sized unlike the axes), or a grounded base.
+  void setReactionWheels(const ReactionWheels& wheels);
+  const ReactionWheels& reactionWheels() const { return wheels_; }
   /// \throws ModelError for a body out of range, a value not finite, or end <= start.
   void addWrench(const ScheduledWrench& wrench);
   const std::vector<ScheduledWrench>& wrenches() const { return wrenches_; }
@@ -212,8 +228,10 @@ class KDL_SPACE_EXPORT Simulator {
   int run(SimulationState& s, double t_end, double output_dt,
           const std::function<void(const SimulationState&)>& observer);
 
-  /// Kinetic energy and momentum (P; L about the world origin) of a state, in O(n). \return 0 or
-  /// the code of forwardKinematics / MomentumSolver::compute; T and h_O untouched on an error.
+  /// Kinetic energy and momentum (P; L about the world origin) of a state, in O(n); with reaction
+  /// wheels, L includes theirs (R A h: T does not, their rotors' inertia being the base's).
+  /// \return 0, E_SIZE_MISMATCH (s.wheel_momentum neither empty nor one per wheel) or the code of
+  /// forwardKinematics / MomentumSolver::compute; T and h_O untouched on an error.
   int energyAndMomentum(const SimulationState& s, double& T, Vector6d& h_O);
   /// The joint torques (controls limited, plus friction) and the base control's wrench that act
   /// at s, into s.tau and s.base_wrench as run() reports them at an output (the torque callback
@@ -238,6 +256,9 @@ class KDL_SPACE_EXPORT Simulator {
   /// unit torque from rest), with the dynamics' locks.
   int apparentInertia(unsigned int j, double& m);
   using Vector = Eigen::VectorXd;
+  detail::StateLayout layout() const;
+  /// The integrated state's vectors and stepper sized for the joints and wheels.
+  void sizeState();
   void pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const;
   int unpack(const Vector& x, double t, SimulationState& s);
   /// unpack() into the scratch state with its torques and work, then copied into s only if it
@@ -292,6 +313,10 @@ class KDL_SPACE_EXPORT Simulator {
   std::vector<bool> locked_now_;  ///< braked or at a stop: what the dynamics hold
   std::vector<double> friction_velocity_;  ///< v_s per joint
   BaseControl base_control_;
+  ReactionWheels wheels_;
+  Eigen::MatrixXd wheel_split_;  ///< A+ (m x 3): the least-norm split of a torque among the wheels
+  Eigen::VectorXd wheel_u_;      ///< the wheels' motor torques at the last actuate()
+  bool wheel_saturated_ = false;
   std::vector<ScheduledWrench> wrenches_;
   TorqueCallback callback_;
   std::function<bool(const SimulationState&)> stop_;
