@@ -88,7 +88,10 @@ struct Streams {
   }
   void add(const SimulateOptions& o, const Scenario& sc, const std::vector<std::string>& joints, const MotionSample& x) {
     if (!o.csv.empty()) {
-      if (!csv) csv.emplace(o.csv, joints, sc.simulation.base_control.on(), sc.compliant.has_value());
+      if (!csv) {
+        const long wheels = sc.base_actuators.wheels.count();
+        csv.emplace(o.csv, joints, sc.simulation.base_control.on() || wheels > 0, sc.compliant.has_value(), wheels);
+      }
       csv->write(x);
     }
     if (plot_file) {

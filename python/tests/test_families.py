@@ -349,6 +349,39 @@ def test_the_operation_runs_and_keeps_the_momentum(tmp_path, family):
     assert np.abs(samples["momentum"] - h0).max() <= 1e-9 * (np.linalg.norm(h0) + 1)
 
 
+@pytest.mark.parametrize("family", FAMILIES, ids=IDS)
+def test_reaction_wheels_take_momentum_and_keep_the_total(tmp_path, family):
+    """run_operation with four weak reaction wheels holding the bus (robot.base_actuators): the
+    momentum of the links with the wheels is the capture's momentum after at every sample (1e-9);
+    the wheels' momentum, turned into world axes here (R A h from the samples' quaternions), is
+    not zero; none passes its capacity; the JSON's wheels say the same peaks."""
+    path = write_scenario(tmp_path, family, tag="wheels")
+    text = path.read_text().replace(
+        "  contact:", "  base_actuators: {wheels: {axes: [[1, 0, 0], [0, 0.6, 0.8], [0, -0.8, 0.6], [1, 1, 1]], "
+        "torque_limit: 0.05, capacity: 0.01}}\n  contact:", 1).replace(
+        "simulation: {", "simulation: {base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}, ", 1)
+    path.write_text(text)
+    with pytest.warns(RuntimeWarning, match="wheel_saturated"):  # so weak they saturate
+        r = kdl_space.run_operation(kdl_space.load_scenario(str(path)))
+    samples = r["samples"]
+    h0 = np.asarray(r["capture"]["momentum_after"])
+    assert np.abs(samples["momentum"] - h0).max() <= 1e-9 * (np.linalg.norm(h0) + 1)
+    h = samples["wheel_momentum"]
+    assert h.shape == (len(samples["t"]), 4)
+    assert np.abs(h).max() <= 0.01 * (1 + 1e-6)
+    A = np.array([[1, 0, 0], [0, 0.6, 0.8], [0, -0.8, 0.6], [1, 1, 1]], float).T
+    A /= np.linalg.norm(A, axis=0)
+    world = []
+    for (x, y, z, w), hk in zip(samples["base_quaternion"], h):
+        R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+        world.append(R @ A @ hk)
+    assert np.linalg.norm(world, axis=1).max() > 1e-6
+    wheels = r["simulation"]["wheels"]["wheels"]
+    np.testing.assert_allclose([w["peak_momentum"] for w in wheels], np.abs(h).max(axis=0), rtol=0, atol=1e-15)
+
+
 def contact_pose(path, q_by_name, world_T_base, link, offset):
     return urdf_fk(path, q_by_name, world_T_base)[link] @ homogeneous(np.eye(3), offset)
 

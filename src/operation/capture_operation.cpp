@@ -7,6 +7,7 @@
 
 #include "kdl_space/simulation/integrator.hpp"
 #include "operation/phases.hpp"
+#include "spatial/message_text.hpp"
 
 namespace kdl_space {
 namespace {
@@ -182,6 +183,7 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
   s.t = t_capture;
   s.state = r.joined ? r.joined->state : problem.robot.state;
   s.velocity = r.joined ? r.joined->velocity : capture ? capture->robot.after : problem.robot.velocity;
+  s.wheel_momentum = operation::wheelsAtContact(sc, r);
   // A free-floating target that separated after a point impact moves on by itself.
   std::optional<FloatingSystem> separated;
   if (const auto* target = std::get_if<FloatingSystem>(&problem.target))
@@ -240,6 +242,14 @@ void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationStat
   // The servos' stiffness at the start, with the friction's regularisation of the run.
   if (const int src = sim.stiffness(start, r.record.stiffness))
     throw OperationError(sc.file + ": simulation: " + strError(src), src, std::make_shared<const OperationResult>(r));
+  if (r.record.stats.wheel_saturation_time > 0.0)
+    r.warnings.push_back(Diagnostic{"robot.base_actuators.wheels",
+                                    "the reaction wheels were at their torque limit or momentum capacity for " +
+                                        detail::number(r.record.stats.wheel_saturation_time) + " s from t = " +
+                                        detail::number(r.record.stats.wheel_saturation_first_time) +
+                                        " s: the bus's attitude was not held as the law asked (larger wheels, "
+                                        "softer gains, or thrusters to unload them)",
+                                    "wheel_saturated"});
   if (const std::string advice = stiffnessAdvice(r.record); !advice.empty())  // a warning, by the joint's name
     r.warnings.push_back(Diagnostic{r.model->jointNames()[r.record.stiffness.fastest_joint],
                                     advice + " (its gains come from simulation.joints, where a pattern such as \"*\" "
@@ -297,6 +307,7 @@ OperationResult runCaptureOperation(const Scenario& sc, const OperationOptions& 
   if (o.approach) checkApproachStiffness(sc);
   r.at_contact = sc.capture;
   SimulationState s;
+  s.wheel_momentum = sc.base_actuators.wheel_momentum;
   if (sc.approach && o.approach) {
     if (sc.simulation.base_control.on() && sc.simulation.base_control.in_approach)
       r.base_control_phases.push_back("approach");

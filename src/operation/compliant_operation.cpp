@@ -61,6 +61,7 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
                                     "contact_opened_at_touch"});
   SimulationState s;
   s.t = t0 + c.duration;
+  s.wheel_momentum = wheelsAtContact(sc, r);  // (the contact's own run carries no wheels: unchanged)
   std::optional<FloatingSystem> separated;
   if (c.end == ContactEnd::Caught || compliant_after) {  // one system moves on, the grasp locked or compliant
     r.joined = c.joined;

@@ -12,6 +12,7 @@ void MotionRecord::takeFrom(const Simulator& sim) {
   controls = sim.jointControls();
   limit_modes = sim.limitModes();
   base_control = sim.baseControl();
+  wheels = sim.reactionWheels();
   friction_velocities = sim.frictionVelocities();
 }
 
@@ -25,6 +26,15 @@ void MotionRecord::add(const MotionSample& x) {
   balance_linear = std::max(balance_linear, e.head<3>().norm());
   balance_angular = std::max(balance_angular, e.tail<3>().norm());
   torques = torques || (x.tau.size() > 0 && x.tau.cwiseAbs().maxCoeff() > 0.0);
+  if (x.wheel_momentum.size() > 0) {
+    if (wheel_peak_momentum.size() != x.wheel_momentum.size()) {
+      wheel_peak_momentum.setZero(x.wheel_momentum.size());
+      wheel_peak_torque.setZero(x.wheel_momentum.size());
+    }
+    wheel_peak_momentum = wheel_peak_momentum.cwiseMax(x.wheel_momentum.cwiseAbs());
+    if (x.wheel_torque.size() == x.wheel_momentum.size())
+      wheel_peak_torque = wheel_peak_torque.cwiseMax(x.wheel_torque.cwiseAbs());
+  }
 }
 
 double MotionRecord::meanStep() const {

@@ -26,6 +26,8 @@ int sampleOf(Simulator& sim, const SimulationState& x, Phase phase, MotionSample
   smp.base_wrench = x.base_wrench;
   smp.work << x.work.controller, x.work.friction, x.work.limits, x.work.base_control, x.work.wrenches, x.work.gravity;
   smp.impulse = x.impulse;
+  smp.wheel_momentum = x.wheel_momentum;
+  smp.wheel_torque = x.wheel_torque;
   smp.phase = phase;
   const int rc = sim.energyAndMomentum(x, smp.T, smp.h);
   if (rc) smp.T = std::nan(""), smp.h.setConstant(std::nan(""));

@@ -11,6 +11,10 @@
 
 namespace kdl_space::operation {
 
+Eigen::VectorXd wheelsAtContact(const Scenario& sc, const OperationResult& r) {
+  return r.wheel_momentum_at_contact.size() > 0 ? r.wheel_momentum_at_contact : sc.base_actuators.wheel_momentum;
+}
+
 std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                         bool approach) {
   try {
@@ -147,6 +151,7 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
   });
   s.state = robot.state;
   s.velocity = robot.velocity;
+  s.wheel_momentum = sc.base_actuators.wheel_momentum;
   ApproachOutcome outcome;
   outcome.start_warnings = approachStartWarnings(sc);
   if (const int rc = sim->engageBrakes(s)) throw InputError(sc.file + ": approach: cannot engage the brakes: " + strError(rc));
@@ -197,6 +202,7 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
   if (outcome.record.reached && !samples.empty()) samples.back().phase = Phase::Capture;
   result.at_contact.robot.state = s.state;
   result.at_contact.robot.velocity = s.velocity;
+  result.wheel_momentum_at_contact = s.wheel_momentum;
   result.approach = outcome;
   result.t_capture = s.t;
   if (!outcome.record.reached)  // what happened is the caller's to show (the CSV, the plot) with the refusal

@@ -50,6 +50,10 @@ std::unique_ptr<Simulator> targetSimulator(const Scenario& sc, const FloatingSys
 std::shared_ptr<FloatingApproachTarget> approachTarget(const Scenario& sc, const FloatingSystem& target,
                                                        const std::function<bool()>& cancelled);
 
+/// The reaction wheels' momenta where the motion after the contact starts: where the approach left
+/// them (r.wheel_momentum_at_contact), else the scenario's at the start; empty without wheels.
+Eigen::VectorXd wheelsAtContact(const Scenario& sc, const OperationResult& r);
+
 /// The simulator as the scenario says, or its refusal in the scenario's words.
 std::unique_ptr<Simulator> simulatorFor(const Scenario& sc, const std::shared_ptr<const FloatingModel>& model,
                                         bool approach);

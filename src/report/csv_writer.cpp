@@ -7,8 +7,9 @@
 
 namespace kdl_space::report {
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact)
-    : file_(path, "--csv"), base_control_(base_control), contact_(contact) {
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact,
+                     long wheels)
+    : file_(path, "--csv"), base_control_(base_control), contact_(contact), wheels_(wheels) {
   out_.open(file_.tmp());
   if (!out_) throw InputError("--csv " + path + ": cannot write in its folder");
   out_ << std::setprecision(17);
@@ -20,6 +21,8 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
   if (base_control_) out_ << ",base_control_fx,base_control_fy,base_control_fz,base_control_nx,base_control_ny,base_control_nz";
   out_ << ",work_controller,work_friction,work_limits,work_base_control,work_wrenches,work_gravity,phase,grasp_distance";
   if (contact_) out_ << ",contact_fx,contact_fy,contact_fz,contact_nx,contact_ny,contact_nz";
+  for (long i = 1; i <= wheels_; ++i) out_ << ",wheel_h_" << i;
+  for (long i = 1; i <= wheels_; ++i) out_ << ",wheel_u_" << i;
   out_ << '\n';
 }
 
@@ -43,6 +46,11 @@ void CsvWriter::write(const MotionSample& s) {
     for (int i = 0; i < 6; ++i) {
       out_ << ',';
       if (!std::isnan(s.contact_wrench(i))) out_ << s.contact_wrench(i);
+    }
+  for (const Eigen::VectorXd* v : {&s.wheel_momentum, &s.wheel_torque})  // empty where no wheels ran (a contact)
+    for (long i = 0; i < wheels_; ++i) {
+      out_ << ',';
+      if (v->size() == wheels_) out_ << (*v)(i);
     }
   out_ << '\n';
   if (!out_) failed();  // a buffer that could not be flushed sets badbit

@@ -73,6 +73,26 @@ Json baseControlJson(const MotionRecord& r) {
   return j;
 }
 
+Json wheelsJson(const MotionRecord& r) {
+  const ReactionWheels& w = r.wheels;
+  if (w.count() == 0) return nullptr;
+  Json list = Json::array();
+  for (Eigen::Index i = 0; i < w.count(); ++i) {
+    const double peak = r.wheel_peak_momentum.size() > i ? r.wheel_peak_momentum(i) : 0.0;
+    list.push_back(Json{{"axis", toJson(Vector3d(w.axes.col(i)))},
+                        {"torque_limit", w.torque_limit(i)},
+                        {"capacity", w.capacity(i)},
+                        {"momentum_start", r.first.wheel_momentum.size() > i ? r.first.wheel_momentum(i) : 0.0},
+                        {"momentum_final", r.last.wheel_momentum.size() > i ? r.last.wheel_momentum(i) : 0.0},
+                        {"peak_momentum", peak},
+                        {"peak_fraction_of_capacity", peak / w.capacity(i)},
+                        {"peak_torque", r.wheel_peak_torque.size() > i ? r.wheel_peak_torque(i) : 0.0}});
+  }
+  return Json{{"wheels", list},
+              {"saturation_time", r.stats.wheel_saturation_time},
+              {"saturation_first_time", finiteOrNull(r.stats.wheel_saturation_first_time)}};
+}
+
 Json stiffnessJson(const MotionRecord& r) {
   const Stiffness& st = r.stiffness;
   const SimulationStats& stats = r.stats;
@@ -120,6 +140,16 @@ void printMotionReport(std::ostream& out, const MotionRecord& r) {
   }
   if (r.stats.base_saturation_time > 0.0)
     out << "Base control at its limits for " << r.stats.base_saturation_time << " s\n";
+  if (r.wheels.count() > 0 && r.wheel_peak_momentum.size() == r.wheels.count()) {
+    Eigen::Index worst = 0;
+    (r.wheel_peak_momentum.array() / r.wheels.capacity.array()).maxCoeff(&worst);
+    out << "Reaction wheels: peak momentum " << r.wheel_peak_momentum(worst) << " N m s of "
+        << r.wheels.capacity(worst) << " (wheel " << worst + 1 << " of " << r.wheels.count() << ")";
+    if (r.stats.wheel_saturation_time > 0.0)
+      out << "; saturated (torque limit or capacity) for " << r.stats.wheel_saturation_time << " s from t = "
+          << r.stats.wheel_saturation_first_time << " s";
+    out << "\n";
+  }
   const MotionSample& last = r.last;
   const MotionSample& first = r.first;
   if (last.work.cwiseAbs().maxCoeff() > 0.0)

@@ -218,7 +218,8 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"energy_split", energySplitJson(record)},
                          {"base_control", baseControlJson(record)},
                          {"stiffness", stiffnessJson(record)},
-                         {"friction", frictionJson(record)}};
+                         {"friction", frictionJson(record)},
+                         {"wheels", wheelsJson(record)}};
   return j;
 }
 

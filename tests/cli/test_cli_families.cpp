@@ -402,6 +402,51 @@ TEST_P(CliFamilies, SimulateRunsAndKeepsTheMomentum) {
   EXPECT_NEAR(t_last, 0.3, 1e-12);
 }
 
+// simulate with reaction wheels (robot.base_actuators) holding the bus's attitude: four wheels
+// in a skewed cluster, so weak (0.05 N m, 0.01 N m s) that they reach both their torque limit
+// and their capacity within the run. The momentum of the links with the wheels is the capture's
+// momentum_after (the wheels start at rest), computed independently (momentumBefore: the
+// virtual-joint route) to 1e-9; the work counted balances the energy; the wheels' JSON and CSV
+// columns say what they did.
+TEST_P(CliFamilies, SimulateWithReactionWheelsKeepsTheMomentumOfLinksAndWheels) {
+  const ModelFamily& f = GetParam();
+  const std::string path = writeScenario(f, "wheels", "{type: capture}");
+  std::string text = slurp(path);
+  text = std::regex_replace(text, std::regex("\n  contact:"),
+                            "\n  base_actuators: {wheels: {axes: [[1, 0, 0], [0, 0.6, 0.8], [0, -0.8, 0.6], [1, 1, 1]], "
+                            "torque_limit: 0.05, capacity: 0.01}}\n  contact:");
+  text = std::regex_replace(text, std::regex("simulation: \\{"),
+                            "simulation: {base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}, ");
+  spit(path, text);
+  const std::string csv = scratchIn("cli_families_" + f.name, "wheels.csv");
+  const ToolRun run = kdlSpace("simulate " + path + " --json --csv " + csv);
+  ASSERT_TRUE(noSignal(run, f.name + " simulate with wheels"));
+  ASSERT_EQ(run.rc, 0) << f.name << ": " << run.err;
+  const json j = json::parse(run.out);
+  const json& sim = j.at("simulation");
+  const Eigen::VectorXd h0 = momentumBefore(f);
+  const double tolerance = 1e-9 * (h0.norm() + 1);
+  EXPECT_LE((vectorOf(j.at("capture").at("momentum_after")) - h0).norm(), tolerance);
+  EXPECT_LE(sim.at("max_linear_momentum_change").get<double>(), tolerance);
+  EXPECT_LE(sim.at("max_angular_momentum_change").get<double>(), tolerance);
+  EXPECT_LE(std::abs(sim.at("energy_split").at("residual").get<double>()), 1e-9 * (sim.at("energy").get<double>() + 1));
+  const json& wheels = sim.at("wheels");
+  ASSERT_EQ(wheels.at("wheels").size(), 4u) << wheels.dump();
+  EXPECT_GT(wheels.at("saturation_time").get<double>(), 0.0);
+  double peak = 0.0;
+  for (const json& w : wheels.at("wheels")) {
+    peak = std::max(peak, w.at("peak_momentum").get<double>());
+    EXPECT_LE(w.at("peak_momentum").get<double>(), 0.01 * (1 + 1e-6));  // never past its capacity
+    EXPECT_LE(w.at("peak_torque").get<double>(), 0.05 * (1 + 1e-12));
+  }
+  EXPECT_GT(peak, 0.0);
+  EXPECT_NE(run.err.find("wheel"), std::string::npos) << run.err;  // the saturation's warning
+  std::istringstream lines(slurp(csv));
+  std::string header;
+  ASSERT_TRUE(std::getline(lines, header));
+  EXPECT_NE(header.find(",wheel_h_1,wheel_h_2,wheel_h_3,wheel_h_4,wheel_u_1,"), std::string::npos) << header;
+}
+
 // ik: a pose of the contact frame at another configuration (inside the limits), by KDL's tree
 // solver with the mimic joints set from the URDF's <mimic>, is reached: the angles the tool prints
 // put through the same solver land on it (1e-9 m, 1e-9 rad), inside the limits. At the family's

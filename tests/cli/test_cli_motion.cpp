@@ -260,6 +260,45 @@ TEST(BaseControl, HoldsTheAttitudeWithinItsLimitsAndBalancesTheMomentum) {
   }
 }
 
+// The shipped detumble: three wheels take the captured stack's spin. No impulse from outside at
+// all, so the momentum of the links with the wheels stays the capture's (1e-10); the bus's rate
+// falls from the capture's by more than 20 times; no wheel passes its capacity or its torque
+// limit, which it reaches (the run says so, and how long); the work counted balances the energy.
+TEST(ReactionWheels, DetumbleTheStackWithinTheirLimits) {
+  const std::string csv = scratch("wheels.csv");
+  const ToolRun run = kdlSpace("simulate " + kScenarios + "detumble_with_wheels.yaml --json --csv " + csv);
+  ASSERT_EQ(run.rc, 0) << run.err;
+  const json j = json::parse(run.out);
+  const json& sim = j.at("simulation");
+  EXPECT_LT(sim.at("momentum_balance_error").at("linear").get<double>(), 1e-10);
+  EXPECT_LT(sim.at("momentum_balance_error").at("angular").get<double>(), 1e-10);
+  for (const json& x : sim.at("base_control").at("impulse")) EXPECT_EQ(x.get<double>(), 0.0);
+  const auto rate = [](const json& twist) { return std::hypot(twist[3].get<double>(), twist[4].get<double>(), twist[5].get<double>()); };
+  const double start = rate(j.at("capture").at("robot").at("base_twist_after"));
+  const double end = rate(sim.at("final").at("base_twist"));
+  EXPECT_GT(start, 1e-3);
+  EXPECT_LT(end, start / 20.0);
+  EXPECT_LT(std::abs(sim.at("energy_split").at("residual").get<double>()), 1e-9);
+  const json& wheels = sim.at("wheels");
+  ASSERT_EQ(wheels.at("wheels").size(), 3u);
+  EXPECT_GT(wheels.at("saturation_time").get<double>(), 1.0);
+  for (const json& w : wheels.at("wheels")) {
+    EXPECT_LE(w.at("peak_momentum").get<double>(), w.at("capacity").get<double>());
+    EXPECT_LE(w.at("peak_torque").get<double>(), w.at("torque_limit").get<double>() * (1 + 1e-12));
+  }
+  EXPECT_NE(run.err.find("robot.base_actuators.wheels: the reaction wheels were at their torque limit"), std::string::npos)
+      << run.err;
+  ASSERT_EQ(j.at("warnings").size(), 1u) << j.at("warnings").dump();
+  EXPECT_EQ(j.at("warnings")[0].at("kind"), "wheel_saturated");
+  // The CSV's wheel torques never pass the limit; the bus feels their reaction (base_control_n*).
+  const auto c = readCsv(csv);
+  ASSERT_TRUE(c.count("wheel_u_3")) << "no wheel columns";
+  double largest = 0.0;
+  for (std::size_t i = 0; i < c.at("t").size(); ++i)
+    for (const char* u : {"wheel_u_1", "wheel_u_2", "wheel_u_3"}) largest = std::max(largest, std::abs(c.at(u)[i]));
+  EXPECT_NEAR(largest, 0.5, 1e-12);
+}
+
 TEST(Stiffness, ExplicitRunIsFlaggedAndRosenbrockAgreesWithFarFewerSteps) {
   const std::string dopri = variant("stiff_wrist_servo", "  integrator: rosenbrock\n  rtol: 1.0e-7\n  atol: 1.0e-9",
                                     "  integrator: dopri5\n  rtol: 1.0e-11\n  atol: 1.0e-13");

@@ -183,6 +183,18 @@ const std::vector<Broken>& corpus() {
        "{f}:21: simulation.base_control.attitude.set_point.quaternion: is not a rotation: a unit quaternion has norm 1, "
        "this one 2",
        false},
+      // The base's actuators (robot.base_actuators) and the control they must carry.
+      {"wheels_zero_axis.yaml", "{f}:9: robot.base_actuators.wheels.axes[1]: is zero: a wheel's spin axis has a direction",
+       false},
+      {"wheels_missing_capacity.yaml", "{f}:10: robot.base_actuators.wheels.capacity: missing (a required field)", false},
+      {"wheels_momentum_past_capacity.yaml",
+       "{f}:10: robot.base_actuators.wheels.momentum: wheel 2 starts at 2.5 N m s, past its capacity 2 N m s", false},
+      {"wheels_negative_torque_limit.yaml",
+       "{f}:10: robot.base_actuators.wheels.torque_limit: must be > 0 for every wheel, got -0.1 for wheel 2", false},
+      {"base_position_without_thrusters.yaml",
+       "{f}:24: simulation.base_control.position: robot.base_actuators has no thrusters' force_limit to move the base "
+       "with",
+       false},
       {"wrench_ends_before_start.yaml", "{f}:21: simulation.wrenches[0].end: must be after start (2 s), got 1", false},
       {"wrench_unknown_link.yaml",
        "{f}:21: simulation.wrenches[0].link: the robot has no link 'gripper' (its links: base, link1, link2, hand)",

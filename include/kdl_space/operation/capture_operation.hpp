@@ -109,6 +109,10 @@ struct KDL_SPACE_EXPORT OperationResult {
   std::shared_ptr<const FloatingModel> model;  ///< what moves after the capture
   bool payload_attached = false;  ///< model is the robot with the target as a payload, or joined
   double t_capture = 0.0;         ///< the contact instant (0 without an approach) [s]
+  /// The reaction wheels' momenta at the contact instant (robot.base_actuators: the scenario's at
+  /// the start, or where the approach left them) [N m s]; empty without wheels. A capture's impulse
+  /// and a compliant contact leave them as they are.
+  Eigen::VectorXd wheel_momentum_at_contact;
   std::vector<MotionSample> approach_samples;  ///< the last one: the contact instant
   /// A compliant contact's samples (Phase::Contact, kept whatever keep_samples: they come before
   /// the system after it is known), in the joints of `model`.

@@ -19,6 +19,7 @@ struct KDL_SPACE_EXPORT MotionRecord {
   std::vector<JointControl> controls;          ///< model order
   std::vector<LimitMode> limit_modes;          ///< model order
   BaseControl base_control;
+  ReactionWheels wheels;                       ///< none: count() 0
   std::vector<double> friction_velocities;     ///< v_s per joint (SimulationOptions::friction_rate)
   Stiffness stiffness;                         ///< the servos' at the start of the run
   double output_step = 0.0;
@@ -33,6 +34,8 @@ struct KDL_SPACE_EXPORT MotionRecord {
   /// The momentum balance: max |h - h_0 - impulse| (P and L parts).
   double balance_linear = 0.0, balance_angular = 0.0;
   bool torques = false;  ///< some joint torque acted (a controller, friction)
+  /// Each reaction wheel's largest |momentum| [N m s] and |motor torque| [N m] over the samples.
+  Eigen::VectorXd wheel_peak_momentum, wheel_peak_torque;
 
   /// The simulator's set-up and records after (or during) its run.
   void takeFrom(const Simulator& sim);

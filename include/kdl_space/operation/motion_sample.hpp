@@ -39,6 +39,9 @@ struct MotionSample {
   /// The compliant contact's wrench on the robot (f; n about its contact point), world [N, N m]
   /// (ContactSample::wrench): Phase::Contact only, NaN in the other phases.
   Vector6d contact_wrench = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The reaction wheels' momenta [N m s] and motor torques [N m] (Simulator::setReactionWheels);
+  /// empty without wheels.
+  Eigen::VectorXd wheel_momentum, wheel_torque;
 };
 
 /// \brief The sample of a state of `sim`'s run (its energy and momentum computed in O(n)).

@@ -16,8 +16,10 @@ class CsvWriter {
  public:
   /// Opens the temporary file and writes the header; throws InputError if it cannot.
   /// `base_control`: the base control's wrench columns are written; `contact`: the compliant
-  /// contact's wrench columns (last: empty outside its rows).
-  CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact = false);
+  /// contact's wrench columns (empty outside its rows); `wheels`: that many reaction wheels'
+  /// momentum and torque columns, last.
+  CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact = false,
+            long wheels = 0);
   /// One row; throws InputError at once when it cannot be written (a full disk): the run stops
   /// there rather than computing rows that are lost.
   void write(const MotionSample& s);
@@ -32,6 +34,7 @@ class CsvWriter {
   std::ofstream out_;
   bool base_control_;
   bool contact_;
+  long wheels_;
   std::size_t rows_ = 0;
   /// "cannot write after N rows (disk full?)", with the system's reason when it gave one.
   [[noreturn]] void failed() const;

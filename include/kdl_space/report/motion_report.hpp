@@ -19,6 +19,10 @@ Json energySplitJson(const MotionRecord& r);
 /// null without a base control; else its set points, final errors and the momentum balance.
 Json baseControlJson(const MotionRecord& r);
 Json stiffnessJson(const MotionRecord& r);
+/// null without reaction wheels; else per wheel its axis, torque limit, capacity, momentum at the
+/// start and the end, peak momentum (and its fraction of the capacity) and peak torque, and how
+/// long the cluster was saturated.
+Json wheelsJson(const MotionRecord& r);
 /// The joints with damping or Coulomb friction: their values and the regularisation v_s used.
 Json frictionJson(const MotionRecord& r);
 

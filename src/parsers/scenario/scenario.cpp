@@ -10,6 +10,7 @@
 #include "kdl_space/parsers/formats/robot_file.hpp"
 #include "kdl_space/parsers/urdf/urdf_loader.hpp"
 #include "multibody/model_rules.hpp"
+#include "parsers/scenario/scenario_actuators.hpp"
 #include "parsers/scenario/scenario_approach.hpp"
 #include "parsers/scenario/scenario_fields.hpp"
 #include "parsers/scenario/scenario_mount.hpp"
@@ -93,7 +94,9 @@ double rotorInertia(const Field& f) {
 /// readRobotDocument), its notes and its file; untouched for a URDF file.
 FloatingSystem system(const Field& f, const std::string& folder, std::string& urdf_path, MountedRobot& document,
                       MountedRobot* mount = nullptr) {
-  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp", "mount"});
+  f.onlyKeys({"urdf", "contact", "base", "q", "qdot", "mode", "locked", "armature", "place", "link", "grasp", "mount",
+              "base_actuators"});
+  if (f.has("base_actuators") && !mount) f.at("base_actuators").fail("only the robot (the servicer) has base actuators here");
   FloatingSystem s;
   if (f.has("mount")) {
     if (!mount) f.at("mount").fail("only the robot is mounted (its arms on a bus): give the target's urdf");
@@ -370,6 +373,15 @@ Scenario loadScenario(const std::string& path) {
                                         s.impact && floating ? floating->model.get() : nullptr);
     if (s.impact && s.simulation.grounded.value_or(false) && s.capture.robot.response == Response::FreeFloating)
       sections::groundForTheCapture(top.at("simulation").at("base"), s.capture.robot);
+  }
+  if (robot.has("base_actuators")) {
+    s.base_actuators = sections::baseActuators(robot.at("base_actuators"));
+    if (s.simulation.grounded.value_or(s.capture.robot.response == Response::Grounded))
+      robot.at("base_actuators").fail("the base is grounded (held still): its actuators have nothing to move; "
+                                      "remove them, or let the base float (simulation.base: free)");
+    if (top.has("simulation") && top.at("simulation").has("base_control"))
+      sections::checkBaseControlHardware(s.base_actuators, s.simulation.base_control,
+                                         top.at("simulation").at("base_control"));
   }
   return s;
 }

@@ -33,8 +33,19 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
   if (!approach)
     for (const auto& [joint, control] : spec.joints) sim->setJointControl(jointIn(joint), control);
   for (const auto& [joint, mode] : spec.limits) sim->setLimitMode(jointIn(joint), mode);
-  // The base control acts in the phases the scenario names (base_control.phases; default: after).
-  if (approach ? spec.base_control.in_approach : spec.base_control.after_capture) sim->setBaseControl(spec.base_control);
+  // The base's actuators, and its control in the phases the scenario names (base_control.phases;
+  // default: after) within their limits.
+  const BaseActuators& hardware = sc.base_actuators;
+  if (hardware.wheels.count() > 0 && !options.grounded) sim->setReactionWheels(hardware.wheels);
+  if (approach ? spec.base_control.in_approach : spec.base_control.after_capture) {
+    BaseControl control = spec.base_control;
+    if (hardware.given) {
+      control.position.force_limit = control.position.force_limit.cwiseMin(hardware.thruster_force);
+      if (hardware.wheels.count() == 0)
+        control.attitude.torque_limit = control.attitude.torque_limit.cwiseMin(hardware.thruster_torque);
+    }
+    sim->setBaseControl(control);
+  }
   for (ScheduledWrench w : spec.wrenches) {
     w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
     sim->addWrench(w);

@@ -3,6 +3,7 @@
 // `kdl_space capture` and `simulate` read; a library user can build the same types in code.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -40,6 +41,21 @@ struct SimulationSpec {
   std::vector<ScheduledWrench> wrenches;
 };
 
+/// \brief `robot.base_actuators`: the servicer's reaction wheels and thrusters as hardware. With
+/// them, the base control's attitude torque is the wheels' (internal: the momentum of the system
+/// with its wheels is kept) or, without wheels, the thrusters', limited to thruster_torque; its
+/// force the thrusters', limited to thruster_force (each also by the control's own limit).
+/// Without them (`given` false) the base control is an external wrench within its own limits.
+struct BaseActuators {
+  bool given = false;
+  ReactionWheels wheels;           ///< none: count() 0
+  Eigen::VectorXd wheel_momentum;  ///< the wheels' momenta at the start [N m s]
+  bool thrusters = false;
+  /// Per base axis [N], [N m]; infinity: that kind of thrust is absent.
+  Vector3d thruster_force = Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Vector3d thruster_torque = Vector3d::Constant(std::numeric_limits<double>::infinity());
+};
+
 /// A scenario file, read and checked.
 struct Scenario {
   std::string file;         ///< the path it was read from
@@ -75,6 +91,7 @@ struct Scenario {
   /// the contact point, and its position tolerance at most the capture's touch tolerance.
   std::optional<ApproachSpec> approach;
   SimulationSpec simulation;
+  BaseActuators base_actuators;  ///< `robot.base_actuators`
   /// `robot.place: grasp`: the inverse kinematics that put the robot's contact frame at the
   /// target's grasp frame (`robot.grasp.target_frame`, in the target's frame); its q is
   /// capture.robot.state.q (joints off the contact's chain keep robot.q).
