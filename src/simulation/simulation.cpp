@@ -224,9 +224,9 @@ int Simulator::unpack(const Vector& x, double t, SimulationState& s) {
     s.velocity.base_twist = KDL::Twist::Zero();
     return E_NOERROR;
   }
-  Vector6d h = x.segment<6>(L.h);  // the system's with its wheels: the links' alone for eq. 2
-  if (L.m > 0) h.tail<3>() -= kin_.R[0] * (wheels_.axes * s.wheel_momentum);
-  return momentum_.baseTwist(kin_, h, s.velocity.qdot, s.velocity.base_twist);  // eq. 2
+  h_links_ = x.segment<6>(L.h);  // the system's with its wheels: the links' alone for eq. 2
+  if (L.m > 0) h_links_.tail<3>() -= kin_.R[0] * (wheels_.axes * s.wheel_momentum);
+  return momentum_.baseTwist(kin_, h_links_, s.velocity.qdot, s.velocity.base_twist);  // eq. 2
 }
 
 int Simulator::derivative(double t, const Vector& x, Vector& dx) {

@@ -28,9 +28,14 @@ int Simulator::actuate(double t, const Vector& x) {
   const unsigned int n = model().nj();
   const KDL::JntArray& q = scratch_.state.q;
   const KDL::JntArray& qdot = scratch_.velocity.qdot;
+  if (distribution_.on)
+    if (const int rc = distributionRates()) return rc;
   for (unsigned int j = 0; j < n; ++j) {
     const JointControl& c = controls_[j];
-    tau_control_(j) = c.mode == JointControl::Mode::PD ? c.kp * (c.set_point - q(j)) - c.kd * qdot(j) : 0.0;
+    if (distribution_.on && distribution_.joints[j])  // a rate servo on the reactionless rate
+      tau_control_(j) = distribution_gain_(j) * (distribution_rates_(j) - qdot(j));
+    else
+      tau_control_(j) = c.mode == JointControl::Mode::PD ? c.kp * (c.set_point - q(j)) - c.kd * qdot(j) : 0.0;
   }
   if (callback_) {
     SetToZero(tau_extra_);
@@ -73,6 +78,9 @@ int Simulator::actuate(double t, const Vector& x) {
     if (base_control_.on()) {
       scratch_.base_wrench = baseControlWrench(base_control_, scratch_.state.world_T_base,
                                                scratch_.velocity.base_twist, &base_saturated_);
+      // momentum_distribution: the attitude actuators draw the links' momentum out (after the
+      // control's own limit; the wheels' limits follow).
+      if (distribution_.on && base_control_.attitude.on) scratch_.base_wrench.tail<3>() -= distribution_.unload_gain * L_g_;
       // With wheels the attitude torque is theirs (below), an internal one.
       const Vector3d thrust_torque = wheels ? Vector3d::Zero() : Vector3d(scratch_.base_wrench.tail<3>());
       apply(0, kin_.com[0], scratch_.base_wrench.head<3>(), thrust_torque, external_power_[0]);
@@ -187,6 +195,8 @@ int Simulator::startRun(SimulationState& s) {
   if (base_control_.position.hold) base_control_.position.set_point = toEigen(s.state.world_T_base.p);
   std::fill(at_stop_.begin(), at_stop_.end(), false);
   applyLocks();
+  if (distribution_.on)
+    if (const int rc = distributionGains(s)) return rc;
   // The Coulomb regularisation of each joint, from its apparent inertia here.
   std::fill(friction_velocity_.begin(), friction_velocity_.end(), options_.friction_velocity);
   bool any_friction = false;
@@ -367,8 +377,9 @@ int Simulator::stiffness(const SimulationState& s, Stiffness& result) {
   for (unsigned int j = 0; j < n; ++j) {
     if (locked_now_[j]) continue;
     const JointControl& c = controls_[j];
-    const double kp = c.mode == JointControl::Mode::PD ? c.kp : 0.0;
-    double kd = (c.mode == JointControl::Mode::PD ? c.kd : 0.0);
+    const bool rate_servo = distribution_.on && distribution_.joints[j];  // momentum_distribution's
+    const double kp = c.mode == JointControl::Mode::PD && !rate_servo ? c.kp : 0.0;
+    double kd = rate_servo ? distribution_gain_(j) : c.mode == JointControl::Mode::PD ? c.kd : 0.0;
     if (options_.joint_friction) kd += props[j].damping + props[j].friction / friction_velocity_[j];
     if (kp == 0.0 && kd == 0.0) continue;
     double m = 0.0;  // the joint's apparent inertia

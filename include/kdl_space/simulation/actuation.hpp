@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "kdl_space/export.hpp"
 #include "kdl_space/spatial/spatial.hpp"
@@ -112,6 +113,28 @@ KDL_SPACE_EXPORT void wheelTorques(const ReactionWheels& wheels, const Eigen::Ma
 /// \brief The torque the wheels exert on the bus (world axes): -R A u - w x (R A h).
 KDL_SPACE_EXPORT Vector3d wheelReaction(const ReactionWheels& wheels, const Matrix3d& R, const Vector3d& w,
                                         const Eigen::VectorXd& h, const Eigen::VectorXd& u);
+
+/// \brief The post-capture law `momentum_distribution`, after Dimitrov and Yoshida's bias momentum
+/// approach: the arm's joints take up the stack's angular momentum so that the base does not turn,
+/// and the base's attitude actuators (its wheels) unload it from the arm.
+///  - The joints it drives (`joints`, each a PD joint of the simulator) are rate servos,
+///    tau_j = kv_j (qdot_d,j - qdot_j), kv_j = bandwidth H*_jj with H*_jj the inertia the joint
+///    meets with the others held and the base free, at the start of the run (their PD gains no
+///    longer act), tracking the reactionless rates:
+///    the least-norm qdot_d over them with A_w qdot = L_g, the base's angular velocity zero
+///    (eq. 2 in the centroid's coordinates: I_g w = L_g - A_w qdot, A_w the angular rows of A_m,
+///    L_g the links' angular momentum about the system's CoM, the other joints' rates as they
+///    are); a damped inverse below a singular value of 1e-2 of the largest; scaled down as a whole
+///    to the joints' rate limits (`rate_limit`; infinity: none).
+///  - The base control's attitude torque gets -unload_gain L_g: the wheels (or thrusters) draw
+///    the momentum out of the links, and as it goes the reactionless rates and the arm come to rest.
+struct MomentumDistribution {
+  bool on = false;
+  std::vector<bool> joints;      ///< model order: driven by the law
+  Eigen::VectorXd rate_limit;    ///< model order [rad/s or m/s]; infinity: none
+  double unload_gain = 0.0;      ///< [1/s], >= 0
+  double bandwidth = 20.0;       ///< the rate servos' [1/s], > 0
+};
 
 /// \brief An external wrench on a body over a time window (a thruster firing, a push): the force
 /// f acts at `point` (in the body's frame) and the couple n is added; both in world axes, or in

@@ -169,6 +169,15 @@ class KDL_SPACE_EXPORT Simulator {
   /// > 0 (or sized unlike the axes), or a grounded base.
   void setReactionWheels(const ReactionWheels& wheels);
   const ReactionWheels& reactionWheels() const { return wheels_; }
+  /// \brief The post-capture law momentum_distribution (MomentumDistribution); off: the joints'
+  /// own controls. \throws ModelError for a driven joint that is no PD joint, sizes unlike the
+  /// model's joints, a rate limit that is not > 0, a negative or non-finite gain, or a grounded base.
+  void setMomentumDistribution(const MomentumDistribution& law);
+  const MomentumDistribution& momentumDistribution() const { return distribution_; }
+  /// \brief The reactionless rates at s (MomentumDistribution): the driven joints' qdot_d (the
+  /// others 0), as the law computes them. For a caller that checks the law. \return 0,
+  /// E_SIZE_MISMATCH, E_BAD_ARGUMENT (the law off) or a code of the dynamics.
+  int reactionlessRates(const SimulationState& s, Eigen::VectorXd& qdot_d);
   /// \throws ModelError for a body out of range, a value not finite, or end <= start.
   void addWrench(const ScheduledWrench& wrench);
   const std::vector<ScheduledWrench>& wrenches() const { return wrenches_; }
@@ -316,6 +325,18 @@ class KDL_SPACE_EXPORT Simulator {
   ReactionWheels wheels_;
   Eigen::MatrixXd wheel_split_;  ///< A+ (m x 3): the least-norm split of a torque among the wheels
   Eigen::VectorXd wheel_u_;      ///< the wheels' motor torques at the last actuate()
+  MomentumDistribution distribution_;
+  /// At kin_ and scratch_ (unpacked, with its links' momentum h_links_): the law's rates into
+  /// distribution_rates_, and the links' angular momentum about the CoM into L_g_.
+  int distributionRates();
+  /// momentum_distribution's rate servos at the start of a run: kv_j = bandwidth H*_jj at s.
+  int distributionGains(const SimulationState& s);
+  Vector6d h_links_ = Vector6d::Zero();  ///< the links' momentum (P; L about the origin) at the last unpack()
+  Vector3d L_g_ = Vector3d::Zero();
+  Eigen::VectorXd distribution_rates_;
+  Eigen::VectorXd distribution_gain_;    ///< kv_j = bandwidth m_j, set at the start of a run
+  Eigen::Matrix3Xd distribution_A_;      ///< A_w over the driven joints (3 x n, unused columns zero)
+  FloatingVelocity unit_velocity_;       ///< a unit rate, the base still
   bool wheel_saturated_ = false;
   std::vector<ScheduledWrench> wrenches_;
   TorqueCallback callback_;

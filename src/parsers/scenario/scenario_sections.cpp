@@ -138,12 +138,46 @@ ScheduledWrench wrench(const Field& f, const FloatingModel& robot) {
   return w;
 }
 
+/// `after_capture: {law: hold | momentum_distribution, unload_gain}`: the law of the motion after
+/// the capture; momentum_distribution drives the robot's PD servos and unloads through the base's
+/// attitude control, so it needs both.
+void afterCapture(const Field& section, SimulationSpec& s) {
+  const Field f = section.at("after_capture");
+  f.onlyKeys({"law", "unload_gain", "bandwidth"});
+  const Field law = f.at("law");
+  if (law.text() == "hold") s.after_capture = SimulationSpec::Law::Hold;
+  else if (law.text() == "momentum_distribution") s.after_capture = SimulationSpec::Law::MomentumDistribution;
+  else law.fail(echo(law.text()) + " is not one of hold, momentum_distribution");
+  if (f.has("unload_gain")) {
+    if (s.after_capture != SimulationSpec::Law::MomentumDistribution)
+      f.at("unload_gain").fail("is momentum_distribution's: the law is " + law.text());
+    s.unload_gain = f.at("unload_gain").number();
+    if (s.unload_gain < 0.0) f.at("unload_gain").fail("must be >= 0 [1/s], got " + number(s.unload_gain));
+  }
+  if (f.has("bandwidth")) {
+    if (s.after_capture != SimulationSpec::Law::MomentumDistribution)
+      f.at("bandwidth").fail("is momentum_distribution's: the law is " + law.text());
+    s.bandwidth = f.at("bandwidth").number();
+    if (!(s.bandwidth > 0.0)) f.at("bandwidth").fail("must be > 0 [1/s], got " + number(s.bandwidth));
+  }
+  if (s.after_capture != SimulationSpec::Law::MomentumDistribution) return;
+  bool servo = false;
+  for (const auto& [j, c] : s.joints) servo = servo || c.mode == JointControl::Mode::PD;
+  if (!servo)
+    law.fail("momentum_distribution drives the arm's servos: give the robot's joints pd servos in simulation.joints "
+             "(their kd is the rate gain)");
+  if (!s.base_control.attitude.on || !s.base_control.after_capture)
+    law.fail("momentum_distribution unloads the arm through the base's attitude control: give "
+             "simulation.base_control.attitude (acting after the capture), with robot.base_actuators.wheels");
+  if (s.grounded.value_or(false)) law.fail("momentum_distribution keeps a free base from turning; this base is grounded");
+}
+
 }  // namespace
 
 SimulationSpec simulation(const Field& f, const FloatingModel& robot, const FloatingModel* target) {
   f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "max_steps", "gravity",
               "joints", "base", "limits", "effort_limits", "friction", "friction_velocity", "base_control", "wrenches",
-              "target_joints"});
+              "target_joints", "after_capture"});
   SimulationSpec s;
   const auto positive = [&](const char* key, double& value) {
     if (!f.has(key)) return;
@@ -210,6 +244,7 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot, const Floa
   if (f.has("base_control")) s.base_control = baseControl(f.at("base_control"));
   if (f.has("wrenches"))
     for (const Field& w : f.at("wrenches").items("wrenches {link, force, torque, start, end}")) s.wrenches.push_back(wrench(w, robot));
+  if (f.has("after_capture")) afterCapture(f, s);
   return s;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace kdl_space {
 
@@ -45,6 +46,18 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
         control.attitude.torque_limit = control.attitude.torque_limit.cwiseMin(hardware.thruster_torque);
     }
     sim->setBaseControl(control);
+  }
+  if (!approach && spec.after_capture == SimulationSpec::Law::MomentumDistribution) {
+    MomentumDistribution law;  // over the robot's PD servos, at their joints' rate limits
+    law.on = true;
+    law.unload_gain = spec.unload_gain;
+    law.bandwidth = spec.bandwidth;
+    law.joints.assign(model->nj(), false);
+    law.rate_limit = Eigen::VectorXd::Constant(model->nj(), std::numeric_limits<double>::infinity());
+    for (unsigned int j = 0; j < model->nj(); ++j) law.rate_limit(j) = model->jointProperties()[j].velocity;
+    for (const auto& [joint, control] : spec.joints)
+      if (control.mode == JointControl::Mode::PD) law.joints[jointIn(joint)] = true;
+    sim->setMomentumDistribution(law);
   }
   for (ScheduledWrench w : spec.wrenches) {
     w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));

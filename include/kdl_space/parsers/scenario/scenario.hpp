@@ -39,6 +39,14 @@ struct SimulationSpec {
   std::vector<std::pair<unsigned int, JointControl>> target_joints;
   BaseControl base_control;
   std::vector<ScheduledWrench> wrenches;
+  /// `after_capture`: the law of the motion after the capture (or of a plain motion).
+  enum class Law {
+    Hold,                  ///< `hold`: the joints' controls as `joints` gives them (the default)
+    MomentumDistribution,  ///< `momentum_distribution`: MomentumDistribution over the robot's PD joints
+  };
+  Law after_capture = Law::Hold;
+  double unload_gain = 0.2;  ///< momentum_distribution's [1/s]
+  double bandwidth = 20.0;   ///< momentum_distribution's rate servos' [1/s]
 };
 
 /// \brief `robot.base_actuators`: the servicer's reaction wheels and thrusters as hardware. With
