@@ -382,6 +382,31 @@ def test_reaction_wheels_take_momentum_and_keep_the_total(tmp_path, family):
     np.testing.assert_allclose([w["peak_momentum"] for w in wheels], np.abs(h).max(axis=0), rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("family", FAMILIES, ids=IDS)
+def test_momentum_distribution_keeps_the_momentum_or_says_why_not(tmp_path, family):
+    """run_operation under simulation.after_capture's momentum_distribution with three wheels:
+    the momentum of links and wheels is the NumPy route's before the capture (1e-9 at every
+    sample); a robot without joints is refused, naming simulation.joints."""
+    path = write_scenario(tmp_path, family, tag="distribution")
+    text = path.read_text().replace(
+        "  contact:", "  base_actuators: {wheels: {torque_limit: 10, capacity: 10}}\n  contact:", 1)
+    text = text[:text.index("simulation:")] + (
+        "simulation:\n  duration: 0.3\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
+        "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
+        "  base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}\n"
+        "  after_capture: {law: momentum_distribution}\n")
+    path.write_text(text)
+    if family.joints == 0:
+        with pytest.raises(kdl_space.InputError, match="simulation.joints"):
+            kdl_space.load_scenario(str(path))
+        return
+    scenario = kdl_space.load_scenario(str(path))
+    r = kdl_space.run_operation(scenario)
+    h = momentum_before(family, scenario.robot)
+    assert np.abs(r["samples"]["momentum"] - h).max() <= 1e-9 * (np.linalg.norm(h) + 1)
+    assert abs(r["simulation"]["energy_split"]["residual"]) <= 1e-9 * (r["simulation"]["energy"] + 1)
+
+
 def contact_pose(path, q_by_name, world_T_base, link, offset):
     return urdf_fk(path, q_by_name, world_T_base)[link] @ homogeneous(np.eye(3), offset)
 

@@ -447,6 +447,39 @@ TEST_P(CliFamilies, SimulateWithReactionWheelsKeepsTheMomentumOfLinksAndWheels) 
   EXPECT_NE(header.find(",wheel_h_1,wheel_h_2,wheel_h_3,wheel_h_4,wheel_u_1,"), std::string::npos) << header;
 }
 
+// simulate under momentum_distribution (simulation.after_capture) with three wheels: the tool
+// keeps the momentum of links and wheels at the virtual-joint route's momentum before the capture
+// (1e-9) and balances the energy; a robot without joints is refused (exit 3, the field named).
+TEST_P(CliFamilies, SimulateUnderMomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const std::string path = writeScenario(f, "distribution", "{type: capture}");
+  std::string text = slurp(path);
+  text = std::regex_replace(text, std::regex("\n  contact:"),
+                            "\n  base_actuators: {wheels: {torque_limit: 10, capacity: 10}}\n  contact:");
+  text = std::regex_replace(text, std::regex("simulation: \\{[^\n]*\\}\n"),
+                            "simulation:\n  duration: 0.3\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
+                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
+                            "  base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}\n"
+                            "  after_capture: {law: momentum_distribution}\n");
+  spit(path, text);
+  const ToolRun run = kdlSpace("simulate " + path + " --json");
+  ASSERT_TRUE(noSignal(run, f.name + " simulate under momentum_distribution"));
+  if (f.joints == 0) {
+    EXPECT_EQ(run.rc, 3) << run.err;
+    EXPECT_NE(run.err.find("simulation.joints"), std::string::npos) << run.err;
+    return;
+  }
+  ASSERT_EQ(run.rc, 0) << f.name << ": " << run.err;
+  const json j = json::parse(run.out);
+  const json& sim = j.at("simulation");
+  const Eigen::VectorXd h0 = momentumBefore(f);
+  const double tolerance = 1e-9 * (h0.norm() + 1);
+  EXPECT_LE((vectorOf(j.at("capture").at("momentum_after")) - h0).norm(), tolerance);
+  EXPECT_LE(sim.at("max_linear_momentum_change").get<double>(), tolerance);
+  EXPECT_LE(sim.at("max_angular_momentum_change").get<double>(), tolerance);
+  EXPECT_LE(std::abs(sim.at("energy_split").at("residual").get<double>()), 1e-9 * (sim.at("energy").get<double>() + 1));
+}
+
 // ik: a pose of the contact frame at another configuration (inside the limits), by KDL's tree
 // solver with the mimic joints set from the URDF's <mimic>, is reached: the angles the tool prints
 // put through the same solver land on it (1e-9 m, 1e-9 rad), inside the limits. At the family's

@@ -195,6 +195,16 @@ const std::vector<Broken>& corpus() {
        "{f}:24: simulation.base_control.position: robot.base_actuators has no thrusters' force_limit to move the base "
        "with",
        false},
+      {"after_capture_unknown_law.yaml",
+       "{f}:21: simulation.after_capture.law: 'detumble' is not one of hold, momentum_distribution", false},
+      {"distribution_without_servos.yaml",
+       "{f}:23: simulation.after_capture.law: momentum_distribution drives the arm's servos: give the robot's joints "
+       "pd servos in simulation.joints (the law drives their rates, at after_capture.bandwidth)",
+       false},
+      {"distribution_without_attitude_control.yaml",
+       "{f}:23: simulation.after_capture.law: momentum_distribution unloads the arm through the base's attitude "
+       "control: give simulation.base_control.attitude (acting after the capture), with robot.base_actuators.wheels",
+       false},
       {"wrench_ends_before_start.yaml", "{f}:21: simulation.wrenches[0].end: must be after start (2 s), got 1", false},
       {"wrench_unknown_link.yaml",
        "{f}:21: simulation.wrenches[0].link: the robot has no link 'gripper' (its links: base, link1, link2, hand)",

@@ -341,6 +341,44 @@ TEST_P(Families, ReactionWheelsTakeMomentumAndKeepTheTotal) {
   EXPECT_GT(r.record.stats.wheel_saturation_time, 0.0) << f.name;
 }
 
+// simulate under momentum_distribution (simulation.after_capture) with three wheels: the momentum
+// of links and wheels is the capture's (1e-9), the work counted balances the energy, and the
+// robot's joints run at the law's rates (none at rest: the stack's spin is in them). A robot
+// without joints has no servo for the law: refused, naming the field.
+TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const std::string path = writeScenario(f, "{type: capture}", "distribution");
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.insert(text.find("  contact:"), "  base_actuators: {wheels: {torque_limit: 10, capacity: 10}}\n");
+  text.replace(text.rfind("distribution"), 12, "");  // the tag writeScenario appended
+  text = std::regex_replace(text, std::regex("simulation: \\{[^\n]*\\}\n"),
+                            "simulation:\n  duration: 0.5\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
+                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
+                            "  base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}\n"
+                            "  after_capture: {law: momentum_distribution}\n");
+  std::ofstream(path) << text;
+  if (f.joints == 0) {
+    try {
+      loadScenario(path);
+      ADD_FAILURE() << f.name << ": a robot without joints was given a law for its servos";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("simulation.joints"), std::string::npos) << e.what();
+    }
+    return;
+  }
+  const Scenario sc = loadScenario(path);
+  const OperationResult r = runCaptureOperation(sc);
+  ASSERT_TRUE(r.capture);
+  ASSERT_FALSE(r.samples.empty());
+  const Vector6d h0 = r.capture->momentum_after;
+  for (const MotionSample& x : r.samples)
+    EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
+  const MotionSample& last = r.samples.back();
+  EXPECT_NEAR(last.T - r.samples.front().T, last.work.sum(), 1e-9 * (r.samples.front().T + 1)) << f.name;
+  EXPECT_GT(last.qd.cwiseAbs().maxCoeff(), 0.0) << f.name;
+}
+
 // ik: a pose the contact frame had at another configuration is reached, as measured by KDL's
 // virtual-joint tree of the uncoupled robot (its mimic joints where their leaders put them); a
 // robot without joints on the chain is refused, saying so.

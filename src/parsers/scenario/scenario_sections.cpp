@@ -165,7 +165,7 @@ void afterCapture(const Field& section, SimulationSpec& s) {
   for (const auto& [j, c] : s.joints) servo = servo || c.mode == JointControl::Mode::PD;
   if (!servo)
     law.fail("momentum_distribution drives the arm's servos: give the robot's joints pd servos in simulation.joints "
-             "(their kd is the rate gain)");
+             "(the law drives their rates, at after_capture.bandwidth)");
   if (!s.base_control.attitude.on || !s.base_control.after_capture)
     law.fail("momentum_distribution unloads the arm through the base's attitude control: give "
              "simulation.base_control.attitude (acting after the capture), with robot.base_actuators.wheels");
