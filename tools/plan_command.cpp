@@ -50,7 +50,11 @@ void printTerms(std::ostream& out, const char* label, const PlanTerms& t) {
   const MotionMeasures& m = *t.motion;
   out << "           after: peak base rate " << m.peak_base_rate << " rad/s, final " << m.final_base_rate
       << " rad/s, attitude excursion " << m.attitude_excursion * 180.0 / M_PI << " deg, settling " << m.settling_time
-      << " s\n";
+      << " s, detumbled ";
+  if (std::isnan(m.time_to_detumble)) out << "not within the horizon";
+  else out << "after " << m.time_to_detumble << " s";
+  if (!std::isnan(m.wheel_momentum_fraction)) out << ", wheels at " << m.wheel_momentum_fraction * 100.0 << " % of capacity";
+  out << "\n";
   out << "                  peak joint torque ";
   if (m.peak_torque_joint.empty()) out << "(no effort limits)";
   else out << m.peak_torque_ratio * 100.0 << " % of " << m.peak_torque_joint << "'s effort limit";
@@ -71,7 +75,9 @@ CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
                   "What to minimise. At the capture's instant: base_rate (|w| of the base after), impulse (|f| of the "
                   "impulse), joint_rate_jump (largest |dqdot|). Over the motion after it (--horizon): peak_base_rate, "
                   "final_base_rate, attitude_excursion, settling_time, peak_torque_ratio (|tau|/effort), "
-                  "peak_grasp_force, peak_grasp_moment (a compliant law). Default base_rate");
+                  "peak_grasp_force, peak_grasp_moment (a compliant law), time_to_detumble (the base's rate below "
+                  "simulation.detumble_rate for good; not detumbled: the horizon times the final rate over it), "
+                  "wheel_momentum_fraction (robot.base_actuators). Default base_rate");
   cmd->add_option("--weights", o.weights, "A weighted sum instead: NAME=W,... (e.g. base_rate=1,impulse=0.01)");
   cmd->add_option("--horizon", o.horizon,
                   "Seconds of motion after each capture that the operation terms read, the scenario's servos holding "

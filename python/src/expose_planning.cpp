@@ -118,7 +118,7 @@ void bindPlanning(py::module_& m) {
       "rates before the capture then follow from J*: see capture_plan.hpp), the configuration whose capture minimises `objective` "
       "(at the capture's instant: base_rate, impulse, joint_rate_jump; over the motion after it, `horizon` seconds "
       "with the scenario's servos holding and its base control: peak_base_rate, final_base_rate, attitude_excursion, "
-      "settling_time, peak_torque_ratio, peak_grasp_force, peak_grasp_moment) or the weighted sum `weights` "
+      "settling_time, peak_torque_ratio, peak_grasp_force, peak_grasp_moment, time_to_detumble, wheel_momentum_fraction) or the weighted sum `weights` "
       "({name: weight}), inside the joints' position and velocity limits. With a horizon (or an operation term), "
       "optimum and nominal carry `motion`: what the bus felt over it, and momentum_rate the stack's rate once still. Ranges are (lower, upper) pairs; None: the default (self_motion (-1, 1) for a "
       "redundant arm, wrist_roll (-pi/2, pi/2), timing (0, 0), closing_speed: the scenario's rates); (a, a) fixes one. Returns a CapturePlan; InputError "

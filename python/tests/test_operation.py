@@ -64,6 +64,9 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
     if now.get("simulation"):
         assert now["simulation"].pop("html") is None
         assert now["simulation"].pop("wheels") is None
+        assert set(now["simulation"].pop("detumble")) == {"detumble_rate", "time_to_detumble", "peak_base_rate",
+                                                           "final_base_rate", "attitude_excursion",
+                                                           "wheel_momentum_fraction", "energy_dissipated"}
     if now.get("capture"):
         for key in ("contact_point", "contact_point_in_target", "grasp"):
             now["capture"].pop(key)

@@ -205,6 +205,7 @@ void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationStat
   r.record.model = r.model;
   r.record.output_step = r.output_step;
   r.record.t_start = r.record.t_reached = t_start;
+  r.record.detumble.threshold = sc.simulation.detumble_rate;
   if (o.observer) {
     for (const MotionSample& x : r.approach_samples) o.observer(r, x);
     for (const MotionSample& x : r.contact_samples) o.observer(r, x);

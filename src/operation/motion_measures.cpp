@@ -12,8 +12,10 @@
 
 namespace kdl_space {
 
-MotionMeasurer::MotionMeasurer(const FloatingModel& robot, double band) : robot_(robot), band_(band) {
+MotionMeasurer::MotionMeasurer(const FloatingModel& robot, double band, double detumble_rate)
+    : robot_(robot), band_(band), detumble_rate_(detumble_rate) {
   if (!(band > 0.0 && band < 1.0)) throw InputError("settling_band: must lie in (0, 1), got " + detail::number(band));
+  if (!(detumble_rate > 0.0)) throw InputError("detumble_rate: must be > 0, got " + detail::number(detumble_rate));
   reset();
 }
 
@@ -25,6 +27,8 @@ void MotionMeasurer::reset() {
   first_ = true;
   t_.clear();
   w_.clear();
+  detumble_ = DetumbleTime{};
+  detumble_.threshold = detumble_rate_;
 }
 
 void MotionMeasurer::add(const OperationResult& so_far, const MotionSample& x) {
@@ -52,6 +56,9 @@ void MotionMeasurer::add(const OperationResult& so_far, const MotionSample& x) {
   m_.peak_base_rate = std::max(m_.peak_base_rate, w.norm());
   m_.final_base_rate = w.norm();
   m_.attitude_excursion = std::max(m_.attitude_excursion, attitude0_.angularDistance(attitude));
+  detumble_.add(x.t, w.norm());
+  m_.time_to_detumble = detumble_.value();
+  m_.energy_dissipated = -x.work.head<4>().sum();
   t_.push_back(x.t);
   w_.push_back(w);
 }
@@ -76,6 +83,7 @@ int MotionMeasurer::finish(const OperationResult& done, MotionMeasures& out) {
       m_.peak_torque_joint = robot_.jointNames()[j];
     }
   }
+  m_.wheel_momentum_fraction = done.record.wheelMomentumFraction();
   // The stack as one rigid body: its momentum at the end over its inertia there (eq. 2 with qdot = 0).
   int rc = E_NOERROR;
   if (done.record.options.grounded) {

@@ -1,5 +1,7 @@
 #include "kdl_space/operation/motion_record.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -16,9 +18,19 @@ void MotionRecord::takeFrom(const Simulator& sim) {
   friction_velocities = sim.frictionVelocities();
 }
 
+double MotionRecord::wheelMomentumFraction() const {
+  if (wheels.count() == 0 || wheel_peak_momentum.size() != wheels.count()) return std::numeric_limits<double>::quiet_NaN();
+  return (wheel_peak_momentum.array() / wheels.capacity.array()).maxCoeff();
+}
+
 void MotionRecord::add(const MotionSample& x) {
   if (samples++ == 0) first = x;
   last = x;
+  const double rate = x.twist.tail<3>().norm();
+  detumble.add(x.t, rate);
+  peak_base_rate = std::max(peak_base_rate, rate);
+  const Eigen::Quaterniond q0(first.quat(3), first.quat(0), first.quat(1), first.quat(2));
+  attitude_excursion = std::max(attitude_excursion, q0.angularDistance(Eigen::Quaterniond(x.quat(3), x.quat(0), x.quat(1), x.quat(2))));
   max_linear_momentum_change = std::max(max_linear_momentum_change, (x.h.head<3>() - first.h.head<3>()).norm());
   max_angular_momentum_change = std::max(max_angular_momentum_change, (x.h.tail<3>() - first.h.tail<3>()).norm());
   max_energy_change = std::max(max_energy_change, std::abs(x.T - first.T));

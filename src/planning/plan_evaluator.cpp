@@ -30,7 +30,8 @@ void checkRange(const PlanRange& r, const char* name, double lowest) {
 const std::vector<std::string>& planObjectiveTerms() {
   static const std::vector<std::string> terms{
       "base_rate",         "impulse",          "joint_rate_jump",  "peak_base_rate",    "final_base_rate",
-      "attitude_excursion", "settling_time",   "peak_torque_ratio", "peak_grasp_force", "peak_grasp_moment"};
+      "attitude_excursion", "settling_time",   "peak_torque_ratio", "peak_grasp_force", "peak_grasp_moment",
+      "time_to_detumble",  "wheel_momentum_fraction"};
   return terms;
 }
 
@@ -40,8 +41,10 @@ bool isOperationTerm(const std::string& term) {
 
 namespace {
 
-/// A term's value at a configuration (an operation term's from its measures).
-double termValue(const std::string& name, const PlanTerms& t) {
+/// A term's value at a configuration (an operation term's from its measures). A stack not
+/// detumbled within the horizon scores the horizon times its final rate over the threshold (more
+/// than the horizon, and growing with what is left to take out).
+double termValue(const std::string& name, const PlanTerms& t, double horizon, double detumble_rate) {
   if (name == "base_rate") return t.base_rate;
   if (name == "impulse") return t.impulse;
   if (name == "joint_rate_jump") return t.joint_rate_jump;
@@ -52,6 +55,9 @@ double termValue(const std::string& name, const PlanTerms& t) {
   if (name == "settling_time") return m.settling_time;
   if (name == "peak_torque_ratio") return m.peak_torque_ratio;
   if (name == "peak_grasp_force") return m.peak_grasp_force;
+  if (name == "time_to_detumble")
+    return std::isnan(m.time_to_detumble) ? horizon * m.final_base_rate / detumble_rate : m.time_to_detumble;
+  if (name == "wheel_momentum_fraction") return m.wheel_momentum_fraction;
   return m.peak_grasp_moment;
 }
 
@@ -130,7 +136,7 @@ void PlanEvaluator::setUpMotion() {
       throw InputError("objective: peak_torque_ratio: no joint of the robot has an effort limit (the URDF's "
                        "<limit effort=...>): give them, or another term");
   }
-  measurer_.emplace(robot, options_.settling_band);  // or InputError "settling_band: ..."
+  measurer_.emplace(robot, options_.settling_band, scenario_.simulation.detumble_rate);  // or InputError "settling_band: ..."
 }
 
 bool PlanEvaluator::measured(PlanTerms& t) {
@@ -345,7 +351,8 @@ PlanTerms PlanEvaluator::evaluate(const PlanPoint& x, CapturePlan* joints, bool 
   t.impulse = r->impulse.F.head<3>().norm();
   if ((score_motion_ || (measure && measurer_)) && !measured(t)) return t;
   t.objective = 0.0;
-  for (const auto& [name, weight] : options_.weights) t.objective += weight * termValue(name, t);
+  for (const auto& [name, weight] : options_.weights)
+    t.objective += weight * termValue(name, t, horizon_, scenario_.simulation.detumble_rate);
   t.violation = violation(robot, r->robot.after.qdot, closes, t.infeasible);
   t.feasible = t.violation == 0.0 && std::isfinite(t.objective);
   if (joints) {

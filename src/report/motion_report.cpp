@@ -93,6 +93,16 @@ Json wheelsJson(const MotionRecord& r) {
               {"saturation_first_time", finiteOrNull(r.stats.wheel_saturation_first_time)}};
 }
 
+Json detumbleJson(const MotionRecord& r) {
+  return Json{{"detumble_rate", r.detumble.threshold},
+              {"time_to_detumble", finiteOrNull(r.detumble.value())},
+              {"peak_base_rate", r.peak_base_rate},
+              {"final_base_rate", r.last.twist.tail<3>().norm()},
+              {"attitude_excursion", r.attitude_excursion},
+              {"wheel_momentum_fraction", finiteOrNull(r.wheelMomentumFraction())},
+              {"energy_dissipated", r.energyDissipated()}};
+}
+
 Json stiffnessJson(const MotionRecord& r) {
   const Stiffness& st = r.stiffness;
   const SimulationStats& stats = r.stats;
@@ -152,6 +162,13 @@ void printMotionReport(std::ostream& out, const MotionRecord& r) {
   }
   const MotionSample& last = r.last;
   const MotionSample& first = r.first;
+  if (r.samples > 1) {
+    out << "Detumble: the base's rate " << r.peak_base_rate << " rad/s at most, " << last.twist.tail<3>().norm()
+        << " at the end; ";
+    if (std::isnan(r.detumble.value())) out << "not below " << r.detumble.threshold << " rad/s (simulation.detumble_rate) by the end";
+    else out << "below " << r.detumble.threshold << " rad/s for good after " << r.detumble.value() << " s";
+    out << "; attitude excursion " << r.attitude_excursion << " rad; " << r.energyDissipated() << " J dissipated\n";
+  }
   if (last.work.cwiseAbs().maxCoeff() > 0.0)
     out << "Work done [J]: controller " << last.work(0) << ", friction " << last.work(1) << ", limits " << last.work(2)
         << ", base control " << last.work(3) << ", wrenches " << last.work(4) << ", gravity " << last.work(5)

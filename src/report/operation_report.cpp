@@ -219,7 +219,8 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"base_control", baseControlJson(record)},
                          {"stiffness", stiffnessJson(record)},
                          {"friction", frictionJson(record)},
-                         {"wheels", wheelsJson(record)}};
+                         {"wheels", wheelsJson(record)},
+                         {"detumble", detumbleJson(record)}};
   return j;
 }
 

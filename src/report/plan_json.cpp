@@ -18,6 +18,9 @@ Json measuresJson(const MotionMeasures& m, const std::vector<std::string>& joint
   j["peak_grasp_force"] = m.peak_grasp_force;
   j["peak_grasp_moment"] = m.peak_grasp_moment;
   j["momentum_rate"] = m.momentum_rate;
+  j["time_to_detumble"] = m.time_to_detumble;  // null: not detumbled within the horizon
+  j["wheel_momentum_fraction"] = m.wheel_momentum_fraction;
+  j["energy_dissipated"] = m.energy_dissipated;
   return j;
 }
 

@@ -49,6 +49,9 @@ std::vector<std::string> studyColumns(const Study& study) {
   if (self_motion)
     for (const std::string& j : joints) c.push_back("q." + j);
   for (const std::string& j : joints) c.push_back("qdot." + j);
+  if (study.motion_duration > 0.0)  // what the motion did to the tumble (issue 39)
+    for (const char* f : {"time_to_detumble", "attitude_excursion", "wheel_momentum_fraction", "energy_dissipated"})
+      c.emplace_back(f);
   return c;
 }
 
@@ -78,9 +81,9 @@ KDL::Frame handFrame(const Kinematics& kin, const Contact& h) {
 /// servos holding the capture configuration): each joint's largest |torque|, the base's largest
 /// |w| and the largest |qdot_j| / limit_j, at the output steps. A run that fails: its code.
 int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureResult& r, std::vector<double>& peak,
-                double& peak_base_rate, double& rate_ratio) {
+                double& peak_base_rate, double& rate_ratio, MotionMeasures& detumble) {
   const FloatingModel& robot = *problem.robot.model;
-  MotionMeasurer measurer(robot);  // the peaks, as `plan` reads them
+  MotionMeasurer measurer(robot, 0.05, st.scenario.simulation.detumble_rate);  // the peaks, as `plan` reads them
   std::vector<int> in_model;       // the robot's joints in the system after the capture
   OperationOptions o;
   o.duration = st.motion_duration;
@@ -105,7 +108,17 @@ int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureRes
   const MotionMeasures& m = measurer.peaks();
   for (unsigned int j = 0; j < robot.nj(); ++j) peak[j] = std::max(peak[j], m.peak_torque[j]);
   peak_base_rate = std::max(peak_base_rate, m.peak_base_rate);
+  detumble = m;
+  detumble.wheel_momentum_fraction = motion.record.wheelMomentumFraction();
   return E_NOERROR;
+}
+
+/// The detumble columns (studyColumns' last) from the motion's measures.
+template <typename Out>
+Out detumbleColumns(const MotionMeasures& m, Out out) {
+  for (const double v : {m.time_to_detumble, m.attitude_excursion, m.wheel_momentum_fraction, m.energy_dissipated})
+    *out++ = v;
+  return out;
 }
 
 }  // namespace
@@ -251,12 +264,13 @@ void StudyEvaluator::sample(std::uint64_t i, const double* drawn, double* row) {
   *out++ = r->energyLost();
   // The limits: rates after the impact; the motion's peaks too.
   double rate_ratio = 0.0, torque_ratio = 0.0, peak_base_rate = base_rate;
+  MotionMeasures detumble;
   if (st.limits.joint_rate)
     for (unsigned int j = 0; j < n; ++j)
       rate_ratio = std::max(rate_ratio, std::abs(r->robot.after.qdot(j)) / (*st.limits.joint_rate)[j]);
   if (st.motion_duration > 0.0) {
     std::vector<double> peak(n, 0.0);
-    if (const int rc = motionPeaks(st, w.problem, *r, peak, peak_base_rate, rate_ratio))
+    if (const int rc = motionPeaks(st, w.problem, *r, peak, peak_base_rate, rate_ratio, detumble))
       return fail(rc, "motion: the motion after the capture cannot be simulated for " + detail::number(st.motion_duration) + " s");
     for (unsigned int j = 0; j < n; ++j) {
       *out++ = peak[j];
@@ -276,6 +290,7 @@ void StudyEvaluator::sample(std::uint64_t i, const double* drawn, double* row) {
   if (w.self_motion)
     for (unsigned int j = 0; j < n; ++j) *out++ = robot.state.q(j);
   for (unsigned int j = 0; j < n; ++j) *out++ = r->robot.after.qdot(j);
+  if (st.motion_duration > 0.0) out = detumbleColumns(detumble, out);
   row[1] = E_NOERROR;
 }
 

@@ -3,6 +3,8 @@
 // the CSV and the JSON (modes that persist, hard stops, friction, the base's control, stiffness).
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -297,6 +299,42 @@ TEST(ReactionWheels, DetumbleTheStackWithinTheirLimits) {
   for (std::size_t i = 0; i < c.at("t").size(); ++i)
     for (const char* u : {"wheel_u_1", "wheel_u_2", "wheel_u_3"}) largest = std::max(largest, std::abs(c.at(u)[i]));
   EXPECT_NEAR(largest, 0.5, 1e-12);
+}
+
+// simulation.detumble against the CSV of the same run, read here: the time to detumble is the
+// first post row after the last row whose |w| is at or above detumble_rate; the attitude
+// excursion the largest angle from the first post row's quaternion; the energy dissipated minus
+// the work of the controls, friction, stops and base control at the last row; the wheels'
+// fraction the largest |wheel_h_i| over its capacity. The text says the same.
+TEST(ReactionWheels, TheDetumbleMeasuresAreTheCsvs) {
+  const std::string csv = scratch("detumble.csv");
+  const ToolRun run = kdlSpace("simulate " + kScenarios + "detumble_with_wheels.yaml --json --csv " + csv);
+  ASSERT_EQ(run.rc, 0) << run.err;
+  const json d = json::parse(run.out).at("simulation").at("detumble");
+  const auto c = readCsv(csv);
+  const std::vector<double>& t = c.at("t");
+  const double threshold = d.at("detumble_rate").get<double>();
+  EXPECT_EQ(threshold, 1e-3);
+  double settled = t.front(), excursion = 0.0, fraction = 0.0;
+  const Eigen::Quaterniond q0(c.at("base_qw")[0], c.at("base_qx")[0], c.at("base_qy")[0], c.at("base_qz")[0]);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double w = std::hypot(c.at("base_wx")[i], c.at("base_wy")[i], c.at("base_wz")[i]);
+    if (w >= threshold && i + 1 < t.size()) settled = t[i + 1];
+    const Eigen::Quaterniond q(c.at("base_qw")[i], c.at("base_qx")[i], c.at("base_qy")[i], c.at("base_qz")[i]);
+    excursion = std::max(excursion, q0.angularDistance(q));
+    for (const char* h : {"wheel_h_1", "wheel_h_2", "wheel_h_3"}) fraction = std::max(fraction, std::abs(c.at(h)[i]) / 20.0);
+  }
+  EXPECT_GT(settled, t.front());  // it did start above the threshold
+  EXPECT_NEAR(d.at("time_to_detumble").get<double>(), settled - t.front(), 1e-12);
+  EXPECT_NEAR(d.at("attitude_excursion").get<double>(), excursion, 1e-12);
+  EXPECT_NEAR(d.at("wheel_momentum_fraction").get<double>(), fraction, 1e-12);
+  const std::size_t last = t.size() - 1;
+  const double dissipated = -(c.at("work_controller")[last] + c.at("work_friction")[last] + c.at("work_limits")[last] +
+                              c.at("work_base_control")[last]);
+  EXPECT_NEAR(d.at("energy_dissipated").get<double>(), dissipated, 1e-12);
+  EXPECT_GT(dissipated, 0.0);
+  const ToolRun text = kdlSpace("simulate " + kScenarios + "detumble_with_wheels.yaml");
+  EXPECT_NE(text.out.find("below 0.001 rad/s for good after "), std::string::npos) << text.out;
 }
 
 TEST(Stiffness, ExplicitRunIsFlaggedAndRosenbrockAgreesWithFarFewerSteps) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <regex>
 #include <sstream>
 #include <unistd.h>
 
@@ -243,6 +244,47 @@ TEST(StudyCommand, TheSummaryNamesWhyTheFirstSampleOfEachFailureFailed) {
   const std::string expected = "  status -106: " + std::to_string(f["count"].get<int>()) + " samples, the first " +
                                std::to_string(first) + ": " + message.str() + "\n";
   EXPECT_NE(t.out.find(" could not be computed), seed 5; table " + table + "\n" + expected), std::string::npos) << t.out;
+}
+
+// The detumble columns (issue 39): one sample at the shipped detumble's own configuration, 60 s of
+// motion under each law; its time_to_detumble, attitude_excursion, wheel_momentum_fraction and
+// energy_dissipated are `simulate`'s simulation.detumble of the same scenario (the study's servos
+// hold the capture configuration, as the scenario's `set_point: hold` do).
+TEST(StudyCommand, TheDetumbleColumnsAreSimulates) {
+  for (const std::string law : {"hold", "momentum_distribution"}) {
+    SCOPED_TRACE(law);
+    std::string text = slurp(kScenarios + "detumble_with_wheels.yaml");
+    text = std::regex_replace(text, std::regex("\\.\\./urdf"), kScenarios + "../urdf");
+    text += "  after_capture: {law: " + law + "}\n";
+    const std::string scenario = write("detumble_" + law + ".yaml", text);
+    const std::string study = write("detumble_study_" + law + ".yaml", "scenario: " + scenario + "\nseed: 1\n"
+                                    "inputs: {target.mass: {grid: [50, 50, 1]}}\nmotion: {duration: 60, output_step: 0.1}\n");
+    const std::string table = scratch("detumble_" + law + ".csv");
+    const ToolRun s = kdlSpace("study " + study + " -o " + table);
+    ASSERT_EQ(s.rc, 0) << s.err;
+    const ToolRun sim = kdlSpace("simulate " + scenario + " --json");
+    ASSERT_EQ(sim.rc, 0) << sim.err;
+    const json d = json::parse(sim.out).at("simulation").at("detumble");
+    std::istringstream t(slurp(table));
+    std::string line, header;
+    std::getline(t, line);  // the CRC line
+    std::getline(t, header);
+    std::getline(t, line);
+    const auto split = [](const std::string& row) {
+      std::vector<std::string> cells;
+      std::stringstream ss(row);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      return cells;
+    };
+    const std::vector<std::string> names = split(header), values = split(line);
+    for (const char* column : {"time_to_detumble", "attitude_excursion", "wheel_momentum_fraction", "energy_dissipated"}) {
+      const auto at = std::find(names.begin(), names.end(), column);
+      ASSERT_NE(at, names.end()) << column << " in " << header;
+      const double value = std::stod(values[static_cast<std::size_t>(at - names.begin())]);
+      ASSERT_TRUE(d.at(column).is_number()) << column << ": " << d.dump();
+      EXPECT_NEAR(value, d.at(column).get<double>(), 1e-9 * (std::abs(value) + 1e-3)) << column;
+    }
+  }
 }
 
 TEST(StudyCommand, TheNominalSamplesMotionIsSimulates) {

@@ -440,6 +440,32 @@ TEST_P(Families, PlanFindsAnOptimumOrSaysWhyNot) {
 
 // plan over the operation: the motion after each capture measured (the servos holding), an
 // optimum no worse than the nominal, or a refusal that names what is missing.
+// plan with the detumble objective (issue 39 item 4): the optimum's objective is its measured
+// time to detumble (or, not detumbled within the horizon, the horizon times its final rate over
+// the threshold), no worse than the nominal's; a robot without joints is refused as before.
+TEST_P(Families, PlanForTheTimeToDetumbleOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const Scenario sc = loadScenario(writeScenario(f, "{type: capture}"));
+  PlanOptions o;
+  o.weights = {{"time_to_detumble", 1.0}};
+  o.horizon = 0.5;
+  o.scan = 3;
+  o.polish_starts = 1;
+  o.polish_evaluations = 10;
+  if (f.joints == 0) {
+    EXPECT_THROW(planCapture(sc, o), InputError) << f.name;
+    return;
+  }
+  const CapturePlan p = planCapture(sc, o);
+  ASSERT_TRUE(p.optimum.motion) << f.name;
+  const MotionMeasures& m = *p.optimum.motion;
+  const double expected = std::isnan(m.time_to_detumble) ? 0.5 * m.final_base_rate / sc.simulation.detumble_rate
+                                                         : m.time_to_detumble;
+  EXPECT_NEAR(p.optimum.objective, expected, 1e-12 * std::max(1.0, expected)) << f.name;
+  EXPECT_LE(p.optimum.objective, p.nominal.objective + 1e-12) << f.name;
+  EXPECT_TRUE(std::isnan(m.wheel_momentum_fraction)) << f.name << ": no wheels";
+}
+
 TEST_P(Families, PlanOverTheOperationMeasuresTheMotionOrSaysWhyNot) {
   const ModelFamily& f = GetParam();
   const Scenario sc = loadScenario(writeScenario(f, "{type: capture}"));

@@ -41,6 +41,12 @@ struct MotionMeasures {
   /// sample's configuration, moving as one rigid body with that sample's momentum (baseTwist with
   /// qdot = 0) [rad/s]; 0 for a grounded base
   double momentum_rate = std::numeric_limits<double>::quiet_NaN();
+  /// DetumbleTime over the motion's samples at the measurer's threshold [s] (NaN: not detumbled)
+  double time_to_detumble = std::numeric_limits<double>::quiet_NaN();
+  /// The largest fraction of its momentum capacity a reaction wheel used (NaN without wheels; with finish())
+  double wheel_momentum_fraction = std::numeric_limits<double>::quiet_NaN();
+  /// MotionRecord::energyDissipated at the last sample [J]
+  double energy_dissipated = 0.0;
 };
 
 /// \brief Collects MotionMeasures from an operation's samples: give add() as (or from)
@@ -48,8 +54,9 @@ struct MotionMeasures {
 class KDL_SPACE_EXPORT MotionMeasurer {
  public:
   /// `robot`: the robot whose joints' torques are measured (its names are looked up in the
-  /// system after the capture); `band` (0, 1): the settling band's width. \throws InputError for a band outside (0, 1).
-  MotionMeasurer(const FloatingModel& robot, double band = 0.05);
+  /// system after the capture); `band` (0, 1): the settling band's width; `detumble_rate` [rad/s]:
+  /// time_to_detumble's threshold. \throws InputError for a band outside (0, 1) or a rate <= 0.
+  MotionMeasurer(const FloatingModel& robot, double band = 0.05, double detumble_rate = 1e-3);
   /// One sample, in time order (the approach's are skipped; the contact's give the grasp wrench).
   void add(const OperationResult& so_far, const MotionSample& x);
   /// \brief The measures of the samples seen (settling time and momentum rate need the whole run).
@@ -63,6 +70,8 @@ class KDL_SPACE_EXPORT MotionMeasurer {
  private:
   const FloatingModel& robot_;
   double band_;
+  double detumble_rate_;
+  DetumbleTime detumble_;
   MotionMeasures m_;
   std::vector<int> in_model_;  ///< the robot's joints in the system after the capture
   const FloatingModel* after_ = nullptr;

@@ -3,6 +3,8 @@
 // the momentum balance, the energy split), kept as the samples go by: nothing grows with the run.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +13,24 @@
 #include "kdl_space/operation/motion_sample.hpp"
 
 namespace kdl_space {
+
+/// \brief The time to detumble, streamed over a run's samples: from the first sample to the first
+/// one after which the base's angular rate |w| stays below `threshold` to the end [s]; 0 when it
+/// never reaches it, NaN when the last sample is still at or above it (not detumbled in the run).
+struct DetumbleTime {
+  double threshold = 1e-3;  ///< [rad/s]
+  void add(double t, double rate) {
+    if (std::isnan(t_start_)) t_start_ = t;
+    if (!(rate < threshold)) above_ = true, settled_ = std::numeric_limits<double>::quiet_NaN();
+    else if (std::isnan(settled_)) settled_ = above_ ? t : t_start_;
+  }
+  double value() const { return settled_ - t_start_; }
+
+ private:
+  double t_start_ = std::numeric_limits<double>::quiet_NaN();
+  double settled_ = std::numeric_limits<double>::quiet_NaN();
+  bool above_ = false;
+};
 
 struct KDL_SPACE_EXPORT MotionRecord {
   std::shared_ptr<const FloatingModel> model;  ///< the system that moved
@@ -36,6 +56,15 @@ struct KDL_SPACE_EXPORT MotionRecord {
   bool torques = false;  ///< some joint torque acted (a controller, friction)
   /// Each reaction wheel's largest |momentum| [N m s] and |motor torque| [N m] over the samples.
   Eigen::VectorXd wheel_peak_momentum, wheel_peak_torque;
+  /// What the detumble took (the base's rate against DetumbleTime::threshold, `simulation.detumble_rate`)
+  DetumbleTime detumble;
+  double attitude_excursion = 0.0;  ///< max angle of R(t) R(t_0)^T over the samples [rad]
+  double peak_base_rate = 0.0;      ///< max |w| of the base [rad/s]
+  /// The largest fraction of its capacity a wheel used (NaN without wheels).
+  double wheelMomentumFraction() const;
+  /// The kinetic energy the joints' controls, friction, hard stops and the base control took out
+  /// of the system: -(their work) at the last sample [J].
+  double energyDissipated() const { return -last.work.head<4>().sum(); }
 
   /// The simulator's set-up and records after (or during) its run.
   void takeFrom(const Simulator& sim);

@@ -23,6 +23,10 @@ Json stiffnessJson(const MotionRecord& r);
 /// start and the end, peak momentum (and its fraction of the capacity) and peak torque, and how
 /// long the cluster was saturated.
 Json wheelsJson(const MotionRecord& r);
+/// What the motion did to the stack's tumble: `detumble_rate` (the threshold), `time_to_detumble`
+/// (null: not detumbled in the run), `peak_base_rate`, `final_base_rate`, `attitude_excursion`,
+/// `wheel_momentum_fraction` (null without wheels), `energy_dissipated`.
+Json detumbleJson(const MotionRecord& r);
 /// The joints with damping or Coulomb friction: their values and the regularisation v_s used.
 Json frictionJson(const MotionRecord& r);
 

@@ -177,7 +177,7 @@ void afterCapture(const Field& section, SimulationSpec& s) {
 SimulationSpec simulation(const Field& f, const FloatingModel& robot, const FloatingModel* target) {
   f.onlyKeys({"duration", "output_step", "integrator", "step", "rtol", "atol", "max_step", "max_steps", "gravity",
               "joints", "base", "limits", "effort_limits", "friction", "friction_velocity", "base_control", "wrenches",
-              "target_joints", "after_capture"});
+              "target_joints", "after_capture", "detumble_rate"});
   SimulationSpec s;
   const auto positive = [&](const char* key, double& value) {
     if (!f.has(key)) return;
@@ -245,6 +245,10 @@ SimulationSpec simulation(const Field& f, const FloatingModel& robot, const Floa
   if (f.has("wrenches"))
     for (const Field& w : f.at("wrenches").items("wrenches {link, force, torque, start, end}")) s.wrenches.push_back(wrench(w, robot));
   if (f.has("after_capture")) afterCapture(f, s);
+  if (f.has("detumble_rate")) {  // [rad/s] or {deg_per_s: ...}
+    s.detumble_rate = f.at("detumble_rate").angle(true);
+    if (!(s.detumble_rate > 0.0)) f.at("detumble_rate").fail("must be > 0, got " + number(s.detumble_rate));
+  }
   return s;
 }
 

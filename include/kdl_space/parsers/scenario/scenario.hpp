@@ -47,6 +47,9 @@ struct SimulationSpec {
   Law after_capture = Law::Hold;
   double unload_gain = 0.2;  ///< momentum_distribution's [1/s]
   double bandwidth = 20.0;   ///< momentum_distribution's rate servos' [1/s]
+  /// `detumble_rate`: the base's angular rate below which the stack counts as detumbled
+  /// (MotionRecord::detumble, MotionMeasures::time_to_detumble) [rad/s]
+  double detumble_rate = 1e-3;
 };
 
 /// \brief `robot.base_actuators`: the servicer's reaction wheels and thrusters as hardware. With
