@@ -73,6 +73,9 @@ def expected_series(col, phases, i, joints):
     if "base_control_nx" in col:
         for c in "xyz":
             e[("base control", f"n_{c}")] = col[f"base_control_n{c}"][i]
+    for name in col:
+        if name.startswith("wheel_h_"):
+            e[("wheel momentum", "h_" + name[len("wheel_h_"):])] = col[name][i]
     return e
 
 
@@ -253,6 +256,20 @@ def test_base_control_has_its_plot(tmp_path, cli):
     assert [p["name"] for p in plots][-1] == "base control"
     col, _ = columns(csv)
     assert np.abs(col["base_control_nz"]).max() > 1e-6, "the control acts"
+
+
+@needs_browser
+def test_reaction_wheels_have_their_plot(tmp_path, cli):
+    """scenarios/detumble_with_wheels.yaml: the wheels' momenta have a plot, the CSV's at every frame."""
+    page, csv = tmp_path / "wheels.html", tmp_path / "wheels.csv"
+    done = subprocess.run([cli, "simulate", str(SOURCE_DIR / "scenarios" / "detumble_with_wheels.yaml"), "--duration", "10",
+                           "--html", str(page), "--csv", str(csv)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    plots, checked = check_values(page, csv, [f"joint{j}" for j in range(1, 8)])
+    assert [p["name"] for p in plots][-2:] == ["base control", "wheel momentum"]
+    assert plots[-1]["series"] == ["h_1", "h_2", "h_3"]
+    col, _ = columns(csv)
+    assert np.abs(col["wheel_h_3"]).max() > 1.0, "the wheels take momentum"
 
 
 def test_a_humanoids_page_stays_small(tmp_path, cli):

@@ -21,7 +21,7 @@ using namespace page;
 /// [deg/s], the robot's joint rates and torques (NaN for a joint the sample's system lacks), |P|,
 /// |L| (about the world origin), the kinetic energy T and its balance T - T_0 - work (T_0 at the
 /// phase's first sample: the balance restarts at the capture, as the --plot's), the base
-/// control's torque (world axes).
+/// control's torque (world axes), and the reaction wheels' momenta (NaN where a sample has none).
 void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_far, const MotionSample& x) {
   const std::vector<std::string>& robot = sc_.capture.robot.model->jointNames();
   if (series_model_ != so_far.model.get()) {
@@ -48,6 +48,9 @@ void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_f
   for (double v : {x.h.head<3>().norm(), x.h.tail<3>().norm(), x.T, x.T - series_T0_ - x.work.sum()})
     f.push_back(static_cast<float>(v));
   for (int i = 3; i < 6; ++i) f.push_back(static_cast<float>(x.base_wrench(i)));
+  const Eigen::Index wheels = sc_.base_actuators.wheels.count();
+  for (Eigen::Index i = 0; i < wheels; ++i)
+    f.push_back(x.wheel_momentum.size() == wheels ? static_cast<float>(x.wheel_momentum(i)) : std::nanf(""));
   series_size_ = f.size() - series_at_;
 }
 
@@ -82,6 +85,9 @@ void HtmlWriter::plotsJson(Json& data, const OperationResult& r) {
   plot("energy balance", "energy balance T - T0 - work [J] (from each phase's start)", {"T - T0 - work"}, 9 + 2 * nj);
   if (sc_.simulation.base_control.attitude.on)
     plot("base control", "base control torque (world axes) [N m]", {"n_x", "n_y", "n_z"}, 10 + 2 * nj);
+  std::vector<std::string> wheels;
+  for (Eigen::Index i = 1; i <= sc_.base_actuators.wheels.count(); ++i) wheels.push_back("h_" + std::to_string(i));
+  if (!wheels.empty()) plot("wheel momentum", "reaction wheels' momenta [N m s]", wheels, 13 + 2 * nj);
   std::vector<float> series;
   series.reserve(n * columns.size());
   for (std::size_t k = 0; k < n; ++k)
