@@ -78,9 +78,19 @@ int Simulator::actuate(double t, const Vector& x) {
     if (base_control_.on()) {
       scratch_.base_wrench = baseControlWrench(base_control_, scratch_.state.world_T_base,
                                                scratch_.velocity.base_twist, &base_saturated_);
-      // momentum_distribution: the attitude actuators draw the links' momentum out (after the
-      // control's own limit; the wheels' limits follow).
-      if (distribution_.on && base_control_.attitude.on) scratch_.base_wrench.tail<3>() -= distribution_.unload_gain * L_g_;
+      // momentum_distribution: the attitude actuators draw the links' momentum out, within their
+      // limits (the wheels' below; the thrusters' the control's own, per base axis).
+      if (distribution_.on && base_control_.attitude.on) {
+        Vector3d n = scratch_.base_wrench.tail<3>() - distribution_.unload_gain * L_g_;
+        if (!wheels) {
+          const Matrix3d& R = kin_.R[0];
+          const Vector3d local = R.transpose() * n, limit = base_control_.attitude.torque_limit;
+          const Vector3d clamped = local.cwiseMax(-limit).cwiseMin(limit);
+          base_saturated_ = base_saturated_ || clamped != local;
+          n = R * clamped;
+        }
+        scratch_.base_wrench.tail<3>() = n;
+      }
       // With wheels the attitude torque is theirs (below), an internal one.
       const Vector3d thrust_torque = wheels ? Vector3d::Zero() : Vector3d(scratch_.base_wrench.tail<3>());
       apply(0, kin_.com[0], scratch_.base_wrench.head<3>(), thrust_torque, external_power_[0]);

@@ -150,6 +150,42 @@ TEST(PostCaptureLaws, PlanarMomentumDistributionClosedForm) {
   EXPECT_GT(largest_rate, 0.0);
 }
 
+// The same planar system with thrusters instead of wheels: the unloading is an external torque,
+// held to the attitude control's limit per base axis like the rest of it; the momentum then
+// changes by exactly its impulse.
+TEST(PostCaptureLaws, DistributionThroughThrustersStaysWithinTheirTorqueLimit) {
+  const ModelPtr model = std::make_shared<const FloatingModel>(loadUrdfString(kPlanar, "planar"));
+  SimulationOptions options;
+  options.rtol = 1e-12;
+  options.atol = 1e-14;
+  Simulator sim(model, options);
+  BaseControl thrusters;
+  thrusters.attitude.on = thrusters.attitude.hold = true;
+  thrusters.attitude.torque_limit = Vector3d::Constant(0.01);  // [N m]: k L_g asks ~0.1
+  sim.setBaseControl(thrusters);
+  distribute(sim, 200.0, 0.3);
+  SimulationState s;
+  s.state = State(*model);
+  s.velocity.qdot = KDL::JntArray(1);
+  s.velocity.base_twist.rot = KDL::Vector(0, 0, 0.05);
+  double T;
+  Vector6d h0, h;
+  ASSERT_EQ(sim.energyAndMomentum(s, T, h0), E_NOERROR);
+  double largest = 0.0, balance = 0.0;
+  ASSERT_EQ(sim.run(s, 5.0, 0.1,
+                    [&](const SimulationState& x) {
+                      largest = std::max(largest, x.base_wrench.tail<3>().cwiseAbs().maxCoeff());
+                      ASSERT_EQ(sim.energyAndMomentum(x, T, h), E_NOERROR);
+                      balance = std::max(balance, (h - h0 - x.impulse).norm());
+                    }),
+            E_NOERROR);
+  EXPECT_LE(largest, 0.01 * (1 + 1e-12));
+  EXPECT_GT(largest, 0.0099);
+  EXPECT_GT(sim.stats().base_saturation_time, 1.0);
+  EXPECT_LT(balance, 1e-12);
+  EXPECT_GT(std::abs(s.impulse(5)), 0.04);  // 0.01 N m for most of 5 s
+}
+
 // 3. `hold`'s attitude law through a wheel on a rigid bus, unsaturated: I_z th'' = -kp th - kd th',
 // th(0) = 0, th'(0) = w0: th = (w0 / w_d) exp(-zeta w_n t) sin(w_d t).
 TEST(PostCaptureLaws, HoldsAttitudeLawThroughAWheelIsTheDampedOscillator) {
