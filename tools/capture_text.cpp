@@ -98,8 +98,10 @@ void printCompliantSummary(std::ostream& out, const CompliantCaptureResult& c, c
                          "settled (the relative motion died out; the grasp stays compliant, law.lock: never)"};
   const char* rules[3] = {"", ": the relative speed fell below law.catch_tolerance",
                           ": the springs' energy passed its maximum (the hand stopped closing)"};
+  const bool stays = c.lock == GraspLock::Never && c.end == ContactEnd::TimedOut;  // the springs go on holding
   out << "\nCompliant contact (law.type compliant; the impulsive capture above is its limit):\n"
-      << "  end " << ends[static_cast<int>(c.end)] << rules[static_cast<int>(c.catch_rule)] << " after " << c.duration << " s (" << c.history.size()
+      << "  end " << ends[static_cast<int>(c.end)] << (stays ? "; the grasp stays compliant (law.lock: never)" : "")
+      << rules[static_cast<int>(c.catch_rule)] << " after " << c.duration << " s (" << c.history.size()
       << " samples, " << c.steps << " steps)\n"
       << "  peak force " << c.peak_force << " N, peak moment " << c.peak_moment << " N m\n"
       << "  impulse (f; n)   " << row(c.impulse) << "\n"

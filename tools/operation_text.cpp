@@ -41,6 +41,8 @@ void printOperation(std::ostream& out, const Scenario& sc, const OperationResult
         << (r.joined ? "the target joins the robot's tree at link '" + contact_link + "' by " +
                            (r.joined->grasp == GraspJoint::Rigid       ? "a fixed joint"
                             : r.joined->grasp == GraspJoint::Spherical ? "a ball joint (grasp_rz, grasp_ry, grasp_rx)"
+                                                                       : r.compliant && r.compliant->lock == GraspLock::Never
+                                                                       ? "six grasp joints held by the gripper's springs and dampers (grasp_x ... grasp_rx; law.lock: never)"
                                                                        : "six grasp joints braked at their deflection (grasp_x ... grasp_rx)")
             : r.payload_attached ? "the target is attached to link '" + contact_link + "'"
             : r.target_motion    ? std::string("the target separates; both move on")

@@ -184,12 +184,13 @@ void bindOperation(py::module_& m) {
         py::arg("damping") = py::none(), py::arg("damping_time") = py::none(), py::arg("catch_tolerance") = py::none(),
         py::arg("max_duration") = py::none(), py::arg("normal") = py::none(), py::arg("lock") = py::none(),
         "The compliant capture of the scenario's target at the scenario's states (docs/COMPLIANT.md): the two "
-        "systems joined at the grasp by a spring-damper, the contact integrated until it is caught or opens. The "
+        "systems joined at the grasp by a spring-damper, the contact integrated until the relative motion has died "
+        "out (or it is caught, or opens). The "
         "law is the scenario's `law: {type: compliant, ...}` (or a stiff gripper's defaults), each keyword "
         "overriding it: stiffness and damping per axis (x, y, z [N/m, N s/m]; about x, y, z [N m/rad, N m s/rad]) "
         "of the robot's contact link, damping_time (D = damping_time * stiffness) [s], catch_tolerance, "
-        "max_duration [s], normal (a one-sided contact), lock (never, tolerance or spring_maximum: when the grasp "
-        "locks). Returns the dict of `kdl_space capture --json`'s 'compliant' (end, duration, peak_force, impulse, "
+        "max_duration [s], normal (a one-sided contact), lock (never, the default: the grasp stays "
+        "compliant; tolerance or spring_maximum: when the grasp locks). Returns the dict of `kdl_space capture --json`'s 'compliant' (end, duration, peak_force, impulse, "
         "lock_share, each side's velocities after, energies, history); "
         "solve_capture(scenario) is its impulsive limit. InputError for a parameter out of range.");
   m.def("run_operation", &runOperation, py::arg("scenario"), py::kw_only(), py::arg("duration") = py::none(),

@@ -237,11 +237,13 @@ def test_compliant_capture_in_the_operation_and_alone():
     'contact', with the wrench on the robot) and the joined motion after it; both sides' momentum is
     kept from the contact's start to the end (the momentum column of a joined system: both sides);
     the dict gives the contact beside its impulsive limit. solve_compliant_capture converges to
-    solve_capture as the stiffness grows (D = damping_time K: first order in 1/K)."""
+    solve_capture as the stiffness grows (a latching grasp, D = damping_time K: first order in 1/K)."""
     scenario = kdl_space.load_scenario(str(SCENARIOS["compliant_capture"]))
     r = kdl_space.run_operation(scenario, duration=0.5)
     c = r["compliant"]
-    assert c["end"] == "caught" and r["capture"] is not None
+    # The shipped gripper stays compliant (law.lock: never, the default): the lock takes nothing.
+    assert c["lock"] == "never" and c["end"] in ("settled", "timed_out") and r["capture"] is not None
+    assert c["lock_share"] == {"linear_impulse": 0.0, "angular_impulse": 0.0, "energy": 0.0}
     assert r["simulation"]["target_joined"]["grasp"] == "compliant"
     samples = r["samples"]
     phases = np.array(samples["phase"])
@@ -262,7 +264,8 @@ def test_compliant_capture_in_the_operation_and_alone():
     errors = []
     for K in (1e9, 1e10, 1e11):  # docs/COMPLIANT.md: beta = 10 ms, the contact lasts ~ m / (beta K)
         stiffness = [K, K, K, K / 100, K / 100, K / 100]
-        c = kdl_space.solve_compliant_capture(touch, stiffness=stiffness, damping_time=1e-2)
+        c = kdl_space.solve_compliant_capture(touch, stiffness=stiffness, damping_time=1e-2, lock="spring_maximum")
+        assert c["lock"] == "spring_maximum"
         errors.append(np.linalg.norm(np.array(c["impulse"]) - limit) / np.linalg.norm(limit))
     assert math.log10(errors[1] / errors[2]) >= 0.9, errors
     assert errors[2] < 1e-6, errors

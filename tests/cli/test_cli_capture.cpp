@@ -269,12 +269,33 @@ nlohmann::json compliantBesideImpulsive(const std::string& file) {
 }
 
 TEST(CaptureTool, CompliantContactBesideTheImpulsiveCapture) {
-  compliantBesideImpulsive(withLaw("robot_to_robot_capture", "{type: compliant}"));
+  compliantBesideImpulsive(withLaw("robot_to_robot_capture", "{type: compliant, lock: spring_maximum}"));
+}
+
+/// The default gripper stays compliant (law.lock: never): the contact ends when the relative
+/// motion has died out (or at law.max_duration), the lock takes no share of the impulse or the
+/// energy, and the momentum and energy balance as for a latching gripper.
+TEST(CaptureTool, CompliantByDefaultTheGraspNeverLocks) {
+  const ToolRun r = kdlSpace("capture " + withLaw("robot_to_robot_capture", "{type: compliant}") + " --json");
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json& c = j.at("compliant");
+  EXPECT_EQ(c.at("lock"), "never");
+  EXPECT_TRUE(c.at("end") == "settled" || c.at("end") == "timed_out") << c.at("end");
+  EXPECT_TRUE(c.at("catch_rule").is_null());
+  for (const char* share : {"linear_impulse", "angular_impulse", "energy"})
+    EXPECT_EQ(c.at("lock_share").at(share).get<double>(), 0.0) << share;
+  EXPECT_EQ(c.at("lock_loss").get<double>(), 0.0);
+  EXPECT_EQ(m(c.at("lock_impulse")).norm(), 0.0);
+  EXPECT_TRUE(near(m(c.at("momentum_after")), m(j.at("momentum_before")), 1e-12, 0.0, "momentum"));
+  const double lost = c.at("energy_before").get<double>() - c.at("energy_after").get<double>();
+  EXPECT_NEAR(lost, c.at("energy_dissipated").get<double>() + c.at("spring_energy").get<double>(),
+              1e-8 * c.at("energy_before").get<double>());
 }
 
 /// A rigid target (the tumbling box) joined as one free body, beside the rigid capture.
 TEST(CaptureTool, CompliantContactOfARigidTarget) {
-  const std::string file = withLaw("tumbling_box_capture", "{type: compliant}");
+  const std::string file = withLaw("tumbling_box_capture", "{type: compliant, lock: spring_maximum}");
   const nlohmann::json j = compliantBesideImpulsive(file);
   const nlohmann::json& c = j.at("compliant");
   const Eigen::MatrixXd w = m(j.at("target").at("twist_after")), wc = m(c.at("target").at("base_twist_after"));

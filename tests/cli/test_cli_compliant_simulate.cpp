@@ -58,8 +58,13 @@ TEST(CompliantSimulate, TheContactsRowsCarryTheForceHistoryAndTheJoinedMotionFol
   ASSERT_TRUE(j.at("capture").is_object()) << "the impulsive limit beside the contact";
   const nlohmann::json& c = j.at("compliant");
   ASSERT_TRUE(c.is_object());
-  EXPECT_EQ(c.at("end"), "caught");
-  EXPECT_TRUE(c.at("catch_rule") == "tolerance" || c.at("catch_rule") == "spring_maximum") << c.at("catch_rule");
+  // The shipped gripper stays compliant (law.lock: never, the default): no lock, no share for it.
+  EXPECT_EQ(c.at("lock"), "never");
+  EXPECT_TRUE(c.at("end") == "settled" || c.at("end") == "timed_out") << c.at("end");
+  EXPECT_TRUE(c.at("catch_rule").is_null());
+  EXPECT_EQ(c.at("lock_share").at("angular_impulse").get<double>(), 0.0);
+  EXPECT_EQ(c.at("lock_loss").get<double>(), 0.0);
+  EXPECT_FALSE(j.at("simulation").at("stiffness").at("stiff").get<bool>()) << j.at("simulation").at("stiffness");
   const double t_start = c.at("t_start").get<double>(), duration = c.at("duration").get<double>();
   EXPECT_DOUBLE_EQ(t_start, j.at("approach").at("t_contact").get<double>());
   EXPECT_DOUBLE_EQ(c.at("t_end").get<double>(), t_start + duration);
@@ -102,7 +107,7 @@ TEST(CompliantSimulate, TheContactsRowsCarryTheForceHistoryAndTheJoinedMotionFol
   ASSERT_EQ(text.rc, 0) << text.err;
   EXPECT_NE(text.out.find("Compliant contact"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("After the compliant contact"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("six grasp joints braked"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("six grasp joints held by the gripper's springs and dampers"), std::string::npos) << text.out;
   fs::remove_all(fs::path(csv_path).parent_path());
 }
 

@@ -94,6 +94,7 @@ double offGrid(const CompliantCaptureResult& c, double t) {
 TEST(CompliantContactEnd, OneAxisCaughtAtTheToleranceAndAtTheCompressionsMaximum) {
   const Oscillator x{1e6, 2.0 * 0.3 * std::sqrt(1e6 * kMu), -0.2};  // zeta 0.3, closing at 0.2 m/s
   CompliantGrasp g;
+  g.lock = GraspLock::SpringMaximum;  // the catch rules, measured on a latching gripper
   g.stiffness << x.K, 1e6, 1e6, 1e4, 1e4, 1e4;
   g.damping = (Vector6d() << x.D, 100.0, 100.0, 1.0, 1.0, 1.0).finished();
   const CaptureProblem p = twoBodies(Vector3d(x.v0, 0.0, 0.0));
@@ -128,6 +129,7 @@ TEST(CompliantContactEnd, TwoAxesCaughtAtTheSpringsEnergyMaximum) {
   const Oscillator x{1e6, 2.0 * 0.2 * std::sqrt(1e6 * kMu), -0.2};
   const Oscillator y{2.3e6, 2.0 * 0.1 * std::sqrt(2.3e6 * kMu), 0.15};
   CompliantGrasp g;
+  g.lock = GraspLock::SpringMaximum;  // the catch rules, measured on a latching gripper
   g.stiffness << x.K, y.K, 1e6, 1e4, 1e4, 1e4;
   g.damping = (Vector6d() << x.D, y.D, 100.0, 1.0, 1.0, 1.0).finished();
   const CaptureProblem p = twoBodies(Vector3d(x.v0, y.v0, 0.0));

@@ -25,7 +25,9 @@ Vector6d momentumBefore(const Scenario& sc) {
 }
 
 TEST(CompliantOperation, CaughtThenTheJoinedSystemMovesOnWithBothSidesMomentum) {
-  const Scenario sc = compliantScenario();
+  CompliantGrasp latching;
+  latching.lock = GraspLock::SpringMaximum;  // caught, then locked (lock: never in test_compliant_lock)
+  const Scenario sc = compliantScenario(latching);
   std::vector<MotionSample> seen;
   OperationOptions o;
   o.observer = [&](const OperationResult& so_far, const MotionSample& x) {
@@ -101,6 +103,7 @@ TEST(CompliantOperation, TheMotionAfterTendsToTheImpulsiveOperationsAsTheStiffne
   // duration becomes ~ m / (beta K)).
   for (const double scale : {1e3, 1e4, 1e5}) {
     CompliantGrasp g;
+    g.lock = GraspLock::SpringMaximum;  // the latching gripper (lock: never has its own test)
     g.stiffness *= scale;
     const Scenario sc = compliantScenario(g);
     const OperationResult r = runCaptureOperation(sc);
@@ -173,6 +176,7 @@ TEST(CompliantOperation, AContactThatOpensAtTheTouchIsWarnedAbout) {
 
 TEST(CompliantOperation, AContactThatNeverEndsIsRefusedWithWhatWasDone) {
   CompliantGrasp g;
+  g.lock = GraspLock::SpringMaximum;  // a latching gripper must be caught (never moves on compliant)
   g.max_duration = 1e-5;  // far shorter than the contact (~ 1e-3 s)
   const Scenario sc = compliantScenario(g);
   try {

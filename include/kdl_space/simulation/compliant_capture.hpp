@@ -57,7 +57,7 @@ struct CompliantGrasp {
   /// the hand; not at a minimum). Empty: the grasp holds from the touch (a closed gripper).
   std::optional<Vector3d> normal;
   /// When the grasp locks (GraspLock).
-  GraspLock lock = GraspLock::SpringMaximum;
+  GraspLock lock = GraspLock::Never;
   /// The damping per axis (damping, else damping_time * stiffness).
   Vector6d dampingPerAxis() const { return damping ? *damping : Vector6d(damping_time * stiffness); }
   /// The spring-damper of grasp joint k (JoinedSystem::grasp_joints order: x, y, z, rz, ry, rx) as

@@ -41,7 +41,8 @@ CompliantGrasp compliantLaw(const Field& f) {
     const std::string lock = f.at("lock").text();
     if (lock == "never") g.lock = GraspLock::Never;
     else if (lock == "tolerance") g.lock = GraspLock::Tolerance;
-    else if (lock != "spring_maximum")
+    else if (lock == "spring_maximum") g.lock = GraspLock::SpringMaximum;
+    else
       f.at("lock").fail(echo(lock) + " is not one of never (the grasp stays compliant), tolerance (it locks when the "
                         "relative speed has fallen to law.catch_tolerance), spring_maximum (also when the springs' "
                         "energy peaks)");
