@@ -75,7 +75,7 @@ CLI::App* addPlan(CLI::App& app, PlanCliOptions& o) {
                   "What to minimise. At the capture's instant: base_rate (|w| of the base after), impulse (|f| of the "
                   "impulse), joint_rate_jump (largest |dqdot|). Over the motion after it (--horizon): peak_base_rate, "
                   "final_base_rate, attitude_excursion, settling_time, peak_torque_ratio (|tau|/effort), "
-                  "peak_grasp_force, peak_grasp_moment (a compliant law), time_to_detumble (the base's rate below "
+                  "peak_grasp_force, peak_grasp_moment (a law that holds the target), time_to_detumble (the base's rate below "
                   "simulation.detumble_rate for good; not detumbled: the horizon times the final rate over it), "
                   "wheel_momentum_fraction (robot.base_actuators). Default base_rate");
   cmd->add_option("--weights", o.weights, "A weighted sum instead: NAME=W,... (e.g. base_rate=1,impulse=0.01)");

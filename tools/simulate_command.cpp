@@ -90,7 +90,8 @@ struct Streams {
     if (!o.csv.empty()) {
       if (!csv) {
         const long wheels = sc.base_actuators.wheels.count();
-        csv.emplace(o.csv, joints, sc.simulation.base_control.on() || wheels > 0, sc.compliant.has_value(), wheels);
+        csv.emplace(o.csv, joints, sc.simulation.base_control.on() || wheels > 0, sc.compliant.has_value(), wheels,
+                    holdsTarget(sc));
       }
       csv->write(x);
     }

@@ -26,7 +26,7 @@ py::dict samplesDict(const OperationResult& r) {
   for (const MotionSample& x : r.samples) rows.push_back(&x);
   const Eigen::Index k = static_cast<Eigen::Index>(rows.size()), n = r.model->nj();
   Eigen::MatrixXd t(k, 1), p(k, 3), quat(k, 4), twist(k, 6), q(k, n), qd(k, n), tau(k, n), h(k, 6), T(k, 1),
-      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1), contact(k, 6);
+      wrench(k, 6), work(k, 6), impulse(k, 6), distance(k, 1), contact(k, 6), grasp(k, 6);
   Eigen::Index m = 0;  // reaction wheels: a sample's count (a compliant contact's rows carry none: NaN)
   for (const MotionSample* x : rows) m = std::max(m, x->wheel_momentum.size());
   Eigen::MatrixXd wheel_h = Eigen::MatrixXd::Constant(k, m, std::nan("")), wheel_u = wheel_h;
@@ -38,6 +38,7 @@ py::dict samplesDict(const OperationResult& r) {
     q.row(i) = x.q.transpose(), qd.row(i) = x.qd.transpose(), tau.row(i) = x.tau.transpose();
     h.row(i) = x.h.transpose(), wrench.row(i) = x.base_wrench.transpose(), work.row(i) = x.work.transpose();
     impulse.row(i) = x.impulse.transpose(), contact.row(i) = x.contact_wrench.transpose();
+    grasp.row(i) = x.grasp_wrench.transpose();
     if (x.wheel_momentum.size() == m) wheel_h.row(i) = x.wheel_momentum.transpose();
     if (x.wheel_torque.size() == m) wheel_u.row(i) = x.wheel_torque.transpose();
     phase.append(toString(x.phase));
@@ -61,6 +62,7 @@ py::dict samplesDict(const OperationResult& r) {
   d["contact_wrench"] = toNumpy(contact);
   d["wheel_momentum"] = toNumpy(wheel_h);
   d["wheel_torque"] = toNumpy(wheel_u);
+  d["grasp_wrench"] = toNumpy(grasp);
   return d;
 }
 
@@ -204,6 +206,8 @@ void bindOperation(py::module_& m) {
         "arrays (t, phase, base_position, base_quaternion, base_twist, q, qdot, tau, momentum, energy, base_wrench, "
         "work, impulse, grasp_distance, contact_wrench: the compliant contact's (f; n) on the robot, NaN outside it; "
         "wheel_momentum, wheel_torque: (k, wheels) of robot.base_actuators' reaction wheels, NaN where none ran; "
+        "grasp_wrench: the load the grasp carries, (f; n about the robot's contact point) the target exerts on the "
+        "robot, in the contact and while the captured target is held, NaN where nothing is held; "
         "joint_names); an OperationResult (a dict) whose to_html(path) writes the run's 3-D page. `controller(t, q, qdot, base_pose, base_twist) -> tau` adds its torques in the motion "
         "after the capture, at `control_rate` Hz (zero-order hold) or at every evaluation (None); "
         "`observer(t, phase, q, qdot)` sees every sample. With control_rate and check_gains the controller is "

@@ -67,6 +67,10 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
         assert set(now["simulation"].pop("detumble")) == {"detumble_rate", "time_to_detumble", "peak_base_rate",
                                                            "final_base_rate", "attitude_excursion",
                                                            "wheel_momentum_fraction", "energy_dissipated"}
+        # ... and the grasp's load (issue 39): null where the law lets the target go; its values:
+        # tests/operation/test_grasp_load.cpp, tests/cli/test_cli_simulate.cpp.
+        load = now["simulation"].pop("grasp_load")
+        assert load is None or (load["peak_force"] >= 0.0 and load["max_force"] is None), load
     if now.get("capture"):
         for key in ("contact_point", "contact_point_in_target", "grasp"):
             now["capture"].pop(key)
@@ -273,6 +277,24 @@ def test_compliant_capture_in_the_operation_and_alone():
         kdl_space.solve_compliant_capture(touch, stiffness=[1e6, 1e6, 0, 1e4, 1e4, 1e4])
     with pytest.raises(ValueError, match="damping"):
         kdl_space.solve_compliant_capture(touch, damping=[1] * 6, damping_time=1e-3)
+
+
+def test_the_grasp_load_while_the_target_is_held():
+    """Issue 39: after a rigid capture the samples carry the grasp's load (the wrench the held box
+    exerts on the hand, about its contact point); the JSON's peaks are the samples' (NumPy);
+    a robot target joined by a fixed joint is held too."""
+    scenario = kdl_space.load_scenario(str(SCENARIOS["tumbling_box_capture"]))
+    r = kdl_space.run_operation(scenario, duration=1.0)
+    w = r["samples"]["grasp_wrench"]
+    assert w.shape == (len(r["samples"]["t"]), 6) and np.all(np.isfinite(w))
+    load = r["simulation"]["grasp_load"]
+    assert load["peak_force"] == pytest.approx(np.linalg.norm(w[:, :3], axis=1).max(), rel=1e-15)
+    assert load["peak_moment"] == pytest.approx(np.linalg.norm(w[:, 3:], axis=1).max(), rel=1e-15)
+    assert load["max_force"] is None and load["force_fraction_of_limit"] is None
+    joined = kdl_space.load_scenario(str(SCENARIOS["robot_to_robot_capture"]))
+    r = kdl_space.run_operation(joined, duration=0.2)
+    assert r["simulation"]["grasp_load"] is not None  # a rigid capture of the robot target: held
+    assert np.all(np.isfinite(r["samples"]["grasp_wrench"]))
 
 
 def test_an_approach_from_stowed_with_a_pre_grasp_move(tmp_path):

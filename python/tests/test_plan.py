@@ -137,8 +137,9 @@ def test_an_operation_plan_is_the_commands_and_what_run_operation_shows(cli, tmp
 
 
 def test_operation_refusals():
-    with pytest.raises(kdl_space.InputError, match="peak_grasp_force is a compliant grasp's load"):
-        kdl_space.plan_capture(str(ARM6), objective="peak_grasp_force")
+    point = ARM6.parent / "arm6_reach_point.json"  # a point impact lets the target go: nothing held
+    with pytest.raises(kdl_space.InputError, match="peak_grasp_force is the load of a grasp that holds the target"):
+        kdl_space.plan_capture(str(point), objective="peak_grasp_force")
     with pytest.raises(kdl_space.InputError, match="horizon: must be finite and > 0"):
         kdl_space.plan_capture(str(ARM6), objective="peak_base_rate", horizon=-1.0)
     with pytest.raises(kdl_space.InputError, match="settling_band"):

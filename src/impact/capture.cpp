@@ -183,6 +183,16 @@ const CaptureResult& CaptureSolver::solve(const CaptureProblem& problem) {
   return result;
 }
 
+LinkPayload payloadInLink(const RigidTarget& target, const KDL::Frame& world_T_link) {
+  const RigidBody b = target.toWorld();
+  const Matrix3d R = toEigen(world_T_link.M);
+  LinkPayload p;
+  p.mass = b.mass;
+  p.com = toEigen(world_T_link.Inverse() * toKDL(b.com));
+  p.I_com = R.transpose() * b.I_com * R;
+  return p;
+}
+
 std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result) {
   switch (problem.law.kind) {
     case ImpactKind::PointImpact:
@@ -206,15 +216,12 @@ std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem,
     throw InputError("robot.contact: " + std::string(strError(E_BAD_CONTACT)));
   const std::string& link_name = model->bodies()[link].name;
   // The target's inertia in the contact link's frame at the capture instant.
-  const RigidBody b = rigid->toWorld();
-  const KDL::Frame& world_T_link = result.contact_body_pose;
-  const Matrix3d R = toEigen(world_T_link.M);
-  const Matrix3d I = R.transpose() * b.I_com * R;
-  const KDL::Vector com = world_T_link.Inverse() * toKDL(b.com);
+  const LinkPayload b = payloadInLink(*rigid, result.contact_body_pose);
+  const Matrix3d& I = b.I_com;
   try {
     return std::make_shared<const FloatingModel>(model->withPayload(
-        link_name,
-        KDL::RigidBodyInertia(b.mass, com, KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)))));
+        link_name, KDL::RigidBodyInertia(b.mass, toKDL(b.com),
+                                         KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)))));
   } catch (const Error& e) {
     e.rethrowWithContext("target: cannot attach the captured target to link " + detail::quoted(link_name) + ": ");
   }

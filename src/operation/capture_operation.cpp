@@ -196,6 +196,56 @@ void runMotionAfterCapture(const Scenario& sc, const CaptureProblem& problem, co
 
 namespace operation {
 
+/// The warning `grasp_overload` when the grasp's peak load (the compliant contact's, or the held
+/// target's in the motion) passed law.max_grasp_wrench.
+void graspOverloadWarning(const Scenario& sc, OperationResult& r) {
+  GraspPeak peak = r.record.grasp;
+  if (r.compliant) {  // the contact's peaks come before the motion's
+    peak.force = std::max(r.compliant->peak_force, peak.held() ? peak.force : 0.0);
+    peak.moment = std::max(r.compliant->peak_moment, std::isnan(peak.moment) ? 0.0 : peak.moment);
+  }
+  if (!peak.held()) return;
+  std::ostringstream why;
+  why << std::setprecision(6);
+  if (peak.force > sc.max_grasp_force)
+    why << "the grasp carried " << peak.force << " N, more than law.max_grasp_wrench.force " << sc.max_grasp_force << " N";
+  if (peak.moment > sc.max_grasp_moment)
+    why << (why.tellp() > 0 ? ", and " : "the grasp carried ") << peak.moment
+        << " N m, more than law.max_grasp_wrench.moment " << sc.max_grasp_moment << " N m";
+  if (why.tellp() > 0)
+    r.warnings.push_back(Diagnostic{"law.max_grasp_wrench",
+                                    why.str() + " (simulation.grasp_load says when): a softer or slower law after the "
+                                                "capture (simulation.after_capture), or a stronger grasp",
+                                    "grasp_overload"});
+}
+
+}  // namespace operation
+
+std::optional<HeldTarget> heldTarget(const OperationResult& r) {
+  if (!r.capture || !r.payload_attached || !r.model) return std::nullopt;  // nothing held after a point impact
+  const CaptureProblem& problem = r.at_contact;
+  const FloatingModel& robot = *problem.robot.model;
+  const std::string& link = robot.bodies()[problem.robot.contact.body].name;
+  HeldTarget held;
+  held.bodies.assign(r.model->bodies().size(), false);
+  held.contact.offset = problem.robot.contact.offset;
+  for (std::size_t i = 0; i < r.model->bodies().size(); ++i) {
+    const std::string& name = r.model->bodies()[i].name;
+    if (name == link) held.contact.body = static_cast<int>(i);
+    held.bodies[i] = robot.bodyIndex(name) < 0;  // joinAtGrasp keeps the robot's names, makes the target's unique
+  }
+  if (!r.joined) {  // a rigid target merged into the hand (attachTarget)
+    const LinkPayload p = payloadInLink(std::get<RigidTarget>(problem.target), r.capture->contact_body_pose);
+    held.payload_body = held.contact.body;
+    held.payload_mass = p.mass;
+    held.payload_com = p.com;
+    held.payload_I_com = p.I_com;
+  }
+  return held;
+}
+
+namespace operation {
+
 void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationState s,
                const std::optional<FloatingSystem>& separated, const OperationOptions& o, OperationResult& r) {
   samplesIn(*r.model, *problem.robot.model, r.approach_samples);
@@ -228,9 +278,18 @@ void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationStat
   int observer_rc = E_NOERROR;
   const Phase phase = sc.impact ? Phase::Post : Phase::Motion;
   const bool spherical = r.joined && r.joined->grasp == GraspJoint::Spherical;
+  const std::optional<HeldTarget> held = heldTarget(r);
+  Kinematics kin(*r.model);
+  FloatingAcceleration acc;
+  std::vector<KDL::Wrench> f_ext;
   const auto observer = [&](const SimulationState& x) {
     MotionSample smp;
     if (const int rc = sampleOf(sim, x, phase, smp)) observer_rc = rc;
+    if (held) {  // the load the grasp carries (eq. of motion of the held bodies)
+      int rc = sim.accelerations(x, kin, acc, f_ext);
+      if (rc == E_NOERROR) rc = graspWrench(*r.model, *held, kin, x.velocity, acc, f_ext, sim.options().gravity, smp.grasp_wrench);
+      if (rc) observer_rc = rc;
+    }
     if (spherical) r.min_chart_margin = std::min(r.min_chart_margin, sphericalChartMargin(*r.joined, x.state));
     r.record.add(smp);
     if (o.observer) o.observer(r, smp);
@@ -251,6 +310,7 @@ void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationStat
                                         " s: the bus's attitude was not held as the law asked (larger wheels, "
                                         "softer gains, or thrusters to unload them)",
                                     "wheel_saturated"});
+  graspOverloadWarning(sc, r);
   if (const std::string advice = stiffnessAdvice(r.record); !advice.empty())  // a warning, by the joint's name
     r.warnings.push_back(Diagnostic{r.model->jointNames()[r.record.stiffness.fastest_joint],
                                     advice + " (its gains come from simulation.joints, where a pattern such as \"*\" "
@@ -275,6 +335,11 @@ void runMotion(const Scenario& sc, const CaptureProblem& problem, SimulationStat
 }
 
 }  // namespace operation
+
+bool holdsTarget(const Scenario& sc) {
+  const ImpactKind k = sc.capture.law.kind;
+  return sc.impact && (sc.compliant || k == ImpactKind::Capture || k == ImpactKind::TranslationalCapture);
+}
 
 double estimatedOutputRows(const Scenario& sc, const OperationOptions& o) {
   const double output_step = o.output_step.value_or(sc.simulation.output_step);

@@ -25,7 +25,7 @@ void compliantCapture(const Scenario& sc, const CaptureProblem& problem, const s
     MotionSample smp;
     if (const int rc = sampleOf(sim, x, Phase::Contact, smp)) sample_rc = rc;
     smp.t += t0;
-    smp.contact_wrench = c.wrench;
+    smp.contact_wrench = smp.grasp_wrench = c.wrench;
     r.contact_samples.push_back(std::move(smp));
   };
   try {

@@ -28,16 +28,15 @@ void MotionMeasurer::reset() {
   t_.clear();
   w_.clear();
   detumble_ = DetumbleTime{};
+  grasp_ = GraspPeak{};
   detumble_.threshold = detumble_rate_;
 }
 
 void MotionMeasurer::add(const OperationResult& so_far, const MotionSample& x) {
   if (x.phase == Phase::Approach || x.phase == Phase::Capture) return;
-  if (x.phase == Phase::Contact) {  // the compliant grasp's wrench (the contact's samples come first)
-    if (std::isnan(m_.peak_grasp_force)) m_.peak_grasp_force = m_.peak_grasp_moment = 0.0;
-    m_.peak_grasp_force = std::max(m_.peak_grasp_force, x.contact_wrench.head<3>().norm());
-    m_.peak_grasp_moment = std::max(m_.peak_grasp_moment, x.contact_wrench.tail<3>().norm());
-  }
+  grasp_.add(x);  // the grasp's load: a compliant contact's, then the held target's after it
+  m_.peak_grasp_force = grasp_.force;
+  m_.peak_grasp_moment = grasp_.moment;
   if (after_ != so_far.model.get()) {  // the robot's joints in the system the sample belongs to
     after_ = so_far.model.get();
     in_model_.assign(robot_.nj(), -1);

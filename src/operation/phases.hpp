@@ -25,6 +25,8 @@ void approach(const Scenario& sc, double output_step, const std::function<bool()
 TargetMotion separatedTarget(const Scenario& sc, const FloatingSystem& target, double t0, double t_end,
                              double output_step, const std::function<bool()>& cancelled);
 
+void graspOverloadWarning(const Scenario& sc, OperationResult& r);
+
 /// \brief The motion after the capture (runMotionAfterCapture's, and a compliant capture's): the
 /// approach's and the contact's samples put in result.model's joints and given to the observer,
 /// then result.model's motion from s (its t the start) for result.duration, and `separated`'s by

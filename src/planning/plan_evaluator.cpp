@@ -125,10 +125,10 @@ void PlanEvaluator::setUpMotion() {
   horizon_ = options_.horizon.value_or(scenario_.simulation.duration);
   const FloatingModel& robot = *scenario_.capture.robot.model;
   for (const auto& [name, weight] : options_.weights) {
-    if ((name == "peak_grasp_force" || name == "peak_grasp_moment") && !scenario_.compliant)
-      throw InputError("objective: " + name + " is a compliant grasp's load during its contact; the scenario's law "
-                       "is impulsive (its load is an impulse: the term impulse): give law.type compliant, or "
-                       "another term");
+    if ((name == "peak_grasp_force" || name == "peak_grasp_moment") && !holdsTarget(scenario_))
+      throw InputError("objective: " + name + " is the load of a grasp that holds the target; the scenario's law "
+                       "lets it go (a point or frictional impact: its load is an impulse, the term impulse): give "
+                       "law.type capture or compliant, or another term");
     if (name == "peak_torque_ratio" &&
         std::none_of(robot.jointProperties().begin(), robot.jointProperties().end(), [](const JointProperties& p) {
           return p.effort > 0.0 && std::isfinite(p.effort);

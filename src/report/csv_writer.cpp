@@ -8,8 +8,8 @@
 namespace kdl_space::report {
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact,
-                     long wheels)
-    : file_(path, "--csv"), base_control_(base_control), contact_(contact), wheels_(wheels) {
+                     long wheels, bool grasp)
+    : file_(path, "--csv"), base_control_(base_control), contact_(contact), wheels_(wheels), grasp_(grasp) {
   out_.open(file_.tmp());
   if (!out_) throw InputError("--csv " + path + ": cannot write in its folder");
   out_ << std::setprecision(17);
@@ -23,6 +23,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& jo
   if (contact_) out_ << ",contact_fx,contact_fy,contact_fz,contact_nx,contact_ny,contact_nz";
   for (long i = 1; i <= wheels_; ++i) out_ << ",wheel_h_" << i;
   for (long i = 1; i <= wheels_; ++i) out_ << ",wheel_u_" << i;
+  if (grasp_) out_ << ",grasp_fx,grasp_fy,grasp_fz,grasp_nx,grasp_ny,grasp_nz";
   out_ << '\n';
 }
 
@@ -51,6 +52,11 @@ void CsvWriter::write(const MotionSample& s) {
     for (long i = 0; i < wheels_; ++i) {
       out_ << ',';
       if (v->size() == wheels_) out_ << (*v)(i);
+    }
+  if (grasp_)  // empty where nothing is held
+    for (int i = 0; i < 6; ++i) {
+      out_ << ',';
+      if (!std::isnan(s.grasp_wrench(i))) out_ << s.grasp_wrench(i);
     }
   out_ << '\n';
   if (!out_) failed();  // a buffer that could not be flushed sets badbit

@@ -103,6 +103,21 @@ Json detumbleJson(const MotionRecord& r) {
               {"energy_dissipated", r.energyDissipated()}};
 }
 
+Json graspLoadJson(const MotionRecord& r, double max_force, double max_moment) {
+  const GraspPeak& g = r.grasp;
+  if (!g.held()) return nullptr;
+  const auto limit = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+  const auto fraction = [](double peak, double x) { return std::isfinite(x) ? Json(peak / x) : Json(nullptr); };
+  return Json{{"peak_force", g.force},
+              {"t_peak_force", g.t_force},
+              {"peak_moment", g.moment},
+              {"t_peak_moment", g.t_moment},
+              {"max_force", limit(max_force)},
+              {"max_moment", limit(max_moment)},
+              {"force_fraction_of_limit", fraction(g.force, max_force)},
+              {"moment_fraction_of_limit", fraction(g.moment, max_moment)}};
+}
+
 Json stiffnessJson(const MotionRecord& r) {
   const Stiffness& st = r.stiffness;
   const SimulationStats& stats = r.stats;
@@ -160,6 +175,9 @@ void printMotionReport(std::ostream& out, const MotionRecord& r) {
           << r.stats.wheel_saturation_first_time << " s";
     out << "\n";
   }
+  if (r.grasp.held())
+    out << "Grasp load: peak force " << r.grasp.force << " N at t = " << r.grasp.t_force << " s, peak moment "
+        << r.grasp.moment << " N m at t = " << r.grasp.t_moment << " s (on the robot at its contact point)\n";
   const MotionSample& last = r.last;
   const MotionSample& first = r.first;
   if (r.samples > 1) {

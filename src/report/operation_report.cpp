@@ -220,7 +220,8 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"stiffness", stiffnessJson(record)},
                          {"friction", frictionJson(record)},
                          {"wheels", wheelsJson(record)},
-                         {"detumble", detumbleJson(record)}};
+                         {"detumble", detumbleJson(record)},
+                         {"grasp_load", graspLoadJson(record, sc.max_grasp_force, sc.max_grasp_moment)}};
   return j;
 }
 

@@ -189,6 +189,25 @@ int Simulator::actuation(SimulationState& s) {
   return E_NOERROR;
 }
 
+int Simulator::accelerations(const SimulationState& s, Kinematics& kin, FloatingAcceleration& a,
+                             std::vector<KDL::Wrench>& f_ext) {
+  const unsigned int n = model().nj();
+  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
+  if (!std::isfinite(s.t)) return E_NOT_FINITE;
+  double T;
+  Vector6d h_O;
+  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
+  pack(s, h_O, x_tmp_);  // x_tmp_, dx_tmp_: a stage's workspaces, free between steps
+  dx_tmp_.resize(x_tmp_.size());
+  if (const int rc = derivative(s.t, x_tmp_, dx_tmp_)) return rc;
+  kin = kin_;
+  a = acc_;
+  const bool external = base_control_.on() || !wrenches_.empty() || wheels_.count() > 0;
+  if (external) f_ext = f_ext_;
+  else f_ext.clear();
+  return E_NOERROR;
+}
+
 void Simulator::pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const {
   const detail::StateLayout L = layout();
   const KDL::Frame& T = s.state.world_T_base;

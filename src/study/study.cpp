@@ -50,7 +50,8 @@ std::vector<std::string> studyColumns(const Study& study) {
     for (const std::string& j : joints) c.push_back("q." + j);
   for (const std::string& j : joints) c.push_back("qdot." + j);
   if (study.motion_duration > 0.0)  // what the motion did to the tumble (issue 39)
-    for (const char* f : {"time_to_detumble", "attitude_excursion", "wheel_momentum_fraction", "energy_dissipated"})
+    for (const char* f : {"time_to_detumble", "attitude_excursion", "wheel_momentum_fraction", "energy_dissipated",
+                          "peak_grasp_force", "peak_grasp_moment", "peak_torque_ratio"})
       c.emplace_back(f);
   return c;
 }
@@ -105,18 +106,19 @@ int motionPeaks(const Study& st, const CaptureProblem& problem, const CaptureRes
     if (e.code() == E_NOERROR) throw;   // (evaluate reports it as the sample's failure, in its words)
     return e.code();
   }
-  const MotionMeasures& m = measurer.peaks();
+  MotionMeasures m;
+  if (const int rc = measurer.finish(motion, m)) return rc;  // the effort ratio with the peaks
   for (unsigned int j = 0; j < robot.nj(); ++j) peak[j] = std::max(peak[j], m.peak_torque[j]);
   peak_base_rate = std::max(peak_base_rate, m.peak_base_rate);
   detumble = m;
-  detumble.wheel_momentum_fraction = motion.record.wheelMomentumFraction();
   return E_NOERROR;
 }
 
-/// The detumble columns (studyColumns' last) from the motion's measures.
+/// The detumble and load columns (studyColumns' last) from the motion's measures.
 template <typename Out>
 Out detumbleColumns(const MotionMeasures& m, Out out) {
-  for (const double v : {m.time_to_detumble, m.attitude_excursion, m.wheel_momentum_fraction, m.energy_dissipated})
+  for (const double v : {m.time_to_detumble, m.attitude_excursion, m.wheel_momentum_fraction, m.energy_dissipated,
+                         m.peak_grasp_force, m.peak_grasp_moment, m.peak_torque_ratio})
     *out++ = v;
   return out;
 }

@@ -78,7 +78,9 @@ TEST(CompliantSimulate, TheContactsRowsCarryTheForceHistoryAndTheJoinedMotionFol
   const Csv csv = readCsv(csv_path);
   const int fx = csv.column("contact_fx"), phase = csv.column("phase"), t = csv.column("t");
   ASSERT_GE(fx, 0);
-  ASSERT_EQ(csv.header.back(), "contact_nz") << "added last: the columns before keep their places";
+  ASSERT_EQ(csv.header[csv.header.size() - 7], "contact_nz") << "added last: the columns before keep their places";
+  const int gx = csv.column("grasp_fx");  // the grasp's load, added after (issue 39): every row from the touch on
+  ASSERT_EQ(gx, static_cast<int>(csv.header.size()) - 6);
   const nlohmann::json& history = c.at("history");
   std::size_t k = 0;
   std::vector<std::string> phases;
@@ -87,8 +89,10 @@ TEST(CompliantSimulate, TheContactsRowsCarryTheForceHistoryAndTheJoinedMotionFol
     if (phases.empty() || phases.back() != row[phase]) phases.push_back(row[phase]);
     if (row[phase] != "contact") {
       for (int i = 0; i < 6; ++i) EXPECT_EQ(row[fx + i], "") << row[phase];
+      for (int i = 0; i < 6; ++i) EXPECT_EQ(row[gx + i].empty(), row[phase] != "post") << row[phase];
       continue;
     }
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(row[gx + i], row[fx + i]);  // the contact's wrench is the grasp's load
     ASSERT_LT(k, history.at("t").size());
     EXPECT_NEAR(std::stod(row[t]), t_start + history.at("t")[k].get<double>(), 1e-12);
     for (int i = 0; i < 6; ++i) {
@@ -118,7 +122,8 @@ TEST(CompliantSimulate, AnotherLawKeepsItsColumns) {
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_TRUE(nlohmann::json::parse(r.out).at("compliant").is_null());
   const Csv csv = readCsv(csv_path);
-  EXPECT_EQ(csv.header.back(), "grasp_distance");
+  EXPECT_EQ(csv.header[csv.header.size() - 7], "grasp_distance");
+  EXPECT_EQ(csv.header.back(), "grasp_nz");  // a rigid capture holds the target: its load, last
   EXPECT_EQ(csv.column("contact_fx"), -1);
   fs::remove_all(fs::path(csv_path).parent_path());
 }

@@ -71,10 +71,12 @@ class PlotPanels : public ::testing::Test {
     head_ = splitBy(line, ',');
     csv_.clear();
     phases_.clear();
+    const std::size_t phase = std::find(head_.begin(), head_.end(), "phase") - head_.begin();
+    ASSERT_LT(phase, head_.size());
     while (std::getline(lines, line)) {
       std::vector<std::string> cells = splitBy(line, ',');
       ASSERT_EQ(cells.size(), head_.size()) << line;
-      phases_.push_back(cells[head_.size() - 2]);
+      phases_.push_back(cells[phase]);
       std::vector<double> row;
       for (const std::string& c : cells) row.push_back(c == phases_.back() ? std::nan("") : number(c));
       csv_.push_back(row);

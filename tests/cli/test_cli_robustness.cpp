@@ -195,6 +195,11 @@ const std::vector<Broken>& corpus() {
        "{f}:24: simulation.base_control.position: robot.base_actuators has no thrusters' force_limit to move the base "
        "with",
        false},
+      {"grasp_limit_on_a_point_impact.yaml",
+       "{f}:15: law.max_grasp_wrench: a point impact holds nothing after it: the grasp's limit goes with a capture or "
+       "compliant law",
+       false},
+      {"grasp_limit_not_positive.yaml", "{f}:17: law.max_grasp_wrench.moment: must be > 0, got -5", false},
       {"after_capture_unknown_law.yaml",
        "{f}:21: simulation.after_capture.law: 'detumble' is not one of hold, momentum_distribution", false},
       {"distribution_without_servos.yaml",

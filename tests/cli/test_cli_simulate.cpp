@@ -39,8 +39,12 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
   const std::vector<std::string> header = split(line);
   const std::vector<std::string> joints = j.at("simulation").at("joint_names");
   EXPECT_EQ(header.front(), "t");
-  EXPECT_EQ(header.back(), "grasp_distance");  // the columns added since end the header
-  EXPECT_EQ(header[header.size() - 3], "work_gravity");
+  // The columns added since end the header: grasp_distance, then the grasp's load (issue 39).
+  const std::vector<std::string> grasp{"grasp_fx", "grasp_fy", "grasp_fz", "grasp_nx", "grasp_ny", "grasp_nz"};
+  ASSERT_GE(header.size(), 9u);
+  EXPECT_EQ(std::vector<std::string>(header.end() - 6, header.end()), grasp);
+  EXPECT_EQ(header[header.size() - 7], "grasp_distance");
+  EXPECT_EQ(header[header.size() - 9], "work_gravity");
   for (const std::string& name : joints) {
     EXPECT_NE(std::find(header.begin(), header.end(), "q_" + name), header.end()) << name;
     EXPECT_NE(std::find(header.begin(), header.end(), "qdot_" + name), header.end()) << name;
@@ -48,17 +52,25 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
   for (const char* col : {"base_x", "base_qw", "base_wz", "P_x", "L_z"})
     EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << col;
   std::vector<std::vector<double>> rows;
+  double peak_force = 0.0, peak_moment = 0.0;  // the grasp's load, as the CSV has it
   while (std::getline(in, line)) {
     std::vector<double> row;
     std::vector<std::string> cells = split(line);
-    if (!line.empty() && line.back() == ',') cells.emplace_back();  // grasp_distance: empty after the impact
     ASSERT_EQ(cells.size(), header.size()) << line;
-    EXPECT_EQ(cells[header.size() - 2], "post");  // the phase: after the impact
-    EXPECT_EQ(cells.back(), "");
-    cells.resize(header.size() - 2);
+    EXPECT_EQ(cells[header.size() - 8], "post");  // the phase: after the impact
+    EXPECT_EQ(cells[header.size() - 7], "");      // grasp_distance: empty after the impact
+    Eigen::Matrix<double, 6, 1> w;
+    for (int k = 0; k < 6; ++k) w(k) = std::stod(cells[header.size() - 6 + k]);  // the box is held: every row
+    peak_force = std::max(peak_force, w.head<3>().norm());
+    peak_moment = std::max(peak_moment, w.tail<3>().norm());
+    cells.resize(header.size() - 8);
     for (const std::string& cell : cells) row.push_back(std::stod(cell));
     rows.push_back(row);
   }
+  const nlohmann::json& load = j.at("simulation").at("grasp_load");  // the JSON's peaks are the rows' (17 digits)
+  EXPECT_NEAR(load.at("peak_force").get<double>(), peak_force, 1e-14 * peak_force);
+  EXPECT_NEAR(load.at("peak_moment").get<double>(), peak_moment, 1e-14 * peak_moment);
+  EXPECT_GT(peak_force, 0.0);
   ASSERT_EQ(rows.size(), 41u);  // t = 0, 0.05, ..., 2
   EXPECT_DOUBLE_EQ(rows.front()[0], 0.0);
   EXPECT_DOUBLE_EQ(rows.back()[0], 2.0);

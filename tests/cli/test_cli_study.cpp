@@ -284,6 +284,15 @@ TEST(StudyCommand, TheDetumbleColumnsAreSimulates) {
       ASSERT_TRUE(d.at(column).is_number()) << column << ": " << d.dump();
       EXPECT_NEAR(value, d.at(column).get<double>(), 1e-9 * (std::abs(value) + 1e-3)) << column;
     }
+    // ... and the grasp's load (the hand holds the box): simulate's simulation.grasp_load.
+    const json g = json::parse(sim.out).at("simulation").at("grasp_load");
+    for (const auto& [column, key] : {std::pair{"peak_grasp_force", "peak_force"}, std::pair{"peak_grasp_moment", "peak_moment"}}) {
+      const auto at = std::find(names.begin(), names.end(), column);
+      ASSERT_NE(at, names.end()) << column << " in " << header;
+      const double value = std::stod(values[static_cast<std::size_t>(at - names.begin())]);
+      EXPECT_GT(value, 0.0) << column;
+      EXPECT_NEAR(value, g.at(key).get<double>(), 1e-9 * value) << column;
+    }
   }
 }
 

@@ -34,6 +34,7 @@
 #include "kdl_space/planning/capture_plan.hpp"
 #include "kdl_space/study/study.hpp"
 #include "model_families.hpp"
+#include "grasp_route.hpp"
 #include "test_util.hpp"
 #include "virtual_joint_route.hpp"
 
@@ -301,6 +302,14 @@ TEST_P(Families, TheOperationRunsAndConservesMomentum) {
   for (const MotionSample& x : r.samples)
     EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
   EXPECT_NEAR(r.samples.back().t, 0.5, 1e-12);
+  // The grasp's load (issue 39): what the hand needs to move the box it holds, against minus the
+  // rate of the box's momentum (tests/support/grasp_route.hpp), at every sample.
+  const std::optional<HeldTarget> held = heldTarget(r);
+  ASSERT_TRUE(held) << f.name;
+  for (const MotionSample& x : r.samples) {
+    const Vector6d route = graspWrenchByMomentumRate(r.model, *held, x);
+    EXPECT_TRUE(near(x.grasp_wrench, route, 0.0, 1e-7 * (route.norm() + 1e-3), f.name + " grasp load at t = " + std::to_string(x.t)));
+  }
 }
 
 // simulate with reaction wheels holding the bus (robot.base_actuators; four wheels in a skewed

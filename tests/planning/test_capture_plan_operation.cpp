@@ -197,7 +197,15 @@ TEST(CapturePlanOperation, MeasuresAreTheirDefinitionsOnTheSamples) {
     MotionMeasures m;
     ASSERT_EQ(measurer.finish(r, m), 0);
     expectMeasuresOfTheirDefinitions(sc, r, m, 0.05);
-    EXPECT_TRUE(std::isnan(m.peak_grasp_force));  // an impulsive law: no contact wrench
+    // A rigid capture holds the box: the grasp's load is the samples' largest grasp wrench.
+    double force = 0.0, moment = 0.0;
+    for (const MotionSample& x : r.samples) {
+      force = std::max(force, x.grasp_wrench.head<3>().norm());
+      moment = std::max(moment, x.grasp_wrench.tail<3>().norm());
+    }
+    EXPECT_GT(force, 0.0) << file;
+    EXPECT_EQ(m.peak_grasp_force, force) << file;
+    EXPECT_EQ(m.peak_grasp_moment, moment) << file;
     const double w = stackRate(r);
     EXPECT_NEAR(m.momentum_rate, w, 1e-9 * w) << file;
     // Servos holding: the joints come nearly to rest, so the base's last rate is near the stack's.
@@ -205,7 +213,7 @@ TEST(CapturePlanOperation, MeasuresAreTheirDefinitionsOnTheSamples) {
   }
 }
 
-TEST(CapturePlanOperation, CompliantGraspLoadIsTheContactsLargestWrench) {
+TEST(CapturePlanOperation, CompliantGraspLoadIsTheLargestWrenchOfTheContactAndTheHold) {
   // The tumbling box grasped by a soft compliant hand (the shipped compliant scenario needs its approach).
   const Scenario sc = loadScenario(defaultOn("compliant", [](const std::string& urdf) { return urdf; },
                                              "{type: compliant, stiffness: [2.0e5, 2.0e5, 2.0e5, 2.0e3, 2.0e3, 2.0e3]}"));
@@ -228,6 +236,11 @@ TEST(CapturePlanOperation, CompliantGraspLoadIsTheContactsLargestWrench) {
   for (const MotionSample& x : r.contact_samples) {
     force = std::max(force, x.contact_wrench.head<3>().norm());
     moment = std::max(moment, x.contact_wrench.tail<3>().norm());
+  }
+  for (const MotionSample& x : r.samples) {  // the grasp stays compliant (lock: never) and holds the box
+    ASSERT_TRUE(x.grasp_wrench.allFinite()) << "t = " << x.t;
+    force = std::max(force, x.grasp_wrench.head<3>().norm());
+    moment = std::max(moment, x.grasp_wrench.tail<3>().norm());
   }
   EXPECT_GT(force, 0.0);
   EXPECT_EQ(plan.nominal.motion->peak_grasp_force, force);
@@ -267,8 +280,22 @@ TEST(CapturePlanOperation, RefusesWhatItCannotMeasure) {
     }
   };
   PlanOptions o;
-  o.weights = {{"peak_grasp_force", 1.0}};
-  refused(o, "objective: peak_grasp_force is a compliant grasp's load");
+  {
+    Scenario point = sc;  // a point impact lets the box go: nothing is held
+    point.capture.law.kind = ImpactKind::PointImpact;
+    point.capture.law.normal = Vector3d(0, -1, 0);
+    PlanOptions g;
+    g.weights = {{"peak_grasp_force", 1.0}};
+    g.wrist_roll = PlanRange{0.0, 0.0};
+    try {
+      planCapture(point, g);
+      ADD_FAILURE() << "a point impact's grasp load was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("objective: peak_grasp_force is the load of a grasp that holds the target"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   o.weights = {{"peak_base_rate", 1.0}};
   o.horizon = 0.0;
   refused(o, "horizon: must be finite and > 0");

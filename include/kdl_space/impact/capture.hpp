@@ -119,4 +119,14 @@ class KDL_SPACE_EXPORT CaptureSolver {
 /// ("target: cannot attach ...").
 KDL_SPACE_EXPORT std::shared_ptr<const FloatingModel> attachTarget(const CaptureProblem& problem, const CaptureResult& result);
 
+/// A rigid target's inertia in a link's frame (`world_T_link`, at the capture instant): what
+/// attachTarget adds to the contact link. Mass [kg], CoM [m] in the link's frame, inertia about
+/// the CoM in its axes [kg m^2].
+struct LinkPayload {
+  double mass = 0.0;
+  Vector3d com = Vector3d::Zero();
+  Matrix3d I_com = Matrix3d::Zero();
+};
+KDL_SPACE_EXPORT LinkPayload payloadInLink(const RigidTarget& target, const KDL::Frame& world_T_link);
+
 }  // namespace kdl_space

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "kdl_space/algorithm/grasp_wrench.hpp"
 #include "kdl_space/export.hpp"
 #include "kdl_space/impact/joined_system.hpp"
 #include "kdl_space/multibody/diagnostics.hpp"
@@ -51,6 +52,16 @@ struct OperationOptions {
   /// instead (the exception propagates). Empty: never cancelled.
   std::function<bool()> cancelled;
 };
+
+/// What the robot holds in the motion after the capture of `r` (in r.model, from r.at_contact): a
+/// joined target's bodies (the names that are not the robot's), or a rigid target merged into the
+/// contact link (its share of that link's inertia); none after an impact that lets the target go,
+/// or without a capture. What graspWrench reads.
+KDL_SPACE_EXPORT std::optional<HeldTarget> heldTarget(const OperationResult& r);
+
+/// Whether the scenario's law holds the target after the capture (a capture, a translational
+/// capture, a compliant grasp): its samples then carry the grasp's load (MotionSample::grasp_wrench).
+KDL_SPACE_EXPORT bool holdsTarget(const Scenario& sc);
 
 /// \brief How many output samples a run of the operation can produce at most: the approach's (if
 /// the scenario has one and options.approach: approach.max_duration / output_step + 1) and the

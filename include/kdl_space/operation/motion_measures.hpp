@@ -33,8 +33,9 @@ struct MotionMeasures {
   /// max_j peak_torque_j / effort_j over the joints with a finite effort limit > 0 (NaN: none has one)
   double peak_torque_ratio = std::numeric_limits<double>::quiet_NaN();
   std::string peak_torque_joint;  ///< where that maximum is (empty: NaN)
-  /// A compliant contact's largest |f| [N] and |n| [N m] on the robot (ContactSample::wrench) over
-  /// its samples; NaN with an impulsive law (its wrench is an impulse)
+  /// The grasp's largest |f| [N] and |n| [N m] on the robot (MotionSample::grasp_wrench) over a
+  /// compliant contact's samples and the motion after a capture that holds the target; NaN when
+  /// nothing is held (a point impact; the impulsive capture itself is an impulse)
   double peak_grasp_force = std::numeric_limits<double>::quiet_NaN();
   double peak_grasp_moment = std::numeric_limits<double>::quiet_NaN();
   /// The base's |w| once the stack's joints are still: the system after the capture at its last
@@ -72,6 +73,7 @@ class KDL_SPACE_EXPORT MotionMeasurer {
   double band_;
   double detumble_rate_;
   DetumbleTime detumble_;
+  GraspPeak grasp_;
   MotionMeasures m_;
   std::vector<int> in_model_;  ///< the robot's joints in the system after the capture
   const FloatingModel* after_ = nullptr;

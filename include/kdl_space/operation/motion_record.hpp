@@ -32,6 +32,21 @@ struct DetumbleTime {
   bool above_ = false;
 };
 
+/// The largest load the grasp carried over samples (MotionSample::grasp_wrench's |f| and |n|, and
+/// when): NaN while nothing held has been seen.
+struct GraspPeak {
+  double force = std::numeric_limits<double>::quiet_NaN();   ///< [N]
+  double moment = std::numeric_limits<double>::quiet_NaN();  ///< [N m]
+  double t_force = std::numeric_limits<double>::quiet_NaN(), t_moment = std::numeric_limits<double>::quiet_NaN();
+  void add(const MotionSample& x) {
+    if (!x.grasp_wrench.allFinite()) return;
+    const double f = x.grasp_wrench.head<3>().norm(), n = x.grasp_wrench.tail<3>().norm();
+    if (!(f <= force)) force = f, t_force = x.t;  // NaN at first: taken
+    if (!(n <= moment)) moment = n, t_moment = x.t;
+  }
+  bool held() const { return !std::isnan(force); }
+};
+
 struct KDL_SPACE_EXPORT MotionRecord {
   std::shared_ptr<const FloatingModel> model;  ///< the system that moved
   SimulationOptions options;
@@ -60,6 +75,7 @@ struct KDL_SPACE_EXPORT MotionRecord {
   DetumbleTime detumble;
   double attitude_excursion = 0.0;  ///< max angle of R(t) R(t_0)^T over the samples [rad]
   double peak_base_rate = 0.0;      ///< max |w| of the base [rad/s]
+  GraspPeak grasp;                  ///< the load the grasp carried (nothing held: NaN)
   /// The largest fraction of its capacity a wheel used (NaN without wheels).
   double wheelMomentumFraction() const;
   /// The kinetic energy the joints' controls, friction, hard stops and the base control took out

@@ -39,6 +39,11 @@ struct MotionSample {
   /// The compliant contact's wrench on the robot (f; n about its contact point), world [N, N m]
   /// (ContactSample::wrench): Phase::Contact only, NaN in the other phases.
   Vector6d contact_wrench = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The load the grasp carries: the wrench the held target exerts on the robot (f; n about its
+  /// contact point), world [N, N m]: a compliant contact's (contact_wrench) in Phase::Contact, and
+  /// after a capture that holds the target (a rigid, ball or compliant grasp, or a rigid target
+  /// merged into the hand) graspWrench's in Phase::Post; NaN where nothing is held.
+  Vector6d grasp_wrench = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// The reaction wheels' momenta [N m s] and motor torques [N m] (Simulator::setReactionWheels);
   /// empty without wheels.
   Eigen::VectorXd wheel_momentum, wheel_torque;

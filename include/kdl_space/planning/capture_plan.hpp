@@ -63,7 +63,8 @@ struct PlanOptions {
   ///   "attitude_excursion" the base's largest turn from its attitude at the capture [rad]
   ///   "settling_time"      when the base's w last left its band about its final value [s]
   ///   "peak_torque_ratio"  max_j max_t |tau_j| / effort_j (the URDF's effort limits) [-]
-  ///   "peak_grasp_force"   a compliant grasp's largest |f| during its contact [N]
+  ///   "peak_grasp_force"   the grasp's largest |f| on the robot, in a compliant contact and while
+  ///                        the captured target is held (MotionSample::grasp_wrench) [N]
   ///   "peak_grasp_moment"  and |n| [N m]
   std::vector<std::pair<std::string, double>> weights{{"base_rate", 1.0}};
   /// The motion after each capture that the operation terms score [s], > 0. Unset: the

@@ -18,8 +18,10 @@ class CsvWriter {
   /// `base_control`: the base control's wrench columns are written; `contact`: the compliant
   /// contact's wrench columns (empty outside its rows); `wheels`: that many reaction wheels'
   /// momentum and torque columns, last.
+  /// `grasp`: the grasp's load columns grasp_fx ... grasp_nz (MotionSample::grasp_wrench, empty
+  /// where nothing is held), last.
   CsvWriter(const std::string& path, const std::vector<std::string>& joints, bool base_control, bool contact = false,
-            long wheels = 0);
+            long wheels = 0, bool grasp = false);
   /// One row; throws InputError at once when it cannot be written (a full disk): the run stops
   /// there rather than computing rows that are lost.
   void write(const MotionSample& s);
@@ -35,6 +37,7 @@ class CsvWriter {
   bool base_control_;
   bool contact_;
   long wheels_;
+  bool grasp_;
   std::size_t rows_ = 0;
   /// "cannot write after N rows (disk full?)", with the system's reason when it gave one.
   [[noreturn]] void failed() const;

@@ -27,6 +27,10 @@ Json wheelsJson(const MotionRecord& r);
 /// (null: not detumbled in the run), `peak_base_rate`, `final_base_rate`, `attitude_excursion`,
 /// `wheel_momentum_fraction` (null without wheels), `energy_dissipated`.
 Json detumbleJson(const MotionRecord& r);
+/// The load the grasp carried in the motion (MotionRecord::grasp) against the law's
+/// max_grasp_wrench (infinite: null): peak force and moment, when, and their fractions of the
+/// limits; null when nothing was held.
+Json graspLoadJson(const MotionRecord& r, double max_force, double max_moment);
 /// The joints with damping or Coulomb friction: their values and the regularisation v_s used.
 Json frictionJson(const MotionRecord& r);
 

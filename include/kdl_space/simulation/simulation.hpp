@@ -247,6 +247,13 @@ class KDL_SPACE_EXPORT Simulator {
   /// is called). For an observer whose callback changes at that instant (a sampled controller).
   /// \return 0, E_SIZE_MISMATCH, E_NOT_FINITE or a code of the dynamics; s untouched on an error.
   int actuation(SimulationState& s);
+  /// \brief The accelerations at s as a run's derivative evaluates them (controls limited, friction,
+  /// base control, wrenches and wheels acting), with the state's kinematics into `kin` and the
+  /// external wrenches per body into `f_ext` (world axes, moment about the body frame's origin;
+  /// empty when none acts): what graspWrench reads. For an observer (it allocates nothing after the
+  /// first call with the same `kin`, `f_ext`).
+  /// \return 0, E_SIZE_MISMATCH, E_NOT_FINITE or a code of the dynamics; outputs untouched on an error.
+  int accelerations(const SimulationState& s, Kinematics& kin, FloatingAcceleration& a, std::vector<KDL::Wrench>& f_ext);
 
   /// The servos' fastest rate at a state (O(n^2): one articulated-body pass per PD joint).
   /// \return 0 or a code of the dynamics.
@@ -359,6 +366,7 @@ class KDL_SPACE_EXPORT Simulator {
   double external_power_[3] = {0.0, 0.0, 0.0};  ///< base control, wrenches, gravity [W]
   FloatingAcceleration acc_;
   Vector x_, x_tmp_, x_new_, x_prev_, x_event_;
+  Vector dx_tmp_;  ///< accelerations()'s derivative
   Vector x_located_;  ///< the stop event's: the retaken state at the bracket's end where g <= 0
   struct Equations;  ///< derivative() as the steppers call it (detail::Derivative)
   std::unique_ptr<Equations> equations_;

@@ -353,6 +353,7 @@ Scenario loadScenario(const std::string& path) {
     if (target.has("grasp")) target.at("grasp").fail("the grasp frame is the robot's field: robot.grasp.target_frame");
     s.capture.law = laws::law(top.at("law"), s.capture.has_normal);
     if (top.at("law").at("type").text() == "compliant") s.compliant = laws::compliantLaw(top.at("law"));
+    laws::graspLimit(top.at("law"), s.max_grasp_force, s.max_grasp_moment);
   } else if (!top.has("simulation")) {
     top.fail("a scenario without target and law is a plain motion: it needs a simulation section");
   }

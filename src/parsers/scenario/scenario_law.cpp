@@ -12,7 +12,8 @@ using fields::echo;
 using fields::Field;
 
 CompliantGrasp compliantLaw(const Field& f) {
-  f.onlyKeys({"type", "normal", "stiffness", "damping", "damping_time", "catch_tolerance", "max_duration", "lock"});
+  f.onlyKeys({"type", "normal", "stiffness", "damping", "damping_time", "catch_tolerance", "max_duration", "lock",
+              "max_grasp_wrench"});
   CompliantGrasp g;
   const auto six = [&](const char* key, bool zero_ok) {
     const Vector6d v = f.at(key).vector(6);
@@ -55,6 +56,23 @@ CompliantGrasp compliantLaw(const Field& f) {
   return g;
 }
 
+void graspLimit(const Field& f, double& force, double& moment) {
+  if (!f.has("max_grasp_wrench")) return;
+  const Field limit = f.at("max_grasp_wrench");
+  const std::string type = f.at("type").text();
+  if (type != "capture" && type != "compliant" && type != "translational")
+    limit.fail("a " + type + " impact holds nothing after it: the grasp's limit goes with a capture or compliant law");
+  limit.onlyKeys({"force", "moment"});
+  if (!limit.has("force") && !limit.has("moment")) limit.fail("give force [N], moment [N m], or both");
+  const auto positive = [&](const char* key, double& value) {
+    if (!limit.has(key)) return;
+    value = limit.at(key).number();
+    if (!(value > 0.0)) limit.at(key).fail("must be > 0, got " + number(value));
+  };
+  positive("force", force);
+  positive("moment", moment);
+}
+
 ImpactLaw law(const Field& f, bool& has_normal) {
   ImpactLaw l;
   if (f.at("type").text() == "compliant") {  // the impulsive limit: a rigid capture
@@ -62,7 +80,7 @@ ImpactLaw law(const Field& f, bool& has_normal) {
     if (has_normal) l.normal = f.at("normal").vector(3).normalized();
     return l;
   }
-  f.onlyKeys({"type", "normal", "restitution", "friction"});
+  f.onlyKeys({"type", "normal", "restitution", "friction", "max_grasp_wrench"});
   const std::string type = f.at("type").text();
   if (type == "capture") l.kind = ImpactKind::Capture;
   else if (type == "point") l.kind = ImpactKind::PointImpact;

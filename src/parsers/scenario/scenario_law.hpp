@@ -12,6 +12,10 @@ namespace kdl_space::laws {
 /// limit, a rigid capture.
 ImpactLaw law(const fields::Field& f, bool& has_normal);
 
+/// `law.max_grasp_wrench: {force, moment}` into `force` [N] and `moment` [N m] (each left as it
+/// is when not given); refused with a law that holds nothing (a point or frictional impact).
+void graspLimit(const fields::Field& f, double& force, double& moment);
+
 /// `law: {type: compliant}`: the hand's spring-damper, every field optional (CompliantGrasp's
 /// defaults, a stiff gripper).
 CompliantGrasp compliantLaw(const fields::Field& f);

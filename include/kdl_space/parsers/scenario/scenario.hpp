@@ -96,6 +96,10 @@ struct Scenario {
   /// `law: {type: compliant, ...}`: the hand's spring-damper (docs/COMPLIANT.md); capture.law is
   /// then the rigid capture (ImpactKind::Capture), the impulsive limit reported beside it.
   std::optional<CompliantGrasp> compliant;
+  /// `law.max_grasp_wrench: {force, moment}`: the load the grasp may carry [N], [N m] (infinite
+  /// when not given), against the motion's peak grasp wrench (MotionRecord::peak_grasp_force).
+  double max_grasp_force = std::numeric_limits<double>::infinity();
+  double max_grasp_moment = std::numeric_limits<double>::infinity();
   /// The `approach` section: the robot starts from its initial state, reaches the grasp point on
   /// the moving target, and the law applies at the contact instant, from the states then. For a
   /// free-floating robot target its `grasp` is in the frame of target.contact's link, its origin
