@@ -37,6 +37,8 @@ int Simulator::actuate(double t, const Vector& x) {
     else
       tau_control_(j) = c.mode == JointControl::Mode::PD ? c.kp * (c.set_point - q(j)) - c.kd * qdot(j) : 0.0;
   }
+  if (impedance_.on)  // the driven joints': J^T F, the grasp's impedance
+    if (const int rc = impedanceTorques(qdot)) return rc;
   if (callback_) {
     SetToZero(tau_extra_);
     callback_(scratch_, tau_extra_);
@@ -207,6 +209,8 @@ int Simulator::startRun(SimulationState& s) {
   applyLocks();
   if (distribution_.on)
     if (const int rc = distributionGains(s)) return rc;
+  if (impedance_.on)
+    if (const int rc = impedanceStart(s)) return rc;
   // The Coulomb regularisation of each joint, from its apparent inertia here.
   std::fill(friction_velocity_.begin(), friction_velocity_.end(), options_.friction_velocity);
   bool any_friction = false;

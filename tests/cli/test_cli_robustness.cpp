@@ -201,7 +201,10 @@ const std::vector<Broken>& corpus() {
        false},
       {"grasp_limit_not_positive.yaml", "{f}:17: law.max_grasp_wrench.moment: must be > 0, got -5", false},
       {"after_capture_unknown_law.yaml",
-       "{f}:21: simulation.after_capture.law: 'detumble' is not one of hold, momentum_distribution", false},
+       "{f}:21: simulation.after_capture.law: 'detumble' is not one of hold, momentum_distribution, impedance", false},
+      {"impedance_without_damping.yaml",
+       "{f}:21: simulation.after_capture.damping: the arm is a damper at the grasp: give it some damping", false},
+      {"impedance_gain_on_hold.yaml", "{f}:20: simulation.after_capture.stiffness: is impedance's: the law is hold", false},
       {"distribution_without_servos.yaml",
        "{f}:23: simulation.after_capture.law: momentum_distribution drives the arm's servos: give the robot's joints "
        "pd servos in simulation.joints (the law drives their rates, at after_capture.bandwidth)",

@@ -388,6 +388,49 @@ TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
   EXPECT_GT(last.qd.cwiseAbs().maxCoeff(), 0.0) << f.name;
 }
 
+// simulate under impedance (simulation.after_capture, issue 39) with a grasp limit: the momentum is
+// the capture's (1e-9), the work counted balances the energy, the joints dissipate, and the grasp's
+// load is the held box's momentum rate (tests/support/grasp_route.hpp) under the law's torques. A
+// robot without joints has no servo for the law: refused, naming the field.
+TEST_P(Families, ImpedanceKeepsTheMomentumOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const std::string path = writeScenario(f, "{type: capture, max_grasp_wrench: {force: 2, moment: 1}}", "impedance");
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.rfind("impedance"), 9, "");  // the tag writeScenario appended
+  text = std::regex_replace(text, std::regex("simulation: \\{[^\n]*\\}\n"),
+                            "simulation:\n  duration: 0.5\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
+                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
+                            "  after_capture: {law: impedance, stiffness: [20, 5], damping: [50, 10]}\n");
+  std::ofstream(path) << text;
+  if (f.joints == 0) {
+    try {
+      loadScenario(path);
+      ADD_FAILURE() << f.name << ": a robot without joints was given a law for its servos";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("simulation.joints"), std::string::npos) << e.what();
+    }
+    return;
+  }
+  const Scenario sc = loadScenario(path);
+  ASSERT_EQ(sc.simulation.after_capture, SimulationSpec::Law::Impedance) << f.name;
+  const OperationResult r = runCaptureOperation(sc);
+  ASSERT_TRUE(r.capture);
+  ASSERT_FALSE(r.samples.empty());
+  const Vector6d h0 = r.capture->momentum_after;
+  for (const MotionSample& x : r.samples)
+    EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
+  const MotionSample& last = r.samples.back();
+  EXPECT_NEAR(last.T - r.samples.front().T, last.work.sum(), 1e-9 * (r.samples.front().T + 1)) << f.name;
+  EXPECT_LE(last.work(0), 0.0) << f.name << ": the law's work";
+  const std::optional<HeldTarget> held = heldTarget(r);
+  ASSERT_TRUE(held) << f.name;
+  for (const MotionSample& x : r.samples) {
+    const Vector6d route = graspWrenchByMomentumRate(r.model, *held, x);
+    EXPECT_TRUE(near(x.grasp_wrench, route, 0.0, 1e-7 * (route.norm() + 1e-3), f.name + " grasp load at t = " + std::to_string(x.t)));
+  }
+}
+
 // ik: a pose the contact frame had at another configuration is reached, as measured by KDL's
 // virtual-joint tree of the uncoupled robot (its mimic joints where their leaders put them); a
 // robot without joints on the chain is refused, saying so.

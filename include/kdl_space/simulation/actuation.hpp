@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kdl_space/export.hpp"
+#include "kdl_space/multibody/model.hpp"
 #include "kdl_space/spatial/spatial.hpp"
 
 namespace kdl_space {
@@ -134,6 +135,32 @@ struct MomentumDistribution {
   Eigen::VectorXd rate_limit;    ///< model order [rad/s or m/s]; infinity: none
   double unload_gain = 0.0;      ///< [1/s], >= 0
   double bandwidth = 20.0;       ///< the rate servos' [1/s], > 0
+};
+
+/// \brief The post-capture law `impedance`: the arm as a spring-damper at the grasp, so that the
+/// hand yields to the held target instead of stopping it at once (a Cartesian impedance without
+/// force sensing). The joints it drives (`joints`, PD joints of the simulator, whose servos it
+/// replaces) get tau = J^T F + tau_N, J the fixed-base Jacobian of `contact` over them (world axes,
+/// the twist of the contact point the joints alone give it), with
+///   F = -K e - D J qdot,
+/// e the contact frame's displacement from its pose relative to the base at the start of the run
+/// (the position; the rotation vector), in world axes; K = diag(stiffness(0) I, stiffness(1) I),
+/// D alike. F's force and moment are each scaled down to max_force and max_moment (the grasp's
+/// limit, law.max_grasp_wrench): the arm gives way rather than pass it. The driven joints' self-
+/// motion (a redundant arm's) is damped by tau_N = -P Kd P qdot, Kd the servos' kd, P = I - B+ B
+/// over the driven joints, B (6 x driven) the hand's acceleration per unit joint torque from rest
+/// with the base free (H*^-1 by the dynamics): B tau_N = 0, so it accelerates no hand and loads no
+/// grasp, and it only dissipates. Zero for an arm of 6 joints or fewer at full rank.
+struct GraspImpedance {
+  bool on = false;
+  std::vector<bool> joints;  ///< model order: driven by the law
+  Contact contact;           ///< the grasp: the robot's contact point in the model that moves
+  /// (translation [N/m], rotation [N m/rad]), >= 0
+  Eigen::Vector2d stiffness = Eigen::Vector2d::Zero();
+  /// (translation [N s/m], rotation [N m s/rad]), >= 0, not both 0
+  Eigen::Vector2d damping = Eigen::Vector2d::Zero();
+  double max_force = std::numeric_limits<double>::infinity();   ///< [N]
+  double max_moment = std::numeric_limits<double>::infinity();  ///< [N m]
 };
 
 /// \brief An external wrench on a body over a time window (a thruster firing, a push): the force

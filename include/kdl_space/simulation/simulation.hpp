@@ -174,6 +174,12 @@ class KDL_SPACE_EXPORT Simulator {
   /// model's joints, a rate limit that is not > 0, a negative or non-finite gain, or a grounded base.
   void setMomentumDistribution(const MomentumDistribution& law);
   const MomentumDistribution& momentumDistribution() const { return distribution_; }
+  /// \brief The post-capture law impedance (GraspImpedance); off: the joints' own controls.
+  /// \throws ModelError for a driven joint that is no PD joint, sizes unlike the model's joints, a
+  /// contact off the model, a negative or non-finite gain, no damping, a limit not > 0, or together
+  /// with momentum_distribution.
+  void setGraspImpedance(const GraspImpedance& law);
+  const GraspImpedance& graspImpedance() const { return impedance_; }
   /// \brief The reactionless rates at s (MomentumDistribution): the driven joints' qdot_d (the
   /// others 0), as the law computes them. For a caller that checks the law. \return 0,
   /// E_SIZE_MISMATCH, E_BAD_ARGUMENT (the law off) or a code of the dynamics.
@@ -333,6 +339,21 @@ class KDL_SPACE_EXPORT Simulator {
   Eigen::MatrixXd wheel_split_;  ///< A+ (m x 3): the least-norm split of a torque among the wheels
   Eigen::VectorXd wheel_u_;      ///< the wheels' motor torques at the last actuate()
   MomentumDistribution distribution_;
+  GraspImpedance impedance_;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> impedance_J_;  ///< 6 x n: the contact's fixed-base Jacobian
+  Matrix3d impedance_R0_ = Matrix3d::Identity();   ///< the contact frame relative to the base at the start
+  Vector3d impedance_p0_ = Vector3d::Zero();
+  Eigen::VectorXd impedance_tau_, impedance_kdq_, impedance_along_;  ///< n: workspaces
+  /// 6 x n: the hand's acceleration per unit torque of each driven joint from rest (H*^-1 through
+  /// the dynamics): the self-motion's damping is kept out of its range, so it loads no grasp.
+  Eigen::Matrix<double, 6, Eigen::Dynamic> impedance_B_;
+  FloatingVelocity impedance_rest_;
+  KDL::JntArray impedance_unit_;
+  FloatingAcceleration impedance_acc_;
+  /// impedance's torques at the state of kin_ into tau_control_ (the driven joints').
+  int impedanceTorques(const KDL::JntArray& qdot);
+  /// impedance's reference: the contact frame relative to the base at s.
+  int impedanceStart(const SimulationState& s);
   /// At kin_ and scratch_ (unpacked, with its links' momentum h_links_): the law's rates into
   /// distribution_rates_, and the links' angular momentum about the CoM into L_g_.
   int distributionRates();

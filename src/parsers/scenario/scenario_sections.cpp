@@ -143,11 +143,29 @@ ScheduledWrench wrench(const Field& f, const FloatingModel& robot) {
 /// attitude control, so it needs both.
 void afterCapture(const Field& section, SimulationSpec& s) {
   const Field f = section.at("after_capture");
-  f.onlyKeys({"law", "unload_gain", "bandwidth"});
+  f.onlyKeys({"law", "unload_gain", "bandwidth", "stiffness", "damping"});
   const Field law = f.at("law");
   if (law.text() == "hold") s.after_capture = SimulationSpec::Law::Hold;
   else if (law.text() == "momentum_distribution") s.after_capture = SimulationSpec::Law::MomentumDistribution;
-  else law.fail(echo(law.text()) + " is not one of hold, momentum_distribution");
+  else if (law.text() == "impedance") s.after_capture = SimulationSpec::Law::Impedance;
+  else law.fail(echo(law.text()) + " is not one of hold, momentum_distribution, impedance");
+  const bool impedance = s.after_capture == SimulationSpec::Law::Impedance;
+  for (const auto& [key, value] : {std::pair{"stiffness", &s.impedance_stiffness}, std::pair{"damping", &s.impedance_damping}}) {
+    if (!f.has(key)) continue;
+    if (!impedance) f.at(key).fail("is impedance's: the law is " + law.text());
+    *value = f.at(key).vector(2);
+    if ((value->array() < 0.0).any())
+      f.at(key).fail("each value must be >= 0 (translation, rotation), got " + number(value->minCoeff()));
+  }
+  if (impedance) {
+    if (!(s.impedance_damping.maxCoeff() > 0.0)) f.at("damping").fail("the arm is a damper at the grasp: give it some damping");
+    bool servo = false;
+    for (const auto& [j, c] : s.joints) servo = servo || c.mode == JointControl::Mode::PD;
+    if (!servo)
+      law.fail("impedance drives the arm's servos: give the robot's joints pd servos in simulation.joints (the law "
+               "replaces them; their kd damps a redundant arm's self-motion)");
+    if (s.grounded.value_or(false)) law.fail("impedance holds the target on a free base; this base is grounded");
+  }
   if (f.has("unload_gain")) {
     if (s.after_capture != SimulationSpec::Law::MomentumDistribution)
       f.at("unload_gain").fail("is momentum_distribution's: the law is " + law.text());

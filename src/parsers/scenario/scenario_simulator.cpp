@@ -59,6 +59,20 @@ std::unique_ptr<Simulator> makeSimulator(const Scenario& sc, const std::shared_p
       if (control.mode == JointControl::Mode::PD) law.joints[jointIn(joint)] = true;
     sim->setMomentumDistribution(law);
   }
+  if (!approach && spec.after_capture == SimulationSpec::Law::Impedance) {
+    GraspImpedance law;  // over the robot's PD servos, at its contact point, within the grasp's limit
+    law.on = true;
+    law.joints.assign(model->nj(), false);
+    for (const auto& [joint, control] : spec.joints)
+      if (control.mode == JointControl::Mode::PD) law.joints[jointIn(joint)] = true;
+    law.contact.body = model->bodyIndex(robot.model->bodies()[robot.contact.body].name);
+    law.contact.offset = robot.contact.offset;
+    law.stiffness = spec.impedance_stiffness;
+    law.damping = spec.impedance_damping;
+    law.max_force = sc.max_grasp_force;
+    law.max_moment = sc.max_grasp_moment;
+    sim->setGraspImpedance(law);
+  }
   for (ScheduledWrench w : spec.wrenches) {
     w.body = static_cast<unsigned int>(model->bodyIndex(robot.model->bodies()[w.body].name));
     sim->addWrench(w);

@@ -43,10 +43,14 @@ struct SimulationSpec {
   enum class Law {
     Hold,                  ///< `hold`: the joints' controls as `joints` gives them (the default)
     MomentumDistribution,  ///< `momentum_distribution`: MomentumDistribution over the robot's PD joints
+    Impedance,             ///< `impedance`: GraspImpedance over the robot's PD joints, at its contact
   };
   Law after_capture = Law::Hold;
   double unload_gain = 0.2;  ///< momentum_distribution's [1/s]
   double bandwidth = 20.0;   ///< momentum_distribution's rate servos' [1/s]
+  /// impedance's (translation [N/m], rotation [N m/rad]) and (translation [N s/m], rotation [N m s/rad])
+  Eigen::Vector2d impedance_stiffness{50.0, 20.0};
+  Eigen::Vector2d impedance_damping{100.0, 40.0};
   /// `detumble_rate`: the base's angular rate below which the stack counts as detumbled
   /// (MotionRecord::detumble, MotionMeasures::time_to_detumble) [rad/s]
   double detumble_rate = 1e-3;
