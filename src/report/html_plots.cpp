@@ -21,7 +21,8 @@ using namespace page;
 /// [deg/s], the robot's joint rates and torques (NaN for a joint the sample's system lacks), |P|,
 /// |L| (about the world origin), the kinetic energy T and its balance T - T_0 - work (T_0 at the
 /// phase's first sample: the balance restarts at the capture, as the --plot's), the base
-/// control's torque (world axes), and the reaction wheels' momenta (NaN where a sample has none).
+/// control's torque (world axes), the reaction wheels' momenta (NaN where a sample has none), and
+/// the grasp's load |f|, |n| (MotionSample::grasp_wrench; NaN where nothing is held).
 void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_far, const MotionSample& x) {
   const std::vector<std::string>& robot = sc_.capture.robot.model->jointNames();
   if (series_model_ != so_far.model.get()) {
@@ -51,6 +52,8 @@ void HtmlWriter::appendSeries(std::vector<float>& f, const OperationResult& so_f
   const Eigen::Index wheels = sc_.base_actuators.wheels.count();
   for (Eigen::Index i = 0; i < wheels; ++i)
     f.push_back(x.wheel_momentum.size() == wheels ? static_cast<float>(x.wheel_momentum(i)) : std::nanf(""));
+  if (holdsTarget(sc_))  // the grasp's load: NaN where nothing is held (the approach)
+    for (double v : {x.grasp_wrench.head<3>().norm(), x.grasp_wrench.tail<3>().norm()}) f.push_back(static_cast<float>(v));
   series_size_ = f.size() - series_at_;
 }
 
@@ -88,6 +91,9 @@ void HtmlWriter::plotsJson(Json& data, const OperationResult& r) {
   std::vector<std::string> wheels;
   for (Eigen::Index i = 1; i <= sc_.base_actuators.wheels.count(); ++i) wheels.push_back("h_" + std::to_string(i));
   if (!wheels.empty()) plot("wheel momentum", "reaction wheels' momenta [N m s]", wheels, 13 + 2 * nj);
+  if (holdsTarget(sc_))
+    plot("grasp load", "grasp load on the hand: |f| [N], |n| about the contact point [N m]", {"|f|", "|n|"},
+         13 + 2 * nj + wheels.size());
   std::vector<float> series;
   series.reserve(n * columns.size());
   for (std::size_t k = 0; k < n; ++k)
