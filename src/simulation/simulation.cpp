@@ -172,7 +172,7 @@ int Simulator::energyAndMomentum(const SimulationState& s, double& T, Vector6d& 
   return E_NOERROR;
 }
 
-int Simulator::actuation(SimulationState& s) {
+int Simulator::packOutside(const SimulationState& s) {
   const unsigned int n = model().nj();
   if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
   if (!std::isfinite(s.t)) return E_NOT_FINITE;
@@ -180,6 +180,12 @@ int Simulator::actuation(SimulationState& s) {
   Vector6d h_O;
   if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
   pack(s, h_O, x_tmp_);  // x_tmp_: a stage's workspace, free between steps
+  return E_NOERROR;
+}
+
+int Simulator::actuation(SimulationState& s) {
+  const unsigned int n = model().nj();
+  if (const int rc = packOutside(s)) return rc;
   if (const int rc = unpack(x_tmp_, s.t, scratch_)) return rc;
   if (const int rc = actuate(s.t, x_tmp_)) return rc;
   if (s.tau.rows() != n) s.tau = KDL::JntArray(n);
@@ -191,14 +197,8 @@ int Simulator::actuation(SimulationState& s) {
 
 int Simulator::accelerations(const SimulationState& s, Kinematics& kin, FloatingAcceleration& a,
                              std::vector<KDL::Wrench>& f_ext) {
-  const unsigned int n = model().nj();
-  if (s.state.q.rows() != n || s.velocity.qdot.rows() != n) return E_SIZE_MISMATCH;
-  if (!std::isfinite(s.t)) return E_NOT_FINITE;
-  double T;
-  Vector6d h_O;
-  if (const int rc = energyAndMomentum(s, T, h_O)) return rc;
-  pack(s, h_O, x_tmp_);  // x_tmp_, dx_tmp_: a stage's workspaces, free between steps
-  dx_tmp_.resize(x_tmp_.size());
+  if (const int rc = packOutside(s)) return rc;
+  dx_tmp_.resize(x_tmp_.size());  // free between steps, as x_tmp_
   if (const int rc = derivative(s.t, x_tmp_, dx_tmp_)) return rc;
   kin = kin_;
   a = acc_;

@@ -350,22 +350,20 @@ TEST_P(Families, ReactionWheelsTakeMomentumAndKeepTheTotal) {
   EXPECT_GT(r.record.stats.wheel_saturation_time, 0.0) << f.name;
 }
 
-// simulate under momentum_distribution (simulation.after_capture) with three wheels: the momentum
-// of links and wheels is the capture's (1e-9), the work counted balances the energy, and the
-// robot's joints run at the law's rates (none at rest: the stack's spin is in them). A robot
-// without joints has no servo for the law: refused, naming the field.
-TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
-  const ModelFamily& f = GetParam();
-  const std::string path = writeScenario(f, "{type: capture}", "distribution");
+/// The family's capture under `law`, `robot_extra` lines in its robot section, and 0.5 s of motion
+/// with servos holding the capture (kp 50, kd 20) and `simulation_extra`: the momentum is the
+/// capture's at every sample (1e-9) and the work counted balances the energy. A robot without
+/// joints has no servo for a post-capture law: refused, naming simulation.joints (none returned).
+std::optional<OperationResult> runUnderLaw(const ModelFamily& f, const std::string& law, const std::string& robot_extra,
+                                           const std::string& simulation_extra) {
+  const std::string path = writeScenario(f, law, simulation_extra);
   std::ifstream in(path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  text.insert(text.find("  contact:"), "  base_actuators: {wheels: {torque_limit: 10, capacity: 10}}\n");
-  text.replace(text.rfind("distribution"), 12, "");  // the tag writeScenario appended
+  text.resize(text.size() - simulation_extra.size());  // the tag writeScenario appended
+  text.insert(text.find("  contact:"), robot_extra);
   text = std::regex_replace(text, std::regex("simulation: \\{[^\n]*\\}\n"),
                             "simulation:\n  duration: 0.5\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
-                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
-                            "  base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}\n"
-                            "  after_capture: {law: momentum_distribution}\n");
+                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n" + simulation_extra);
   std::ofstream(path) << text;
   if (f.joints == 0) {
     try {
@@ -374,18 +372,30 @@ TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("simulation.joints"), std::string::npos) << e.what();
     }
-    return;
+    return std::nullopt;
   }
-  const Scenario sc = loadScenario(path);
-  const OperationResult r = runCaptureOperation(sc);
-  ASSERT_TRUE(r.capture);
-  ASSERT_FALSE(r.samples.empty());
+  OperationResult r = runCaptureOperation(loadScenario(path));
+  EXPECT_TRUE(r.capture && !r.samples.empty()) << f.name;
+  if (!r.capture || r.samples.empty()) return std::nullopt;
   const Vector6d h0 = r.capture->momentum_after;
   for (const MotionSample& x : r.samples)
     EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
   const MotionSample& last = r.samples.back();
   EXPECT_NEAR(last.T - r.samples.front().T, last.work.sum(), 1e-9 * (r.samples.front().T + 1)) << f.name;
-  EXPECT_GT(last.qd.cwiseAbs().maxCoeff(), 0.0) << f.name;
+  return r;
+}
+
+// simulate under momentum_distribution (simulation.after_capture) with three wheels: the momentum
+// of links and wheels is the capture's (1e-9), the work counted balances the energy, and the
+// robot's joints run at the law's rates (none at rest: the stack's spin is in them). A robot
+// without joints has no servo for the law: refused, naming the field.
+TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
+  const ModelFamily& f = GetParam();
+  const std::optional<OperationResult> r = runUnderLaw(
+      f, "{type: capture}", "  base_actuators: {wheels: {torque_limit: 10, capacity: 10}}\n",
+      "  base_control: {attitude: {kp: 5, kd: 40, set_point: hold}}\n  after_capture: {law: momentum_distribution}\n");
+  if (!r) return;  // no joints: refused
+  EXPECT_GT(r->samples.back().qd.cwiseAbs().maxCoeff(), 0.0) << f.name;
 }
 
 // simulate under impedance (simulation.after_capture, issue 39) with a grasp limit: the momentum is
@@ -394,35 +404,12 @@ TEST_P(Families, MomentumDistributionKeepsTheMomentumOrSaysWhyNot) {
 // robot without joints has no servo for the law: refused, naming the field.
 TEST_P(Families, ImpedanceKeepsTheMomentumOrSaysWhyNot) {
   const ModelFamily& f = GetParam();
-  const std::string path = writeScenario(f, "{type: capture, max_grasp_wrench: {force: 2, moment: 1}}", "impedance");
-  std::ifstream in(path);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  text.replace(text.rfind("impedance"), 9, "");  // the tag writeScenario appended
-  text = std::regex_replace(text, std::regex("simulation: \\{[^\n]*\\}\n"),
-                            "simulation:\n  duration: 0.5\n  output_step: 0.1\n  rtol: 1.0e-10\n  atol: 1.0e-12\n"
-                            "  joints: {\"*\": {pd: {kp: 50, kd: 20, set_point: hold}}}\n"
-                            "  after_capture: {law: impedance, stiffness: [20, 5], damping: [50, 10]}\n");
-  std::ofstream(path) << text;
-  if (f.joints == 0) {
-    try {
-      loadScenario(path);
-      ADD_FAILURE() << f.name << ": a robot without joints was given a law for its servos";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("simulation.joints"), std::string::npos) << e.what();
-    }
-    return;
-  }
-  const Scenario sc = loadScenario(path);
-  ASSERT_EQ(sc.simulation.after_capture, SimulationSpec::Law::Impedance) << f.name;
-  const OperationResult r = runCaptureOperation(sc);
-  ASSERT_TRUE(r.capture);
-  ASSERT_FALSE(r.samples.empty());
-  const Vector6d h0 = r.capture->momentum_after;
-  for (const MotionSample& x : r.samples)
-    EXPECT_TRUE(near(x.h, h0, 0, 1e-9 * (h0.norm() + 1), f.name + " momentum at t = " + std::to_string(x.t)));
-  const MotionSample& last = r.samples.back();
-  EXPECT_NEAR(last.T - r.samples.front().T, last.work.sum(), 1e-9 * (r.samples.front().T + 1)) << f.name;
-  EXPECT_LE(last.work(0), 0.0) << f.name << ": the law's work";
+  const std::optional<OperationResult> run =
+      runUnderLaw(f, "{type: capture, max_grasp_wrench: {force: 2, moment: 1}}", "",
+                  "  after_capture: {law: impedance, stiffness: [20, 5], damping: [50, 10]}\n");
+  if (!run) return;  // no joints: refused
+  const OperationResult& r = *run;
+  EXPECT_LE(r.samples.back().work(0), 0.0) << f.name << ": the law's work";
   const std::optional<HeldTarget> held = heldTarget(r);
   ASSERT_TRUE(held) << f.name;
   for (const MotionSample& x : r.samples) {

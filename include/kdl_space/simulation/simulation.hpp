@@ -282,6 +282,8 @@ class KDL_SPACE_EXPORT Simulator {
   /// The integrated state's vectors and stepper sized for the joints and wheels.
   void sizeState();
   void pack(const SimulationState& s, const Vector6d& h_O, Vector& x) const;
+  /// A state given from outside a run (its sizes and t checked, its momentum computed) into x_tmp_.
+  int packOutside(const SimulationState& s);
   int unpack(const Vector& x, double t, SimulationState& s);
   /// unpack() into the scratch state with its torques and work, then copied into s only if it
   /// succeeds.
