@@ -69,6 +69,8 @@ def test_tool_prints_what_it_printed_before_the_operation_moved_into_the_library
                                                            "wheel_momentum_fraction", "energy_dissipated"}
         # ... and the grasp's load (issue 39): null where the law lets the target go; its values:
         # tests/operation/test_grasp_load.cpp, tests/cli/test_cli_simulate.cpp.
+        torques = now["simulation"].pop("joint_torques")  # peak |tau| per joint against its effort limit
+        assert [t["joint"] for t in torques] == now["simulation"]["joint_names"], torques
         load = now["simulation"].pop("grasp_load")
         assert load is None or (load["peak_force"] >= 0.0 and load["max_force"] is None), load
     if now.get("capture"):

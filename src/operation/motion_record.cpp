@@ -30,6 +30,10 @@ void MotionRecord::add(const MotionSample& x) {
   detumble.add(x.t, rate);
   peak_base_rate = std::max(peak_base_rate, rate);
   grasp.add(x);
+  if (x.tau.size() > 0) {
+    if (peak_torque.size() != x.tau.size()) peak_torque.setZero(x.tau.size());
+    peak_torque = peak_torque.cwiseMax(x.tau.cwiseAbs());
+  }
   const Eigen::Quaterniond q0(first.quat(3), first.quat(0), first.quat(1), first.quat(2));
   attitude_excursion = std::max(attitude_excursion, q0.angularDistance(Eigen::Quaterniond(x.quat(3), x.quat(0), x.quat(1), x.quat(2))));
   max_linear_momentum_change = std::max(max_linear_momentum_change, (x.h.head<3>() - first.h.head<3>()).norm());

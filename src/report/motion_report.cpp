@@ -44,6 +44,21 @@ Json saturationJson(const MotionRecord& r) {
               {"base_control_time", r.stats.base_saturation_time}};
 }
 
+Json jointTorquesJson(const MotionRecord& r) {
+  const FloatingModel& m = *r.model;
+  Json joints = Json::array();
+  for (std::size_t j = 0; j < m.nj(); ++j) {
+    const double peak = static_cast<Eigen::Index>(j) < r.peak_torque.size() ? r.peak_torque(static_cast<Eigen::Index>(j)) : 0.0;
+    const double effort = m.jointProperties()[j].effort;
+    const bool limited = std::isfinite(effort) && effort > 0.0;
+    joints.push_back(Json{{"joint", m.jointNames()[j]},
+                          {"peak_torque", peak},
+                          {"effort_limit", limited ? Json(effort) : Json(nullptr)},
+                          {"fraction_of_effort", limited ? Json(peak / effort) : Json(nullptr)}});
+  }
+  return joints;
+}
+
 Json energySplitJson(const MotionRecord& r) {
   const MotionSample& first = r.first;
   const MotionSample& last = r.last;
@@ -175,6 +190,16 @@ void printMotionReport(std::ostream& out, const MotionRecord& r) {
           << r.stats.wheel_saturation_first_time << " s";
     out << "\n";
   }
+  Eigen::Index worst = -1;  // the joint nearest its effort limit
+  double fraction = 0.0;
+  for (Eigen::Index j = 0; j < r.peak_torque.size(); ++j) {
+    const double effort = m.jointProperties()[static_cast<std::size_t>(j)].effort;
+    if (std::isfinite(effort) && effort > 0.0 && r.peak_torque(j) / effort >= fraction) fraction = r.peak_torque(j) / effort, worst = j;
+  }
+  if (worst >= 0)
+    out << "Joint torques: at most " << 100.0 * fraction << " % of an effort limit (joint '"
+        << m.jointNames()[static_cast<std::size_t>(worst)] << "', " << r.peak_torque(worst) << " of "
+        << m.jointProperties()[static_cast<std::size_t>(worst)].effort << ")\n";
   if (r.grasp.held())
     out << "Grasp load: peak force " << r.grasp.force << " N at t = " << r.grasp.t_force << " s, peak moment "
         << r.grasp.moment << " N m at t = " << r.grasp.t_moment << " s (on the robot at its contact point)\n";

@@ -221,7 +221,8 @@ Json operationJson(const Scenario& sc, const OperationResult& r, const Operation
                          {"friction", frictionJson(record)},
                          {"wheels", wheelsJson(record)},
                          {"detumble", detumbleJson(record)},
-                         {"grasp_load", graspLoadJson(record, sc.max_grasp_force, sc.max_grasp_moment)}};
+                         {"grasp_load", graspLoadJson(record, sc.max_grasp_force, sc.max_grasp_moment)},
+                         {"joint_torques", jointTorquesJson(record)}};
   return j;
 }
 

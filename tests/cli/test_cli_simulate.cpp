@@ -2,8 +2,12 @@
 // kept, bad input fails cleanly and leaves no partial file behind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
 
 #include "cli_runner.hpp"
 #include "reference_case.hpp"
@@ -88,6 +92,25 @@ TEST(SimulateTool, WritesAReadableCsvAndPlot) {
                                  std::hypot(row[col("base_qz")], row[col("base_qw")]));
     EXPECT_NEAR(qn, 1.0, 1e-12);
   }
+  // Each joint's peak torque (simulation.joint_torques, issue 39): the largest |tau_JOINT| of the
+  // rows, against the effort limit the URDF gives it (read here with a regular expression).
+  std::ifstream urdf_in(std::string(KDL_SPACE_SOURCE_DIR) + "/urdf/space_arm7.urdf");
+  const std::string urdf((std::istreambuf_iterator<char>(urdf_in)), std::istreambuf_iterator<char>());
+  const nlohmann::json& torques = j.at("simulation").at("joint_torques");
+  ASSERT_EQ(torques.size(), joints.size());
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const nlohmann::json& t = torques[k];
+    EXPECT_EQ(t.at("joint"), joints[k]);
+    double peak = 0.0;
+    for (const auto& row : rows) peak = std::max(peak, std::abs(row[col("tau_" + joints[k])]));
+    EXPECT_NEAR(t.at("peak_torque").get<double>(), peak, 1e-15 * peak) << joints[k];
+    std::smatch effort;
+    const std::regex joint_limit("<joint name=\"" + joints[k] + "\"[\\s\\S]*?effort=\"([0-9.eE+-]+)\"");
+    ASSERT_TRUE(std::regex_search(urdf, effort, joint_limit)) << joints[k];
+    EXPECT_EQ(t.at("effort_limit").get<double>(), std::stod(effort[1])) << joints[k];
+    EXPECT_NEAR(t.at("fraction_of_effort").get<double>(), peak / std::stod(effort[1]), 1e-15) << joints[k];
+  }
+  EXPECT_GT(torques[1].at("peak_torque").get<double>(), 0.0) << "the servos hold the arm";
   // The plot is an SVG document with three panels' worth of curves.
   std::ifstream plot(svg);
   std::stringstream text;

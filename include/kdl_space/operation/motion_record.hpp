@@ -76,6 +76,7 @@ struct KDL_SPACE_EXPORT MotionRecord {
   double attitude_excursion = 0.0;  ///< max angle of R(t) R(t_0)^T over the samples [rad]
   double peak_base_rate = 0.0;      ///< max |w| of the base [rad/s]
   GraspPeak grasp;                  ///< the load the grasp carried (nothing held: NaN)
+  Eigen::VectorXd peak_torque;      ///< per joint (model order): max |tau_j| applied [N m or N]
   /// The largest fraction of its capacity a wheel used (NaN without wheels).
   double wheelMomentumFraction() const;
   /// The kinetic energy the joints' controls, friction, hard stops and the base control took out

@@ -27,6 +27,9 @@ Json wheelsJson(const MotionRecord& r);
 /// (null: not detumbled in the run), `peak_base_rate`, `final_base_rate`, `attitude_excursion`,
 /// `wheel_momentum_fraction` (null without wheels), `energy_dissipated`.
 Json detumbleJson(const MotionRecord& r);
+/// Per joint of the system that moved: its peak |tau| over the samples against its URDF effort
+/// limit ({joint, peak_torque, effort_limit, fraction_of_effort}; null where no limit is given).
+Json jointTorquesJson(const MotionRecord& r);
 /// The load the grasp carried in the motion (MotionRecord::grasp) against the law's
 /// max_grasp_wrench (infinite: null): peak force and moment, when, and their fractions of the
 /// limits; null when nothing was held.

@@ -257,7 +257,7 @@ class KDL_SPACE_EXPORT Simulator {
   /// base control, wrenches and wheels acting), with the state's kinematics into `kin` and the
   /// external wrenches per body into `f_ext` (world axes, moment about the body frame's origin;
   /// empty when none acts): what graspWrench reads. For an observer (it allocates nothing after the
-  /// first call with the same `kin`, `f_ext`).
+  /// first call with the same `kin`, `f_ext`); the torque callback is called, as by actuation().
   /// \return 0, E_SIZE_MISMATCH, E_NOT_FINITE or a code of the dynamics; outputs untouched on an error.
   int accelerations(const SimulationState& s, Kinematics& kin, FloatingAcceleration& a, std::vector<KDL::Wrench>& f_ext);
 
