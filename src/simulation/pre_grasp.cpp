@@ -3,6 +3,8 @@
 // kinematics, and the move itself.
 #include "simulation/pre_grasp.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,7 +39,13 @@ bool predictBase(const std::shared_ptr<const FloatingModel>& robot, const Simula
     return solver.compute(x) == E_NOERROR && solver.baseTwist(PL_g, qdot, twist) == E_NOERROR;
   };
   const auto advance = [](const KDL::Frame& pose, const KDL::Twist& t, double dt) {
-    return KDL::Frame(KDL::Rot(t.rot * dt) * pose.M, pose.p + t.vel * dt);
+    // exp(dt [w]) by Eigen: KDL::Rot returns the identity below an angle of 1e-6 rad
+    const Vector3d turn = toEigen(t.rot) * dt;
+    const Matrix3d R = (turn.norm() > 0.0 ? Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix()
+                                          : Matrix3d::Identity()) *
+                       toEigen(pose.M);
+    return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
+                      pose.p + t.vel * dt);
   };
   base = s.state.world_T_base;
   for (int k = 0; k < steps; ++k) {
